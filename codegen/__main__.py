@@ -1,0 +1,91 @@
+"""``python -m codegen`` writes generated/; ``python -m codegen --check`` verifies it.
+
+The check regenerates everything in memory and fails (exit 1) if any file in
+generated/ would change, naming the files.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from .emit import GENERATOR_VERSION, SIGNATURE, BallcPrinter, c_string_array, header_comment, kernel_c
+from .kernels import MASS_LAYOUT, build_kernels
+from .model import LATCH_FIELDS, LATCH_NAMES, PARAMETER_NAMES, PARAMETERS, PLANES, STATE_NAMES
+
+GENERATED = Path(__file__).resolve().parent.parent / "generated"
+
+
+def render(verbose=False) -> dict[str, str]:
+    """File name -> contents of everything in generated/."""
+    started = time.perf_counter()
+    model, kernels = build_kernels()
+    derived = time.perf_counter()
+    header = header_comment()
+    printer = BallcPrinter()
+    bodies, prototypes, sizes = [], [], []
+    total_ops = 0
+    for kernel in kernels:
+        source, ops = kernel_c(kernel, model.states, model.parameters, printer)
+        total_ops += ops
+        bodies.append(source)
+        prototypes.append(SIGNATURE.format(name=kernel.name) + ";")
+        sizes.append(f"#define BALLC_{kernel.name.upper()}_NOUT {len(kernel.outputs)}")
+        if verbose:
+            print(f"  {kernel.name:28s} {len(kernel.outputs):4d} outputs {ops:6d} ops",
+                  file=sys.stderr)
+
+    units = [p[2] for p in PARAMETERS]
+    h = [header, "#ifndef BALLC_KERNELS_H", "#define BALLC_KERNELS_H", "",
+         "/* Argument layout: the one source of truth for state and parameter order. */",
+         f"#define BALLC_GENERATOR_VERSION \"{GENERATOR_VERSION}\"",
+         f"#define BALLC_N_STATES {len(STATE_NAMES)}",
+         f"#define BALLC_N_PARAMETERS {len(PARAMETER_NAMES)}",
+         f"#define BALLC_N_LATCH {len(LATCH_NAMES)}",
+         f"#define BALLC_N_LATCH_PER_PLANE {len(LATCH_FIELDS)}",
+         f"#define BALLC_N_PLANES {len(PLANES)}",
+         f"#define BALLC_MASS_SIZE {len(MASS_LAYOUT)}",
+         *sizes, "",
+         c_string_array("BALLC_STATE_NAMES", STATE_NAMES).rstrip(),
+         c_string_array("BALLC_PARAMETER_NAMES", PARAMETER_NAMES).rstrip(),
+         c_string_array("BALLC_PARAMETER_UNITS", units).rstrip(),
+         c_string_array("BALLC_LATCH_NAMES", LATCH_NAMES).rstrip(),
+         c_string_array("BALLC_MASS_LAYOUT", MASS_LAYOUT).rstrip(),
+         "", *prototypes, "", "#endif", ""]
+    c = [header, "#include <math.h>", "#include \"ballc_kernels.h\"", "", *bodies]
+    if verbose:
+        print(f"derivation {derived - started:.1f} s, CSE + printing "
+              f"{time.perf_counter() - derived:.1f} s, {total_ops} operations in "
+              f"{len(kernels)} kernels", file=sys.stderr)
+    return {"ballc_kernels.h": "\n".join(h), "ballc_kernels.c": "\n".join(c)}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m codegen", description=__doc__)
+    parser.add_argument("--check", action="store_true",
+                        help="fail if generated/ is not what codegen/ produces")
+    parser.add_argument("--out", type=Path, default=GENERATED, help="output directory")
+    parser.add_argument("-v", "--verbose", action="store_true")
+    args = parser.parse_args(argv)
+
+    files = render(verbose=args.verbose)
+    if args.check:
+        stale = [name for name, text in files.items()
+                 if not (args.out / name).is_file()
+                 or (args.out / name).read_text() != text]
+        if stale:
+            print(f"generated/ is stale: {', '.join(stale)} differ from what codegen/ "
+                  "produces; run `python -m codegen` and commit", file=sys.stderr)
+            return 1
+        print(f"generated/ is current ({len(files)} files)")
+        return 0
+    args.out.mkdir(parents=True, exist_ok=True)
+    for name, text in files.items():
+        (args.out / name).write_text(text)
+    print(f"wrote {', '.join(files)} to {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,181 @@
+"""The mechanics of ballc: a ball with an observer particle between two planes.
+
+This is the seed's model (shared/seed/ball_between_two_planes.txt) re-derived with
+``sympy.physics.mechanics.KanesMethod`` with one deliberate change: the orientation
+is a quaternion instead of body-fixed 123 angles, so that the kinematics have no
+singularity (the seed's explicit 123-angle kinematics divide by cos q3).
+
+Conventions
+-----------
+* ``N`` inertial frame, z up; floor z = 0, ceiling z = H.
+* ``A`` ball-fixed frame; ``R = N.dcm(A)`` maps ball-frame components to inertial ones.
+* Quaternion ``(qw, qx, qy, qz)`` (Hamilton, scalar first).  ``R`` is built from the
+  quaternion divided by its squared norm, so it is a proper rotation for any
+  non-zero quaternion; the kinematics ``qdot = 1/2 [0, omega] (x) q`` (omega in
+  inertial components) preserve the norm exactly.
+* Generalized speeds as in the seed: ``omega_x, omega_y, omega_z`` (angular velocity
+  of A in N, N components) and ``vx, vy, vz`` (velocity of the centre in N).
+
+Everything here is symbolic and used at build time only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sm
+import sympy.physics.mechanics as me
+
+T = me.dynamicsymbols._t
+
+# ---------------------------------------------------------------------------
+# Names.  The order of these tuples IS the argument layout of the generated C.
+# ---------------------------------------------------------------------------
+STATE_NAMES = (
+    "qw", "qx", "qy", "qz",
+    "x", "y", "z",
+    "omega_x", "omega_y", "omega_z",
+    "vx", "vy", "vz",
+)
+
+#: (name, seed symbol, unit, description)
+PARAMETERS = (
+    ("mass", "m", "kg", "mass of the ball"),
+    ("observer_mass", "mo", "kg", "mass of the observer particle"),
+    ("gravity", "g", "m/s^2", "gravitational acceleration, along -z"),
+    ("radius", "r", "m", "radius of the ball"),
+    ("observer_alpha", "alpha", "1", "observer position along ball x, in units of r"),
+    ("observer_beta", "beta", "1", "observer position along ball y, in units of r"),
+    ("observer_gamma", "gamma", "1", "observer position along ball z, in units of r"),
+    ("inertia_xx", "iXX", "kg m^2", "central moment of inertia about ball x"),
+    ("inertia_yy", "iYY", "kg m^2", "central moment of inertia about ball y"),
+    ("inertia_zz", "iZZ", "kg m^2", "central moment of inertia about ball z"),
+    ("ceiling_height", "H", "m", "height of the ceiling plane"),
+    ("mixture", "mixtur", "1", "weight of the dig-in model, 1 - weight of friction"),
+    ("ball_poisson_ratio", "nyb", "1", "Poisson's ratio of the ball"),
+    ("plane_poisson_ratio", "nyp", "1", "Poisson's ratio of the planes"),
+    ("ball_youngs_modulus", "Eb", "Pa", "Young's modulus of the ball"),
+    ("plane_youngs_modulus", "Ep", "Pa", "Young's modulus of the planes"),
+    ("c_tau", "ctau", "1", "Hunt-Crossley restitution constant"),
+    ("friction_coefficient", "mu", "1", "Coulomb friction coefficient"),
+    ("friction_regularization_speed", "-", "m/s",
+     "slip speed below which Coulomb friction becomes viscous: max(|v_t|, this)"),
+)
+PARAMETER_NAMES = tuple(p[0] for p in PARAMETERS)
+
+#: Values latched at the start of a contact, per plane, in this order.
+LATCH_FIELDS = (
+    ("penetration_rate_at_impact", "rhodtu / rhodto",
+     "m/s", "penetration rate when the contact started"),
+    ("digin_direction_x", "ru1 / ro1", "1", "unit contact-point velocity at impact, x"),
+    ("digin_direction_y", "ru2 / ro2", "1", "unit contact-point velocity at impact, y"),
+    ("digin_direction_z", "ru3 / ro3", "1", "unit contact-point velocity at impact, z"),
+)
+PLANES = ("floor", "ceiling")
+LATCH_NAMES = tuple(f"{plane}_{f[0]}" for plane in PLANES for f in LATCH_FIELDS)
+
+
+@dataclass
+class Model:
+    """Symbols and sympy expressions of the ball model."""
+
+    states: list          # 13 dynamicsymbols in STATE_NAMES order
+    parameters: list      # sympy Symbols in PARAMETER_NAMES order
+    latches: list         # sympy Symbols in LATCH_NAMES order
+    frame: me.ReferenceFrame
+    ball_frame: me.ReferenceFrame
+    centre: me.Point
+    observer: me.Point
+    dcm: sm.Matrix        # N.dcm(A)
+    kinematics: sm.Matrix  # time derivatives of the 7 coordinates
+    p: dict = field(default_factory=dict)  # parameter name -> Symbol
+
+    @property
+    def coordinates(self):
+        return self.states[:7]
+
+    @property
+    def speeds(self):
+        return self.states[7:]
+
+
+def quaternion_dcm(qw, qx, qy, qz):
+    """Rotation matrix (ball -> inertial) of a quaternion of any non-zero norm."""
+    s = qw**2 + qx**2 + qy**2 + qz**2
+    return sm.Matrix([
+        [qw**2 + qx**2 - qy**2 - qz**2, 2*(qx*qy - qw*qz), 2*(qx*qz + qw*qy)],
+        [2*(qx*qy + qw*qz), qw**2 - qx**2 + qy**2 - qz**2, 2*(qy*qz - qw*qx)],
+        [2*(qx*qz - qw*qy), 2*(qy*qz + qw*qx), qw**2 - qx**2 - qy**2 + qz**2],
+    ]) / s
+
+
+def build_model() -> Model:
+    """Frames, points, speeds and kinematics (no forces yet)."""
+    states = list(me.dynamicsymbols(" ".join(STATE_NAMES)))
+    qw, qx, qy, qz, x, y, z, wx, wy, wz, vx, vy, vz = states
+    p = {name: sm.Symbol(name) for name in PARAMETER_NAMES}
+    latches = [sm.Symbol(name) for name in LATCH_NAMES]
+
+    N = me.ReferenceFrame("N")
+    A = me.ReferenceFrame("A")
+    R = quaternion_dcm(qw, qx, qy, qz)
+    A.orient_explicit(N, R)
+    A.set_ang_vel(N, wx*N.x + wy*N.y + wz*N.z)
+
+    O = me.Point("O")
+    O.set_vel(N, 0)
+    centre = me.Point("C")
+    centre.set_pos(O, x*N.x + y*N.y + z*N.z)
+    centre.set_vel(N, vx*N.x + vy*N.y + vz*N.z)
+
+    r = p["radius"]
+    observer = me.Point("P_o")
+    observer.set_pos(centre, r*(p["observer_alpha"]*A.x + p["observer_beta"]*A.y
+                                + p["observer_gamma"]*A.z))
+    observer.v2pt_theory(centre, N, A)
+
+    half = sm.Rational(1, 2)
+    kinematics = sm.Matrix([
+        -half*(wx*qx + wy*qy + wz*qz),
+        half*(wx*qw + wy*qz - wz*qy),
+        half*(wy*qw + wz*qx - wx*qz),
+        half*(wz*qw + wx*qy - wy*qx),
+        vx, vy, vz,
+    ])
+    return Model(states=states, parameters=[p[n] for n in PARAMETER_NAMES],
+                 latches=latches, frame=N, ball_frame=A, centre=centre,
+                 observer=observer, dcm=R, kinematics=kinematics, p=p)
+
+
+def contact_point(model: Model, plane: str) -> me.Point:
+    """The point of the ball nearest to ``plane`` ("floor" or "ceiling")."""
+    N = model.frame
+    sign = -1 if plane == "floor" else 1
+    point = me.Point(f"contact_{plane}")
+    point.set_pos(model.centre, sign*model.p["radius"]*N.z)
+    point.v2pt_theory(model.centre, N, model.ball_frame)
+    return point
+
+
+def kanes_equations(model: Model, bodies, loads):
+    """Mass matrix (6x6) and forcing (6) of the dynamic equations via KanesMethod."""
+    kd = [qd.diff(T) - rhs for qd, rhs in zip(model.coordinates, model.kinematics)]
+    km = me.KanesMethod(model.frame, q_ind=model.coordinates, u_ind=model.speeds,
+                        kd_eqs=kd)
+    km.kanes_equations(bodies, loads)
+    return km.mass_matrix, km.forcing
+
+
+def bodies(model: Model):
+    """The ball (rigid body) and the observer (particle)."""
+    p = model.p
+    inertia = me.inertia(model.ball_frame, p["inertia_xx"], p["inertia_yy"], p["inertia_zz"])
+    ball = me.RigidBody("ball", model.centre, model.ball_frame, p["mass"],
+                        (inertia, model.centre))
+    observer = me.Particle("observer", model.observer, p["observer_mass"])
+    return ball, observer
+
+
+def gravity_loads(model: Model, body):
+    """Weight of one body (ball or observer) along -z."""
+    point = body.masscenter
+    return [(point, -body.mass*model.p["gravity"]*model.frame.z)]

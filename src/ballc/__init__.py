@@ -1,0 +1,14 @@
+"""ballc: an elastic ball bouncing between two planes, with a compiled core.
+
+>>> import ballc
+>>> result = ballc.simulate(ballc.Scene(), t_end=5.0)
+>>> print(result.contact_table())
+"""
+from ._core import PARAMETER_NAMES, STATE_NAMES
+from .result import Contact, Result
+from .scene import TANGENTIAL_MODELS, Scene, SceneError
+from .simulate import simulate
+
+__version__ = "0.1.0"
+__all__ = ["Contact", "PARAMETER_NAMES", "Result", "STATE_NAMES", "Scene", "SceneError",
+           "TANGENTIAL_MODELS", "simulate"]

@@ -1,0 +1,165 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
+"""Bridge to the generated C: typed memoryviews in, C called, arrays out.
+
+Private: use the ``ballc`` package.  Every entry point checks lengths; typed
+memoryviews reject wrong dtypes and non-contiguous arrays with ValueError.
+"""
+import numpy as np
+
+cdef extern from "ballc_kernels.h":
+    int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH, BALLC_N_LATCH_PER_PLANE
+    const char *const BALLC_STATE_NAMES[]
+    const char *const BALLC_PARAMETER_NAMES[]
+    const char *const BALLC_PARAMETER_UNITS[]
+    const char *const BALLC_LATCH_NAMES[]
+    const char *BALLC_GENERATOR_VERSION
+    int BALLC_ENERGY_NOUT, BALLC_CONTACT_KINEMATICS_NOUT, BALLC_OBSERVER_POSITION_NOUT
+    void ballc_energy(const double *, const double *, const double *, double *) nogil
+    void ballc_contact_kinematics(const double *, const double *, const double *, double *) nogil
+    void ballc_observer_position(const double *, const double *, const double *, double *) nogil
+
+cdef extern from "_system.h":
+    int BALLC_WITH_OBSERVER, BALLC_FLOOR_FRICTION, BALLC_FLOOR_DIGIN
+    int BALLC_CEILING_FRICTION, BALLC_CEILING_DIGIN
+    int BALLC_OK
+    int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
+    int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
+
+N_STATES = BALLC_N_STATES
+N_PARAMETERS = BALLC_N_PARAMETERS
+N_LATCH = BALLC_N_LATCH
+N_LATCH_PER_PLANE = BALLC_N_LATCH_PER_PLANE
+STATE_NAMES = tuple(BALLC_STATE_NAMES[i].decode() for i in range(BALLC_N_STATES))
+PARAMETER_NAMES = tuple(BALLC_PARAMETER_NAMES[i].decode() for i in range(BALLC_N_PARAMETERS))
+PARAMETER_UNITS = tuple(BALLC_PARAMETER_UNITS[i].decode() for i in range(BALLC_N_PARAMETERS))
+LATCH_NAMES = tuple(BALLC_LATCH_NAMES[i].decode() for i in range(BALLC_N_LATCH))
+GENERATOR_VERSION = BALLC_GENERATOR_VERSION.decode()
+FLAGS = {
+    "observer": BALLC_WITH_OBSERVER,
+    "floor_friction": BALLC_FLOOR_FRICTION,
+    "floor_digin": BALLC_FLOOR_DIGIN,
+    "ceiling_friction": BALLC_CEILING_FRICTION,
+    "ceiling_digin": BALLC_CEILING_DIGIN,
+}
+ENERGY_NOUT = BALLC_ENERGY_NOUT
+CONTACT_KINEMATICS_NOUT = BALLC_CONTACT_KINEMATICS_NOUT
+
+
+cdef inline void _check(name, Py_ssize_t got, Py_ssize_t expected) except *:
+    if got != expected:
+        raise ValueError(f"{name} must have length {expected}, got {got}")
+
+
+DEF BALLC_MAX_STATES = 64
+
+
+cdef inline void _copy_state(const double[:] y, double *ys) except *:
+    """Copy a (possibly strided) state into a C buffer; integrators may pass views."""
+    _check("y", y.shape[0], BALLC_N_STATES)
+    cdef Py_ssize_t i
+    for i in range(y.shape[0]):
+        ys[i] = y[i]
+
+
+cdef class System:
+    """f(t, y) and its Jacobian for one integration segment.
+
+    ``params`` (N_PARAMETERS) and ``latch`` (N_LATCH) are copied; ``flags`` selects
+    the contributions (see FLAGS).  A state at which the equations cannot be
+    evaluated (non-finite values, mass matrix not positive definite) gives NaNs,
+    which makes the integrator reject the step; ``failures`` counts them.
+    """
+    cdef double[::1] _params
+    cdef double[::1] _latch
+    cdef readonly int flags
+    cdef public long nfev, njev, failures
+
+    def __init__(self, const double[::1] params, const double[::1] latch, int flags):
+        _check("params", params.shape[0], BALLC_N_PARAMETERS)
+        _check("latch", latch.shape[0], BALLC_N_LATCH)
+        self._params = np.array(params, dtype=np.float64)
+        self._latch = np.array(latch, dtype=np.float64)
+        self.flags = flags
+        self.nfev = 0
+        self.njev = 0
+        self.failures = 0
+
+    def __call__(self, double t, const double[:] y):
+        cdef double ys[BALLC_MAX_STATES]
+        _copy_state(y, ys)
+        out = np.empty(BALLC_N_STATES)
+        cdef double[::1] o = out
+        self.nfev += 1
+        if ballc_rhs(ys, &self._params[0], &self._latch[0], self.flags, &o[0]) != BALLC_OK:
+            self.failures += 1
+            out.fill(np.nan)
+        return out
+
+    def jacobian(self, double t, const double[:] y):
+        cdef double ys[BALLC_MAX_STATES]
+        _copy_state(y, ys)
+        out = np.empty((BALLC_N_STATES, BALLC_N_STATES))
+        cdef double[:, ::1] o = out
+        self.njev += 1
+        if ballc_jacobian(ys, &self._params[0], &self._latch[0], self.flags,
+                          &o[0, 0]) != BALLC_OK:
+            self.failures += 1
+            out.fill(np.nan)
+        return out
+
+
+def rhs(const double[::1] y, const double[::1] params, const double[::1] latch, int flags):
+    """State derivative (N_STATES) at one state; raises if it cannot be evaluated."""
+    _check("y", y.shape[0], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check("latch", latch.shape[0], BALLC_N_LATCH)
+    out = np.empty(BALLC_N_STATES)
+    cdef double[::1] o = out
+    cdef int status = ballc_rhs(&y[0], &params[0], &latch[0], flags, &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"right-hand side failed with C status {status}")
+    return out
+
+
+def jacobian(const double[::1] y, const double[::1] params, const double[::1] latch,
+             int flags):
+    """Jacobian (N_STATES x N_STATES) at one state; raises if it cannot be evaluated."""
+    _check("y", y.shape[0], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check("latch", latch.shape[0], BALLC_N_LATCH)
+    out = np.empty((BALLC_N_STATES, BALLC_N_STATES))
+    cdef double[:, ::1] o = out
+    cdef int status = ballc_jacobian(&y[0], &params[0], &latch[0], flags, &o[0, 0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"Jacobian failed with C status {status}")
+    return out
+
+
+ctypedef void (*kernel_fn)(const double *, const double *, const double *, double *) nogil
+
+
+cdef object _per_row(kernel_fn kernel, int nout, const double[:, ::1] states,
+                     const double[::1] params):
+    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    out = np.empty((states.shape[0], nout))
+    cdef double[:, ::1] o = out
+    cdef Py_ssize_t i
+    for i in range(states.shape[0]):
+        kernel(&states[i, 0], &params[0], NULL, &o[i, 0])
+    return out
+
+
+def energies(const double[:, ::1] states, const double[::1] params):
+    """(n, 4): kinetic, potential, spring floor, spring ceiling (J) per state row."""
+    return _per_row(ballc_energy, BALLC_ENERGY_NOUT, states, params)
+
+
+def contact_kinematics(const double[:, ::1] states, const double[::1] params):
+    """(n, 10): per plane rho, rhodot, contact-point velocity x, y, z."""
+    return _per_row(ballc_contact_kinematics, BALLC_CONTACT_KINEMATICS_NOUT, states, params)
+
+
+def observer_positions(const double[:, ::1] states, const double[::1] params):
+    """(n, 3): observer position in the inertial frame (m)."""
+    return _per_row(ballc_observer_position, BALLC_OBSERVER_POSITION_NOUT, states, params)

@@ -1,0 +1,33 @@
+/* ballc's right-hand side and Jacobian, assembled from the generated kernels.
+ *
+ * The state derivative is [kinematics (7); udot (6)] where M(q) udot = F(x) and
+ * M = [[J, B], [B^T, D I3]] (see codegen/kernels.py).  udot comes from a Schur
+ * complement: S = J - B B^T / D (symmetric positive definite) is factored by
+ * Cholesky, so no 6x6 (or 13x13) dense solve is needed.
+ */
+#ifndef BALLC_SYSTEM_H
+#define BALLC_SYSTEM_H
+
+#include "ballc_kernels.h"
+
+/* Which contributions act in the current segment (bit flags). */
+enum {
+    BALLC_WITH_OBSERVER = 1,
+    BALLC_FLOOR_FRICTION = 2,
+    BALLC_FLOOR_DIGIN = 4,
+    BALLC_CEILING_FRICTION = 8,
+    BALLC_CEILING_DIGIN = 16
+};
+
+/* Return codes. */
+enum { BALLC_OK = 0, BALLC_NOT_POSITIVE_DEFINITE = 1, BALLC_NOT_FINITE = 2 };
+
+/* xdot (13) = f(state); latch holds BALLC_N_LATCH values (floor then ceiling). */
+int ballc_rhs(const double *state, const double *params, const double *latch,
+              int flags, double *xdot);
+
+/* jac (13 x 13, row-major) = d f / d state. */
+int ballc_jacobian(const double *state, const double *params, const double *latch,
+                   int flags, double *jac);
+
+#endif

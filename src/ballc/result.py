@@ -1,0 +1,133 @@
+"""Result of a simulation: solve_ivp-shaped arrays plus named views, energies, contacts."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _core
+from .orientation import angles_123_from_quaternion
+
+
+@dataclass
+class Contact:
+    """One contact of the ball with a plane (SI units).
+
+    ``t_end`` and the ``*_after`` values are NaN when the simulation ended during
+    the contact.  Velocities are of the ball's centre; angular velocities are in
+    inertial components.
+    """
+
+    plane: str                       # "floor" or "ceiling"
+    t_start: float                   # s
+    velocity_before: np.ndarray      # m/s, at t_start
+    angular_velocity_before: np.ndarray  # rad/s, at t_start
+    penetration_rate_at_impact: float    # m/s, the latched rhodot^-
+    digin_direction: np.ndarray      # unit contact-point velocity at t_start
+    t_end: float = np.nan            # s
+    velocity_after: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
+    angular_velocity_after: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
+    max_penetration: float = 0.0     # m
+
+    @property
+    def duration(self) -> float:
+        return self.t_end - self.t_start
+
+    def as_dict(self) -> dict:
+        row = {"plane": self.plane, "t_start": self.t_start, "t_end": self.t_end,
+               "duration": self.duration, "max_penetration": self.max_penetration,
+               "penetration_rate_at_impact": self.penetration_rate_at_impact}
+        for name in ("velocity_before", "velocity_after", "angular_velocity_before",
+                     "angular_velocity_after"):
+            for axis, value in zip("xyz", getattr(self, name)):
+                row[f"{name}_{axis}"] = float(value)
+        return row
+
+
+@dataclass
+class Result:
+    """What :func:`ballc.simulate` returns, shaped like scipy's ``OdeResult``.
+
+    ``y`` has one row per state (``state_names``) and one column per time in ``t``.
+    ``status``: 0 reached t_end, 1 stopped by a terminal condition (see ``message``),
+    -1 the integrator failed; in every case the arrays hold what was computed.
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    scene: object
+    status: int
+    message: str
+    nfev: int
+    njev: int
+    nlu: int
+    contacts: list
+    state_names: tuple = _core.STATE_NAMES
+    _energy: dict | None = field(default=None, repr=False)
+
+    @property
+    def success(self) -> bool:
+        return self.status >= 0
+
+    def _rows(self, first, count=3):
+        return self.y[first:first + count]
+
+    @property
+    def quaternion(self) -> np.ndarray:
+        """(4, n) unit quaternion (qw, qx, qy, qz), ball frame -> inertial."""
+        q = self._rows(0, 4)
+        return q / np.linalg.norm(q, axis=0)
+
+    @property
+    def angles(self) -> np.ndarray:
+        """(3, n) the seed's body-fixed 123 angles q1, q2, q3 (rad), derived."""
+        return angles_123_from_quaternion(self.quaternion.T).T
+
+    @property
+    def position(self) -> np.ndarray:
+        """(3, n) centre position (m)."""
+        return self._rows(4)
+
+    @property
+    def angular_velocity(self) -> np.ndarray:
+        """(3, n) angular velocity, inertial components (rad/s)."""
+        return self._rows(7)
+
+    @property
+    def velocity(self) -> np.ndarray:
+        """(3, n) centre velocity (m/s)."""
+        return self._rows(10)
+
+    @property
+    def observer_position(self) -> np.ndarray:
+        """(3, n) position of the observer particle (m)."""
+        return _core.observer_positions(np.ascontiguousarray(self.y.T),
+                                        self.scene.parameter_vector()).T
+
+    @property
+    def energy(self) -> dict:
+        """name -> (n,) array (J): kinetic, potential, spring, total."""
+        if self._energy is None:
+            e = _core.energies(np.ascontiguousarray(self.y.T), self.scene.parameter_vector())
+            spring = e[:, 2] + e[:, 3]
+            self._energy = {"kinetic": e[:, 0], "potential": e[:, 1], "spring": spring,
+                            "total": e[:, 0] + e[:, 1] + spring}
+        return self._energy
+
+    def contact_table(self) -> str:
+        """The contacts as a fixed-width text table."""
+        head = (f"{'#':>2} {'plane':7} {'t_start':>8} {'t_end':>8} {'max pen.':>9} "
+                f"{'vx before':>10} {'vx after':>9} {'vy before':>10} {'vy after':>9} "
+                f"{'vz before':>10} {'vz after':>9}")
+        lines = [head, "-" * len(head)]
+        for i, c in enumerate(self.contacts, 1):
+            vb, va = c.velocity_before, c.velocity_after
+            lines.append(f"{i:2d} {c.plane:7} {c.t_start:8.4f} {c.t_end:8.4f} "
+                         f"{c.max_penetration:9.4f} {vb[0]:10.3f} {va[0]:9.3f} "
+                         f"{vb[1]:10.3f} {va[1]:9.3f} {vb[2]:10.3f} {va[2]:9.3f}")
+        return "\n".join(lines)
+
+    def __repr__(self):
+        return (f"Result(status={self.status}, message={self.message!r}, "
+                f"t=[{self.t[0]:g} .. {self.t[-1]:g}] ({self.t.size} points), "
+                f"contacts={len(self.contacts)}, nfev={self.nfev}, njev={self.njev})")

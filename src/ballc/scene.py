@@ -1,0 +1,220 @@
+"""Scene: every parameter and initial condition of one simulation, with units.
+
+Defaults are the seed's (shared/seed/ball_between_two_planes.txt).  SI units.
+
+=================================  ==============  ===========  ====================
+field                              seed symbol     unit         default
+=================================  ==============  ===========  ====================
+mass                               m               kg           1.0
+observer_mass                      mo              kg           1e-4
+radius                             r               m            1.0
+gravity                            g               m/s^2        9.81
+ceiling_height                     H               m            10.0
+inertia (about ball x, y, z)       iXX, iYY, iZZ   kg m^2       2/5 m r^2 each
+observer_position (ball frame)     alpha, beta,    r (radius)   (0.7, 0, 0.7)
+                                   gamma
+ball_youngs_modulus                Eb              Pa           3e3
+plane_youngs_modulus               Ep              Pa           2e10
+ball_poisson_ratio                 nyb             1            0.25
+plane_poisson_ratio                nyp             1            0.15
+c_tau                              ctau            1            0.9
+friction_coefficient               mu              1            0.1
+mixture                            mixtur          1            0.375
+tangential_model                   -               -            "mixture"
+friction_regularization_speed      (1e-10 in the   m/s          1e-10
+                                   seed's code)
+position (centre)                  m1, m2, m3      m            (0, 0, 5)
+velocity (centre)                  um1, um2, um3   m/s          (-5, 5, -25)
+angles (body-fixed 123)            q1, q2, q3      rad          (0, 0, 0)
+angular_velocity (inertial comps)  u1, u2, u3      rad/s        (0, 0, 0)
+=================================  ==============  ===========  ====================
+
+``tangential_model`` is "mixture" (force = (1 - mixture) friction + mixture dig-in),
+"friction" (mixture taken as 0) or "dig-in" (mixture taken as 1).
+The seed's latched values rhodtu, rhodto, ru1..3, ro1..3 are not parameters: ballc
+latches them itself at each contact start.
+"""
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from . import _core
+from .orientation import quaternion_from_angles_123
+
+TANGENTIAL_MODELS = ("mixture", "friction", "dig-in")
+
+#: Scene field -> seed symbol(s).
+SEED_SYMBOLS = {
+    "mass": "m", "observer_mass": "mo", "radius": "r", "gravity": "g",
+    "ceiling_height": "H", "inertia": ("iXX", "iYY", "iZZ"),
+    "observer_position": ("alpha", "beta", "gamma"),
+    "ball_youngs_modulus": "Eb", "plane_youngs_modulus": "Ep",
+    "ball_poisson_ratio": "nyb", "plane_poisson_ratio": "nyp", "c_tau": "ctau",
+    "friction_coefficient": "mu", "mixture": "mixtur",
+    "position": ("m1", "m2", "m3"), "velocity": ("um1", "um2", "um3"),
+    "angles": ("q1", "q2", "q3"), "angular_velocity": ("u1", "u2", "u3"),
+}
+
+
+class SceneError(ValueError):
+    """A scene parameter has a value ballc cannot simulate."""
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One ball between a floor (z = 0) and a ceiling (z = ceiling_height).
+
+    All quantities in SI units; see the module docstring for the table of fields,
+    units, seed symbols and defaults.  ``Scene(**fields)`` validates; invalid values
+    raise :class:`SceneError` naming the field, the value and what is allowed.
+    """
+
+    mass: float = 1.0
+    observer_mass: float = 1e-4
+    radius: float = 1.0
+    gravity: float = 9.81
+    ceiling_height: float = 10.0
+    inertia: tuple | None = None
+    observer_position: tuple = (0.7, 0.0, 0.7)
+    ball_youngs_modulus: float = 3e3
+    plane_youngs_modulus: float = 2e10
+    ball_poisson_ratio: float = 0.25
+    plane_poisson_ratio: float = 0.15
+    c_tau: float = 0.9
+    friction_coefficient: float = 0.1
+    mixture: float = 0.375
+    tangential_model: str = "mixture"
+    friction_regularization_speed: float = 1e-10
+    position: tuple = (0.0, 0.0, 5.0)
+    velocity: tuple = (-5.0, 5.0, -25.0)
+    angles: tuple = (0.0, 0.0, 0.0)
+    angular_velocity: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        for name in ("inertia", "observer_position", "position", "velocity", "angles",
+                     "angular_velocity"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            try:
+                vector = tuple(float(v) for v in value)
+            except (TypeError, ValueError):
+                raise SceneError(f"{name} must be 3 numbers, got {value!r}") from None
+            if len(vector) != 3:
+                raise SceneError(f"{name} must be 3 numbers, got {len(vector)}: {value!r}")
+            object.__setattr__(self, name, vector)
+        if self.inertia is None:
+            i = 0.4 * float(self.mass) * float(self.radius) ** 2
+            object.__setattr__(self, "inertia", (i, i, i))
+        _validate(self)
+
+    @classmethod
+    def from_dict(cls, values: dict) -> "Scene":
+        """Scene from a mapping; unknown keys raise with a suggestion."""
+        known = [f.name for f in fields(cls)]
+        for key in values:
+            if key not in known:
+                close = difflib.get_close_matches(key, known, n=1)
+                hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise SceneError(f"unknown scene field {key!r}{hint}")
+        return cls(**values)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def replace(self, **changes) -> "Scene":
+        """A copy with some fields changed (validated)."""
+        return Scene.from_dict({**self.to_dict(), **changes})
+
+    @property
+    def effective_mixture(self) -> float:
+        """Weight of the dig-in law actually used (0 for "friction", 1 for "dig-in")."""
+        return {"friction": 0.0, "dig-in": 1.0}.get(self.tangential_model, self.mixture)
+
+    @property
+    def hertz_stiffness(self) -> float:
+        """k0 = 4 / (3 (sigma_b + sigma_p)) sqrt(r), N/m^(3/2)."""
+        sigma_b = (1 - self.ball_poisson_ratio ** 2) / self.ball_youngs_modulus
+        sigma_p = (1 - self.plane_poisson_ratio ** 2) / self.plane_youngs_modulus
+        return 4.0 / (3.0 * (sigma_b + sigma_p)) * math.sqrt(self.radius)
+
+    def parameter_vector(self) -> np.ndarray:
+        """Parameters in the generated layout order (``ballc._core.PARAMETER_NAMES``)."""
+        ix, iy, iz = self.inertia
+        a, b, c = self.observer_position
+        values = {
+            "mass": self.mass, "observer_mass": self.observer_mass,
+            "gravity": self.gravity, "radius": self.radius,
+            "observer_alpha": a, "observer_beta": b, "observer_gamma": c,
+            "inertia_xx": ix, "inertia_yy": iy, "inertia_zz": iz,
+            "ceiling_height": self.ceiling_height, "mixture": self.effective_mixture,
+            "ball_poisson_ratio": self.ball_poisson_ratio,
+            "plane_poisson_ratio": self.plane_poisson_ratio,
+            "ball_youngs_modulus": self.ball_youngs_modulus,
+            "plane_youngs_modulus": self.plane_youngs_modulus,
+            "c_tau": self.c_tau, "friction_coefficient": self.friction_coefficient,
+            "friction_regularization_speed": self.friction_regularization_speed,
+        }
+        return np.array([float(values[name]) for name in _core.PARAMETER_NAMES])
+
+    def initial_state(self) -> np.ndarray:
+        """State vector in the generated layout order (``ballc._core.STATE_NAMES``)."""
+        return np.concatenate([quaternion_from_angles_123(self.angles), self.position,
+                               self.angular_velocity, self.velocity])
+
+
+def _validate(s: Scene) -> None:
+    def fail(name, value, allowed):
+        raise SceneError(f"{name} = {value!r} is not allowed: {allowed}")
+
+    def finite(name, value):
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            fail(name, value, "must be a real number")
+        if not math.isfinite(x):
+            fail(name, value, "must be finite")
+        return x
+
+    for name in ("mass", "radius", "ceiling_height", "ball_youngs_modulus",
+                 "plane_youngs_modulus", "friction_regularization_speed"):
+        if not finite(name, getattr(s, name)) > 0:
+            fail(name, getattr(s, name), "must be > 0")
+    for name in ("observer_mass", "gravity", "friction_coefficient"):
+        if not finite(name, getattr(s, name)) >= 0:
+            fail(name, getattr(s, name), "must be >= 0")
+    for name in ("ball_poisson_ratio", "plane_poisson_ratio"):
+        if not -1 < finite(name, getattr(s, name)) <= 0.5:
+            fail(name, getattr(s, name), "must be in (-1, 0.5]")
+    if not 0 < finite("c_tau", s.c_tau) <= 1:
+        fail("c_tau", s.c_tau, "must be in (0, 1]")
+    if not 0 <= finite("mixture", s.mixture) <= 1:
+        fail("mixture", s.mixture, "must be in [0, 1]")
+    if s.tangential_model not in TANGENTIAL_MODELS:
+        close = difflib.get_close_matches(str(s.tangential_model), TANGENTIAL_MODELS, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        fail("tangential_model", s.tangential_model, f"must be one of {TANGENTIAL_MODELS}{hint}")
+    if not s.ceiling_height > 2 * s.radius:
+        fail("ceiling_height", s.ceiling_height, f"must be > 2 * radius = {2 * s.radius}")
+    for name in ("inertia", "observer_position", "position", "velocity", "angles",
+                 "angular_velocity"):
+        for v in getattr(s, name):
+            finite(name, v)
+    ix, iy, iz = s.inertia
+    if min(s.inertia) <= 0:
+        fail("inertia", s.inertia, "every moment of inertia must be > 0")
+    if ix + iy < iz or iy + iz < ix or iz + ix < iy:
+        fail("inertia", s.inertia, "moments must satisfy the triangle inequality "
+             "(each <= the sum of the other two)")
+    if sum(v * v for v in s.observer_position) >= 1:
+        fail("observer_position", s.observer_position,
+             "the observer must lie strictly inside the ball (alpha^2 + beta^2 + gamma^2 < 1)")
+    z = s.position[2]
+    if not s.radius <= z <= s.ceiling_height - s.radius:
+        fail("position", s.position, f"the ball must start clear of both planes: "
+             f"{s.radius} <= z <= {s.ceiling_height - s.radius}")
+
