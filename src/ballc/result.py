@@ -67,7 +67,8 @@ class Result:
 
     @property
     def success(self) -> bool:
-        return self.status >= 0
+        """True only when t_end was reached (status 0)."""
+        return self.status == 0
 
     def _rows(self, first, count=3):
         return self.y[first:first + count]

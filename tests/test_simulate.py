@@ -1,0 +1,97 @@
+"""Whole simulations: conservation laws, the seed's published behaviour, honest status."""
+import numpy as np
+import pytest
+
+import ballc
+
+
+@pytest.fixture(scope="module")
+def seed_run():
+    return ballc.simulate(ballc.Scene(), 5.0)
+
+
+def test_conservative_scene_conserves_energy():
+    """c_tau = 1, mu = 0, mixture = 0: Hertz contact, no dissipation -> energy constant.
+    The observer makes the ball spin (gravity torque), so rotation is exercised too."""
+    scene = ballc.Scene(c_tau=1.0, friction_coefficient=0.0, mixture=0.0, observer_mass=0.2)
+    result = ballc.simulate(scene, 5.0, rtol=1e-12, atol=1e-12)
+    assert result.status == 0
+    assert len(result.contacts) >= 8
+    total = result.energy["total"]
+    assert np.abs(total / total[0] - 1).max() <= 1e-8
+    assert np.abs(result.angular_velocity).max() > 0.1
+
+
+def test_seed_scene_contacts_alternate_and_motion_reverses(seed_run):
+    contacts = seed_run.contacts
+    assert seed_run.status == 0 and seed_run.success
+    assert [c.plane for c in contacts] == ["floor", "ceiling"] * 4 + ["floor"]
+    first_ceiling = contacts[1]
+    assert first_ceiling.velocity_before[0] < 0 < first_ceiling.velocity_after[0]
+    for c in contacts:
+        assert c.t_start < c.t_end
+        assert 0 < c.max_penetration < ballc.Scene().radius
+
+
+def test_contact_events_are_exact(seed_run):
+    """At every contact boundary the penetration is zero (to event tolerance)."""
+    r, h = 1.0, 10.0
+    for c in seed_run.contacts:
+        for t in (c.t_start, c.t_end):
+            i = np.argmin(np.abs(seed_run.t - t))
+            z = seed_run.position[2, i]
+            gap = z - r if c.plane == "floor" else h - r - z
+            assert abs(gap) < 1e-9
+
+
+def test_result_views_are_consistent(seed_run):
+    assert seed_run.y.shape == (13, seed_run.t.size)
+    np.testing.assert_array_equal(seed_run.position, seed_run.y[4:7])
+    np.testing.assert_allclose(np.linalg.norm(seed_run.quaternion, axis=0), 1.0, rtol=1e-14)
+    assert seed_run.angles.shape == (3, seed_run.t.size)
+    assert set(seed_run.energy) == {"kinetic", "potential", "spring", "total"}
+    assert np.all(np.diff(seed_run.t) > 0)
+
+
+def test_observer_mass_zero_runs_to_the_end():
+    """The seed's 123-angle formulation fails at t = 3.31 s here; the quaternion does not."""
+    result = ballc.simulate(ballc.Scene(observer_mass=0.0), 5.0)
+    assert result.status == 0 and result.t[-1] == 5.0
+    assert len(result.contacts) == 9
+
+
+def test_t_eval_is_honoured():
+    t_eval = np.linspace(0, 1.0, 101)
+    result = ballc.simulate(ballc.Scene(), 1.0, t_eval=t_eval)
+    np.testing.assert_array_equal(result.t, t_eval)
+
+
+def test_free_flight_is_ballistic():
+    """Before the first contact the centre follows z0 + vz t - g t^2 / 2 exactly."""
+    scene = ballc.Scene(observer_mass=0.0, velocity=(1.0, 0.0, 2.0), position=(0, 0, 5.0))
+    t = np.linspace(0, 0.5, 11)
+    result = ballc.simulate(scene, 0.5, t_eval=t, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(result.position[2], 5.0 + 2.0 * t - 9.81 / 2 * t ** 2, atol=1e-10)
+    np.testing.assert_allclose(result.position[0], t, atol=1e-10)
+
+
+def test_pure_digin_passes_through_the_floor_with_honest_status():
+    """The seed's dig-in alone injects energy; ballc stops when rho reaches r."""
+    result = ballc.simulate(ballc.Scene(tangential_model="dig-in"), 5.0)
+    assert result.status == 1 and not result.success
+    assert "passed through" in result.message
+    assert result.t[-1] < 5.0
+    assert np.all(np.isfinite(result.y))
+
+
+@pytest.mark.slow
+def test_trajectory_matches_seed_pipeline():
+    """The seed's own pipeline (side-effecting gradient, 123 angles, lambdify) at
+    rtol = atol = 1e-12 and ballc agree on the contact times and the final state."""
+    from codegen.seed_reference import run_seed_pipeline
+    seed = run_seed_pipeline(5.0)
+    ours = ballc.simulate(ballc.Scene(), 5.0, rtol=1e-12, atol=1e-12, t_eval=seed["t"])
+    np.testing.assert_allclose(ours.position, seed["y"][3:6], atol=2e-3)
+    np.testing.assert_allclose(ours.velocity, seed["y"][9:12], atol=2e-2)
+    seed_times = [t for t, _ in seed["contacts"]]
+    np.testing.assert_allclose([c.t_start for c in ours.contacts], seed_times, atol=2e-3)
