@@ -90,6 +90,19 @@ def _latch_values(y, params, plane):
     return max(rate, MIN_IMPACT_RATE), direction
 
 
+def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval, max_step):
+    """Integrate one smooth segment; returns a solve_ivp-style solution.
+
+    This is the one seam between the driver and an integrator.  The solution must
+    have ``t, y, t_events, y_events, status (0 reached t1, 1 terminal event, -1
+    failure), message, nfev, njev, nlu``.  Events are solve_ivp-style callables with
+    ``terminal`` and ``direction`` attributes.
+    """
+    options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
+    return solve_ivp(system, (t0, t1), y0, method=method, rtol=rtol, atol=atol,
+                     t_eval=t_eval, events=events, max_step=max_step, **options)
+
+
 def _check_options(scene, t_end, method, rtol, atol):
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a ballc.Scene, got {type(scene).__name__}")
@@ -158,13 +171,11 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
     while t < t_end:
         system = _core.System(params, latch, _flags(scene, in_contact))
         events = _segment_events(scene, in_contact)
-        options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > t) & (t_eval <= t_end)]
-        sol = solve_ivp(system, (t, t_end), y, method=method, rtol=rtol, atol=atol,
-                        t_eval=segment_eval, events=[e[2] for e in events],
-                        max_step=max_step, **options)
+        sol = integrate_segment(system, t, t_end, y, [e[2] for e in events], method=method,
+                                rtol=rtol, atol=atol, t_eval=segment_eval, max_step=max_step)
         nfev += sol.nfev
         njev += sol.njev
         nlu += sol.nlu
