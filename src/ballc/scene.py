@@ -94,6 +94,12 @@ class Scene:
     angles: tuple = (0.0, 0.0, 0.0)
     angular_velocity: tuple = (0.0, 0.0, 0.0)
 
+    def __new__(cls, *args, **kwargs):
+        # Unknown keyword -> SceneError with a "did you mean" (the dataclass __init__
+        # would raise a bare TypeError without a suggestion).
+        _reject_unknown_fields(kwargs)
+        return super().__new__(cls)
+
     def __post_init__(self):
         for name in ("inertia", "observer_position", "position", "velocity", "angles",
                      "angular_velocity"):
@@ -101,6 +107,9 @@ class Scene:
             if value is None:
                 continue
             try:
+                if isinstance(value, (str, bytes)) or any(
+                        isinstance(v, (str, bytes, bool, np.bool_)) for v in value):
+                    raise TypeError   # "123" would otherwise become (1.0, 2.0, 3.0)
                 vector = tuple(float(v) for v in value)
             except (TypeError, ValueError):
                 raise SceneError(f"{name} must be 3 numbers, got {value!r}") from None
@@ -108,19 +117,17 @@ class Scene:
                 raise SceneError(f"{name} must be 3 numbers, got {len(vector)}: {value!r}")
             object.__setattr__(self, name, vector)
         if self.inertia is None:
-            i = 0.4 * float(self.mass) * float(self.radius) ** 2
+            try:
+                i = 0.4 * float(self.mass) * float(self.radius) ** 2
+            except (TypeError, ValueError):
+                i = math.nan   # _validate reports the bad mass or radius first
             object.__setattr__(self, "inertia", (i, i, i))
         _validate(self)
 
     @classmethod
     def from_dict(cls, values: dict) -> "Scene":
         """Scene from a mapping; unknown keys raise with a suggestion."""
-        known = [f.name for f in fields(cls)]
-        for key in values:
-            if key not in known:
-                close = difflib.get_close_matches(key, known, n=1)
-                hint = f"; did you mean {close[0]!r}?" if close else ""
-                raise SceneError(f"unknown scene field {key!r}{hint}")
+        _reject_unknown_fields(values)
         return cls(**values)
 
     def to_dict(self) -> dict:
@@ -167,11 +174,25 @@ class Scene:
                                self.angular_velocity, self.velocity])
 
 
+def _reject_unknown_fields(values) -> None:
+    known = [f.name for f in fields(Scene)]
+    for key in values:
+        if key not in known:
+            close = difflib.get_close_matches(str(key), known, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise SceneError(f"unknown scene field {key!r} is not allowed: must be one of "
+                             f"the Scene fields{hint}")
+
+
 def _validate(s: Scene) -> None:
     def fail(name, value, allowed):
         raise SceneError(f"{name} = {value!r} is not allowed: {allowed}")
 
     def finite(name, value):
+        # Strings and bools would pass float() but are not numbers (a str field
+        # would break arithmetic later, e.g. in hertz_stiffness).
+        if isinstance(value, (str, bytes, bool, np.bool_)):
+            fail(name, value, "must be a real number")
         try:
             x = float(value)
         except (TypeError, ValueError):
@@ -202,8 +223,10 @@ def _validate(s: Scene) -> None:
         fail("ceiling_height", s.ceiling_height, f"must be > 2 * radius = {2 * s.radius}")
     for name in ("inertia", "observer_position", "position", "velocity", "angles",
                  "angular_velocity"):
-        for v in getattr(s, name):
-            finite(name, v)
+        vector = getattr(s, name)
+        for i, v in enumerate(vector):
+            if not math.isfinite(v):
+                fail(f"{name}[{i}]", v, f"every component must be finite (got {name} = {vector})")
     ix, iy, iz = s.inertia
     if min(s.inertia) <= 0:
         fail("inertia", s.inertia, "every moment of inertia must be > 0")

@@ -103,10 +103,17 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
                      t_eval=t_eval, events=events, max_step=max_step, **options)
 
 
-def _check_options(scene, t_end, method, rtol, atol):
+#: scipy raises any rtol below 100 machine epsilons to that value (with a warning);
+#: ballc rejects such an rtol instead of silently integrating with another one.
+MIN_RTOL = 100 * np.finfo(float).eps
+
+
+def _check_options(scene, t_end, method, rtol, atol, max_step=np.inf):
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a ballc.Scene, got {type(scene).__name__}")
     try:
+        if isinstance(t_end, (str, bytes, bool, np.bool_)):
+            raise TypeError   # float("5") or float(True) would pass
         t_end = float(t_end)
     except (TypeError, ValueError):
         raise SceneError(f"t_end = {t_end!r} is not allowed: must be a number > 0") from None
@@ -115,8 +122,28 @@ def _check_options(scene, t_end, method, rtol, atol):
     if method not in SCIPY_METHODS:
         raise SceneError(f"method = {method!r} is not allowed: must be one of {SCIPY_METHODS}")
     for name, value in (("rtol", rtol), ("atol", atol)):
-        if not (np.all(np.isfinite(value)) and np.all(np.asarray(value) > 0)):
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise SceneError(f"{name} = {value!r} is not allowed: must be a number "
+                             "(atol: or one per state)") from None
+        if not (np.all(np.isfinite(array)) and np.all(array > 0)):
             raise SceneError(f"{name} = {value!r} is not allowed: must be finite and > 0")
+    if np.ndim(rtol) != 0:
+        raise SceneError(f"rtol = {rtol!r} is not allowed: must be a single number")
+    if float(rtol) < MIN_RTOL:
+        raise SceneError(f"rtol = {rtol!r} is not allowed: must be >= 100 machine "
+                         f"epsilons = {MIN_RTOL:.3g}")
+    if np.ndim(atol) > 1 or np.ndim(atol) == 1 and np.size(atol) != len(_core.STATE_NAMES):
+        raise SceneError(f"atol = {atol!r} is not allowed: must be a number or one per "
+                         f"state ({len(_core.STATE_NAMES)}: {', '.join(_core.STATE_NAMES)})")
+    try:
+        max_step_ok = float(max_step) > 0   # NaN fails too
+    except (TypeError, ValueError):
+        max_step_ok = False
+    if not max_step_ok:
+        raise SceneError(f"max_step = {max_step!r} is not allowed: must be a number > 0 "
+                         "(inf for no limit)")
     return t_end
 
 
@@ -147,12 +174,18 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
         run (the ball passed through a plane), -1 when the integrator failed; the
         arrays always hold what was computed up to there.
     """
-    t_end = _check_options(scene, t_end, method, rtol, atol)
+    t_end = _check_options(scene, t_end, method, rtol, atol, max_step)
     if t_eval is not None:
-        t_eval = np.asarray(t_eval, dtype=float)
-        if t_eval.ndim != 1 or np.any(np.diff(t_eval) <= 0) or t_eval.size and (
-                t_eval[0] < 0 or t_eval[-1] > t_end):
-            raise SceneError("t_eval must be increasing and within [0, t_end]")
+        t_eval_given = t_eval
+        try:
+            t_eval = np.asarray(t_eval, dtype=float)
+        except (TypeError, ValueError):
+            raise SceneError(f"t_eval = {t_eval_given!r} is not allowed: must be "
+                             "numbers") from None
+        if t_eval.ndim != 1 or not np.all(np.isfinite(t_eval)) or np.any(
+                np.diff(t_eval) <= 0) or t_eval.size and (t_eval[0] < 0 or t_eval[-1] > t_end):
+            raise SceneError(f"t_eval = {t_eval_given!r} is not allowed: must be a 1-D, "
+                             f"strictly increasing sequence within [0, t_end = {t_end}]")
 
     params = scene.parameter_vector()
     latch = np.zeros(_core.N_LATCH)

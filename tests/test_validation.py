@@ -1,0 +1,197 @@
+"""Input validation: every rule rejects before anything is integrated, and the
+error names the parameter, the offending value and what is allowed.
+
+One parametrized case per rule.  Each case is (kwargs, parameter name, value text):
+the message must contain the name and the value's text.
+"""
+import math
+import sys
+
+import numpy as np
+import pytest
+
+import ballc
+from ballc import SceneError
+
+nan, inf = math.nan, math.inf
+
+#: (Scene keyword arguments, parameter named in the message, value shown in the message)
+SCENE_CASES = {
+    # positive finite mass, radius, ceiling height, moduli
+    "mass zero": (dict(mass=0.0), "mass", "0.0"),
+    "mass negative": (dict(mass=-1.0), "mass", "-1.0"),
+    "mass nan": (dict(mass=nan), "mass", "nan"),
+    "mass inf": (dict(mass=inf), "mass", "inf"),
+    "mass string": (dict(mass="1.0"), "mass", "'1.0'"),
+    "mass bool": (dict(mass=True), "mass", "True"),
+    "mass complex": (dict(mass=1j), "mass", "1j"),
+    "radius zero": (dict(radius=0.0), "radius", "0.0"),
+    "radius negative": (dict(radius=-0.5), "radius", "-0.5"),
+    "radius nan": (dict(radius=nan), "radius", "nan"),
+    "ceiling negative": (dict(ceiling_height=-10.0), "ceiling_height", "-10.0"),
+    "ceiling inf": (dict(ceiling_height=inf), "ceiling_height", "inf"),
+    "ball modulus zero": (dict(ball_youngs_modulus=0.0), "ball_youngs_modulus", "0.0"),
+    "ball modulus nan": (dict(ball_youngs_modulus=nan), "ball_youngs_modulus", "nan"),
+    "plane modulus negative": (dict(plane_youngs_modulus=-2e10), "plane_youngs_modulus",
+                               "-20000000000.0"),
+    "plane modulus inf": (dict(plane_youngs_modulus=inf), "plane_youngs_modulus", "inf"),
+    "regularization zero": (dict(friction_regularization_speed=0.0),
+                            "friction_regularization_speed", "0.0"),
+    "observer mass negative": (dict(observer_mass=-1e-4), "observer_mass", "-0.0001"),
+    "gravity negative": (dict(gravity=-9.81), "gravity", "-9.81"),
+    # ceiling height > 2 radius
+    "ceiling equals diameter": (dict(ceiling_height=2.0, position=(0, 0, 1.0)),
+                                "ceiling_height", "2.0"),
+    "ceiling below diameter": (dict(ceiling_height=1.5, position=(0, 0, 0.75)),
+                               "ceiling_height", "1.5"),
+    # Poisson ratios in (-1, 0.5]
+    "ball poisson -1": (dict(ball_poisson_ratio=-1.0), "ball_poisson_ratio", "-1.0"),
+    "ball poisson 0.6": (dict(ball_poisson_ratio=0.6), "ball_poisson_ratio", "0.6"),
+    "plane poisson -1.5": (dict(plane_poisson_ratio=-1.5), "plane_poisson_ratio", "-1.5"),
+    "plane poisson 0.5000001": (dict(plane_poisson_ratio=0.5000001), "plane_poisson_ratio",
+                                "0.5000001"),
+    # c_tau in (0, 1]
+    "c_tau zero": (dict(c_tau=0.0), "c_tau", "0.0"),
+    "c_tau above one": (dict(c_tau=1.01), "c_tau", "1.01"),
+    "c_tau nan": (dict(c_tau=nan), "c_tau", "nan"),
+    # friction coefficient >= 0
+    "mu negative": (dict(friction_coefficient=-0.1), "friction_coefficient", "-0.1"),
+    "mu inf": (dict(friction_coefficient=inf), "friction_coefficient", "inf"),
+    # mixture in [0, 1]
+    "mixture negative": (dict(mixture=-0.01), "mixture", "-0.01"),
+    "mixture above one": (dict(mixture=1.5), "mixture", "1.5"),
+    # observer strictly inside the ball
+    "observer on surface": (dict(observer_position=(1.0, 0.0, 0.0)), "observer_position",
+                            "(1.0, 0.0, 0.0)"),
+    "observer outside": (dict(observer_position=(0.8, 0.8, 0.0)), "observer_position",
+                         "(0.8, 0.8, 0.0)"),
+    "observer nan": (dict(observer_position=(nan, 0.0, 0.0)), "observer_position[0]", "nan"),
+    # positive inertias satisfying the triangle inequality
+    "inertia zero": (dict(inertia=(0.0, 0.4, 0.4)), "inertia", "(0.0, 0.4, 0.4)"),
+    "inertia negative": (dict(inertia=(-0.4, 0.4, 0.4)), "inertia", "(-0.4, 0.4, 0.4)"),
+    "inertia triangle": (dict(inertia=(0.1, 0.1, 0.3)), "inertia", "(0.1, 0.1, 0.3)"),
+    "inertia nan": (dict(inertia=(0.4, nan, 0.4)), "inertia[1]", "nan"),
+    "inertia length": (dict(inertia=(0.4, 0.4)), "inertia", "(0.4, 0.4)"),
+    # finite initial state, 3 numbers per vector
+    "position nan": (dict(position=(0.0, nan, 5.0)), "position[1]", "nan"),
+    "velocity inf": (dict(velocity=(0.0, inf, 0.0)), "velocity[1]", "inf"),
+    "angles nan": (dict(angles=(nan, 0.0, 0.0)), "angles[0]", "nan"),
+    "angular velocity -inf": (dict(angular_velocity=(0.0, 0.0, -inf)),
+                              "angular_velocity[2]", "-inf"),
+    "velocity too long": (dict(velocity=(1.0, 2.0, 3.0, 4.0)), "velocity", "(1.0, 2.0, 3.0, 4.0)"),
+    "velocity string": (dict(velocity="123"), "velocity", "'123'"),
+    "velocity scalar": (dict(velocity=5.0), "velocity", "5.0"),
+    # initial position not overlapping a plane
+    "overlaps floor": (dict(position=(0.0, 0.0, 0.5)), "position", "(0.0, 0.0, 0.5)"),
+    "below floor": (dict(position=(0.0, 0.0, -3.0)), "position", "(0.0, 0.0, -3.0)"),
+    "overlaps ceiling": (dict(position=(0.0, 0.0, 9.5)), "position", "(0.0, 0.0, 9.5)"),
+    # unknown tangential model, with a suggestion
+    "tangential model typo": (dict(tangential_model="frictoin"), "tangential_model",
+                              "'frictoin'"),
+    "tangential model none": (dict(tangential_model=None), "tangential_model", "None"),
+}
+
+
+@pytest.mark.parametrize("kwargs, name, value", list(SCENE_CASES.values()),
+                         ids=list(SCENE_CASES))
+def test_invalid_scene_is_rejected_naming_parameter_and_value(kwargs, name, value):
+    with pytest.raises(SceneError) as info:
+        ballc.Scene(**kwargs)
+    message = str(info.value)
+    assert name in message and value in message, message
+    assert "allowed" in message or "must" in message, message
+
+
+def test_tangential_model_typo_suggests_the_right_name():
+    with pytest.raises(SceneError, match="did you mean 'friction'"):
+        ballc.Scene(tangential_model="frictoin")
+    with pytest.raises(SceneError, match="did you mean 'dig-in'"):
+        ballc.Scene(tangential_model="digin")
+
+
+@pytest.mark.parametrize("make", [lambda: ballc.Scene(frictoin_coefficient=0.1),
+                                  lambda: ballc.Scene.from_dict({"frictoin_coefficient": 0.1}),
+                                  lambda: ballc.Scene().replace(frictoin_coefficient=0.1)],
+                         ids=["Scene", "from_dict", "replace"])
+def test_unknown_field_is_rejected_with_did_you_mean(make):
+    with pytest.raises(SceneError) as info:
+        make()
+    message = str(info.value)
+    assert "'frictoin_coefficient'" in message
+    assert "did you mean 'friction_coefficient'" in message
+
+
+def test_unknown_field_without_close_match_has_no_bogus_suggestion():
+    with pytest.raises(SceneError) as info:
+        ballc.Scene(zzzzzz=1)
+    assert "'zzzzzz'" in str(info.value) and "did you mean" not in str(info.value)
+
+
+def test_error_is_a_value_error():
+    """Callers who catch ValueError keep working."""
+    assert issubclass(SceneError, ValueError)
+
+
+@pytest.mark.parametrize("kwargs", [
+    dict(position=(0.0, 0.0, 1.0), velocity=(0.0, 0.0, -1.0)),   # touching the floor
+    dict(position=(0.0, 0.0, 9.0), velocity=(0.0, 0.0, 1.0)),    # touching the ceiling
+    dict(c_tau=1.0), dict(mixture=0.0), dict(mixture=1.0), dict(friction_coefficient=0.0),
+    dict(ball_poisson_ratio=0.5), dict(ball_poisson_ratio=-0.99), dict(gravity=0.0),
+    dict(observer_mass=0.0), dict(inertia=(0.2, 0.2, 0.4)),       # triangle equality
+    dict(ceiling_height=2.0001, position=(0.0, 0.0, 1.00005)),
+    dict(position=np.array([0.0, 0.0, 5.0]), velocity=[1, 2, 3]),  # any sequence of numbers
+    dict(mass=np.float32(2.0), radius=2),
+], ids=repr)
+def test_boundary_values_are_accepted(kwargs):
+    ballc.Scene(**kwargs)
+
+
+#: (simulate keyword arguments besides the scene, parameter named, value shown)
+SIMULATE_CASES = {
+    "t_end zero": (dict(t_end=0.0), "t_end", "0.0"),
+    "t_end negative": (dict(t_end=-1.0), "t_end", "-1.0"),
+    "t_end nan": (dict(t_end=nan), "t_end", "nan"),
+    "t_end inf": (dict(t_end=inf), "t_end", "inf"),
+    "t_end string": (dict(t_end="5"), "t_end", "'5'"),
+    "rtol zero": (dict(t_end=1.0, rtol=0.0), "rtol", "0.0"),
+    "rtol negative": (dict(t_end=1.0, rtol=-1e-6), "rtol", "-1e-06"),
+    "rtol nan": (dict(t_end=1.0, rtol=nan), "rtol", "nan"),
+    "rtol below 100 eps": (dict(t_end=1.0, rtol=1e-15), "rtol", "1e-15"),
+    "atol zero": (dict(t_end=1.0, atol=0.0), "atol", "0.0"),
+    "atol inf": (dict(t_end=1.0, atol=inf), "atol", "inf"),
+    "atol wrong length": (dict(t_end=1.0, atol=[1e-8] * 5), "atol", "1e-08"),
+    "atol negative entry": (dict(t_end=1.0, atol=[1e-8] * 12 + [-1.0]), "atol", "-1.0"),
+    "method unknown": (dict(t_end=1.0, method="radau"), "method", "'radau'"),
+    "max_step zero": (dict(t_end=1.0, max_step=0.0), "max_step", "0.0"),
+    "max_step nan": (dict(t_end=1.0, max_step=nan), "max_step", "nan"),
+    "t_eval beyond t_end": (dict(t_end=1.0, t_eval=[0.0, 2.0]), "t_eval", "2.0"),
+    "t_eval decreasing": (dict(t_end=1.0, t_eval=[0.5, 0.2]), "t_eval", "0.5"),
+    "t_eval negative": (dict(t_end=1.0, t_eval=[-0.1, 0.5]), "t_eval", "-0.1"),
+    "t_eval 2-D": (dict(t_end=1.0, t_eval=[[0.1, 0.5]]), "t_eval", "[[0.1, 0.5]]"),
+}
+
+
+@pytest.mark.parametrize("kwargs, name, value", list(SIMULATE_CASES.values()),
+                         ids=list(SIMULATE_CASES))
+def test_invalid_simulate_option_is_rejected_before_integration(kwargs, name, value,
+                                                                monkeypatch):
+    driver = sys.modules["ballc.simulate"]   # the module; ballc.simulate is the function
+
+    def must_not_integrate(*args, **kw):
+        raise AssertionError("integrated despite invalid input")
+
+    monkeypatch.setattr(driver, "integrate_segment", must_not_integrate)
+    with pytest.raises(SceneError) as info:
+        ballc.simulate(ballc.Scene(), **kwargs)
+    message = str(info.value)
+    assert name in message and value in message, message
+
+
+def test_scene_must_be_a_scene():
+    with pytest.raises(TypeError, match="Scene"):
+        ballc.simulate({"mass": 1.0}, 1.0)
+
+
+def test_per_state_atol_is_accepted():
+    result = ballc.simulate(ballc.Scene(), 0.05, atol=np.full(len(ballc.STATE_NAMES), 1e-9))
+    assert result.status == 0
