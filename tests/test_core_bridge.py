@@ -54,3 +54,109 @@ def test_singular_mass_matrix_gives_nan_not_crash():
     with pytest.raises(FloatingPointError):
         _core.rhs(Y, p, L, 0)
     assert np.all(np.isnan(_core.System(p, L, 0)(0.0, Y)))
+
+
+# --- issue 6: more ways to hand the compiled layer bad arrays ------------------------
+
+KERNELS = [_core.energies, _core.contact_kinematics, _core.observer_positions]
+ALL_FLAGS = sum(_core.FLAGS.values())
+
+
+@pytest.mark.parametrize("entry", ["rhs", "jacobian", "System"])
+def test_two_dimensional_state_raises(entry):
+    y2 = np.ascontiguousarray(Y[None, :])
+    call = {"rhs": lambda: _core.rhs(y2, P, L, 0),
+            "jacobian": lambda: _core.jacobian(y2, P, L, 0),
+            "System": lambda: _core.System(P, L, 0)(0.0, y2)}[entry]
+    with pytest.raises(ValueError, match="dimensions"):
+        call()
+
+
+@pytest.mark.parametrize("kernel", KERNELS, ids=lambda k: k.__name__)
+@pytest.mark.parametrize("states", [
+    np.ascontiguousarray(Y),                            # 1-D
+    np.ascontiguousarray(Y[None, None, :]),             # 3-D
+    np.asfortranarray(np.tile(Y, (3, 1))),              # not C-contiguous
+    np.broadcast_to(Y, (3, Y.size)),                    # zero stride, read-only
+    np.tile(Y, (3, 1)).astype(np.float32),              # wrong dtype
+    np.tile(Y, (3, 1)).astype(np.int64),
+    np.tile(Y, (3, 1)).astype(">f8"),                   # non-native byte order
+    np.zeros((3, Y.size - 1)),                          # wrong row length
+], ids=["1d", "3d", "fortran", "broadcast", "float32", "int64", "big-endian", "short-rows"])
+def test_per_row_kernels_reject_bad_state_arrays(kernel, states):
+    with pytest.raises(ValueError):
+        kernel(states, P)
+
+
+@pytest.mark.parametrize("kernel", KERNELS, ids=lambda k: k.__name__)
+def test_per_row_kernels_accept_zero_rows(kernel):
+    assert kernel(np.zeros((0, Y.size)), P).shape[0] == 0
+
+
+def test_read_only_arrays_are_accepted_and_not_written():
+    """const memoryviews: read-only inputs work and give the same numbers."""
+    y, p, lat = Y.copy(), P.copy(), L.copy()
+    for a in (y, p, lat):
+        a.flags.writeable = False
+    np.testing.assert_array_equal(_core.rhs(y, p, lat, ALL_FLAGS), _core.rhs(Y, P, L, ALL_FLAGS))
+    np.testing.assert_array_equal(_core.jacobian(y, p, lat, ALL_FLAGS),
+                                  _core.jacobian(Y, P, L, ALL_FLAGS))
+    np.testing.assert_array_equal(_core.System(p, lat, 0)(0.0, y), _core.rhs(Y, P, L, 0))
+    states = np.tile(Y, (2, 1))
+    states.flags.writeable = False
+    np.testing.assert_array_equal(_core.energies(states, p), _core.energies(np.tile(Y, (2, 1)), P))
+    np.testing.assert_array_equal(y, Y)
+
+
+@pytest.mark.parametrize("bad", [None, "abc", [1.0] * 13, 5.0], ids=repr)
+def test_non_array_arguments_raise(bad):
+    with pytest.raises((TypeError, ValueError)):
+        _core.rhs(bad, P, L, 0)
+    with pytest.raises((TypeError, ValueError)):
+        _core.System(bad, L, 0)
+
+
+def test_flags_and_time_of_wrong_type_raise():
+    with pytest.raises(OverflowError):
+        _core.rhs(Y, P, L, 2 ** 40)
+    with pytest.raises(TypeError):
+        _core.System(P, L, 0)("0.0", Y)
+
+
+#: State components the equations of motion depend on (x and y never appear;
+#: z only through the contact laws).
+_DYNAMIC = [n for n in _core.STATE_NAMES if n not in ("x", "y", "z")]
+
+
+@pytest.mark.parametrize("flags", [0, ALL_FLAGS], ids=["free", "all-contacts"])
+@pytest.mark.parametrize("name", _DYNAMIC)
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_non_finite_state_raises_or_gives_nan(name, bad, flags):
+    """Never a finite answer from a non-finite input the equations use, never a crash."""
+    y = Y.copy()
+    y[_core.STATE_NAMES.index(name)] = bad
+    with pytest.raises(FloatingPointError):
+        _core.rhs(y, P, L, flags)
+    assert np.all(np.isnan(_core.System(P, L, flags)(0.0, y)))
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "defect (issue 6 report): ballc_rhs checks finiteness of its outputs only; with the "
+    "contact laws on, a NaN height z takes the branch-free 'no contact' path and yields a "
+    "finite derivative. Fix in _system.c: reject non-finite state/params/latch on input."))
+def test_nan_height_with_contact_laws_on_is_not_silently_accepted():
+    y = Y.copy()
+    y[_core.STATE_NAMES.index("z")] = np.nan
+    with pytest.raises(FloatingPointError):
+        _core.rhs(y, P, L, ALL_FLAGS)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "defect (issue 6 report): a NaN contact parameter (moduli, Poisson ratios, c_tau, "
+    "ceiling height) gives a finite RHS out of contact; the C layer does not check its "
+    "inputs. Scene validation prevents it through the public API."))
+def test_nan_contact_parameter_is_not_silently_accepted():
+    p = P.copy()
+    p[_core.PARAMETER_NAMES.index("c_tau")] = np.nan
+    with pytest.raises(FloatingPointError):
+        _core.rhs(Y, p, L, ALL_FLAGS)
