@@ -5,10 +5,11 @@
 >>> print(result.contact_table())
 """
 from ._core import PARAMETER_NAMES, STATE_NAMES
+from .io import load
 from .result import Contact, Result
 from .scene import TANGENTIAL_MODELS, Scene, SceneError
 from .simulate import simulate
 
 __version__ = "0.1.0"
 __all__ = ["Contact", "PARAMETER_NAMES", "Result", "STATE_NAMES", "Scene", "SceneError",
-           "TANGENTIAL_MODELS", "simulate"]
+           "TANGENTIAL_MODELS", "load", "simulate"]

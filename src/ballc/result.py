@@ -64,6 +64,10 @@ class Result:
     contacts: list
     state_names: tuple = _core.STATE_NAMES
     _energy: dict | None = field(default=None, repr=False)
+    #: (n,) int: right-hand-side flags of the segment that computed each sample, and
+    #: (N_LATCH, n): its latched contact values (see ``ballc._core.FLAGS``/``LATCH_NAMES``).
+    flags: np.ndarray | None = field(default=None, repr=False)
+    latch: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def success(self) -> bool:
@@ -114,6 +118,59 @@ class Result:
             self._energy = {"kinetic": e[:, 0], "potential": e[:, 1], "spring": spring,
                             "total": e[:, 0] + e[:, 1] + spring}
         return self._energy
+
+    # --- the observer: what a sensor inside the ball records (see ballc.observer) ---
+
+    @property
+    def observer_acceleration(self) -> np.ndarray:
+        """(3, n) inertial acceleration of the observer point (m/s^2)."""
+        from .observer import observer_acceleration
+        return observer_acceleration(self)
+
+    @property
+    def observer_specific_force(self) -> np.ndarray:
+        """(3, n) specific force on the observer (acceleration - gravity), in g,
+        inertial components; 1 g = 9.80665 m/s^2.  At rest on the floor: (0, 0, +1)·g/9.80665."""
+        from .observer import specific_force
+        return specific_force(self, frame="inertial")
+
+    @property
+    def observer_specific_force_ball(self) -> np.ndarray:
+        """(3, n) the same specific force in ball-frame components (g): an accelerometer's reading."""
+        from .observer import specific_force
+        return specific_force(self, frame="ball")
+
+    # --- thin entry points to plot.py / animate.py / io.py (imported lazily) ---
+
+    def plot(self, **options):
+        """Coordinates and velocities against time; returns (figure, axes). See ballc.plot."""
+        from .plot import plot_coordinates
+        return plot_coordinates(self, **options)
+
+    def plot_energy(self, **options):
+        """Energies against time; returns (figure, axes). See ballc.plot."""
+        from .plot import plot_energy
+        return plot_energy(self, **options)
+
+    def plot_observer(self, **options):
+        """The observer's specific force (g) against time; returns (figure, axes)."""
+        from .plot import plot_observer
+        return plot_observer(self, **options)
+
+    def plot_contacts(self, **options):
+        """Top view of the contact points coloured by time; returns (figure, axes)."""
+        from .plot import plot_contacts_top_view
+        return plot_contacts_top_view(self, **options)
+
+    def animate(self, path=None, **options):
+        """3D animation (matplotlib FuncAnimation), written to ``path`` (.gif/.mp4) if given."""
+        from .animate import animate
+        return animate(self, path, **options)
+
+    def save(self, path) -> None:
+        """Write to ``path``: .npz (always) or .nc (netCDF, needs xarray). See ballc.io."""
+        from .io import save
+        save(self, path)
 
     def contact_table(self) -> str:
         """The contacts as a fixed-width text table."""

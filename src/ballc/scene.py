@@ -37,6 +37,7 @@ latches them itself at each contact start.
 from __future__ import annotations
 
 import difflib
+import json
 import math
 from dataclasses import asdict, dataclass, fields
 
@@ -133,6 +134,27 @@ class Scene:
     def to_dict(self) -> dict:
         return asdict(self)
 
+    @classmethod
+    def from_toml(cls, path) -> "Scene":
+        """Scene from a TOML file of scene fields (SI units, as in the table above).
+
+        A ``[simulate]`` table (e.g. ``t_end``) is for ``ballc run`` and is ignored here.
+        Errors (unreadable TOML, unknown field, invalid value) raise SceneError naming the file.
+        """
+        values = read_toml(path)
+        values.pop("simulate", None)
+        try:
+            return cls.from_dict(values)
+        except SceneError as error:
+            raise SceneError(f"{path}: {error}") from None
+
+    def to_toml(self, path) -> None:
+        """Write every field to a TOML file that ``Scene.from_toml`` reads back equal."""
+        lines = ["# ballc scene: SI units, fields as in README.md 'Scene fields'"]
+        lines += [f"{name} = {_toml_value(value)}" for name, value in self.to_dict().items()]
+        with open(path, "w", encoding="utf-8") as stream:
+            stream.write("\n".join(lines) + "\n")
+
     def replace(self, **changes) -> "Scene":
         """A copy with some fields changed (validated)."""
         return Scene.from_dict({**self.to_dict(), **changes})
@@ -182,6 +204,32 @@ def _reject_unknown_fields(values) -> None:
             hint = f"; did you mean {close[0]!r}?" if close else ""
             raise SceneError(f"unknown scene field {key!r} is not allowed: must be one of "
                              f"the Scene fields{hint}")
+
+
+def read_toml(path) -> dict:
+    """The TOML file at ``path`` as a dict (tomllib, or tomli on Python 3.10)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:    # Python 3.10
+        import tomli as tomllib
+    with open(path, "rb") as stream:
+        try:
+            return tomllib.load(stream)
+        except tomllib.TOMLDecodeError as error:
+            raise SceneError(f"{path}: not valid TOML: {error}") from None
+
+
+def _toml_value(value) -> str:
+    """A scene value as TOML: numbers (repr: exact round trip), strings, flat arrays."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return repr(float(value)) if isinstance(value, (float, np.floating)) else str(int(value))
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, (tuple, list)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write {value!r} ({type(value).__name__}) to TOML")
 
 
 def _validate(s: Scene) -> None:

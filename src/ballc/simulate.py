@@ -9,6 +9,7 @@ no step ever straddles a contact boundary.  At contact start the penetration rat
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -148,7 +149,8 @@ def _check_options(scene, t_end, method, rtol, atol, max_step=np.inf):
 
 
 def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float = 1e-10,
-             atol: float = 1e-10, t_eval=None, max_step: float = np.inf) -> Result:
+             atol: float = 1e-10, t_eval=None, max_step: float = np.inf,
+             progress: bool | None = None) -> Result:
     """Simulate ``scene`` from t = 0 to ``t_end`` (s).
 
     Parameters
@@ -166,6 +168,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
         every contact event.
     max_step : float
         Largest step (s).
+    progress : bool, optional
+        Show a tqdm progress bar in simulated time (advanced once per segment).
+        None (default): only when stderr is a terminal.
 
     Returns
     -------
@@ -198,10 +203,18 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
     if t_eval is not None:
         keep = t_eval == 0.0
         ts, ys = [t_eval[keep]], [np.repeat(y[:, None], keep.sum(), axis=1)]
+    # Per stored sample: the flags and latched values of the segment that computed it,
+    # so outputs that need the right-hand side (the observer's acceleration) can
+    # re-evaluate it exactly as integrated.  Same shapes as ts/ys (one column per sample).
+    flag_columns = [np.full(ts[0].size, _flags(scene, in_contact), dtype=np.int32)]
+    latch_columns = [np.zeros((_core.N_LATCH, ts[0].size))]
+    bar = _progress_bar(progress, t_end)
     nfev = njev = nlu = 0
     status, message = 0, "The solver successfully reached the end of the integration interval."
 
     while t < t_end:
+        if bar is not None:
+            bar.update(t - bar.n)
         system = _core.System(params, latch, _flags(scene, in_contact))
         events = _segment_events(scene, in_contact)
         segment_eval = None
@@ -215,6 +228,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
         first = 1 if t_eval is None else 0   # the segment's start is already stored
         ts.append(sol.t[first:])
         ys.append(sol.y[:, first:])
+        flag_columns.append(np.full(ts[-1].size, system.flags, dtype=np.int32))
+        latch_columns.append(np.repeat(latch[:, None], ts[-1].size, axis=1))
         for (kind, plane, _), t_hits, y_hits in zip(events, sol.t_events, sol.y_events):
             if kind == "deepest" and len(t_hits):
                 depth = max(_penetration(plane, scene)(0, yy) for yy in y_hits)
@@ -256,9 +271,24 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
                        "(penetration reached the ball's radius)")
             break
 
+    if bar is not None:
+        bar.update((t_end if status == 0 else t) - bar.n)
+        bar.close()
     for plane, contact in open_contacts.items():   # still in contact at the end
         depth = _penetration(plane, scene)(0, ys[-1][:, -1]) if ys[-1].size else 0.0
         contact.max_penetration = max(contact.max_penetration, depth)
     return Result(t=np.concatenate(ts), y=np.concatenate(ys, axis=1), scene=scene,
                   status=status, message=message, nfev=nfev, njev=njev, nlu=nlu,
-                  contacts=contacts)
+                  contacts=contacts, flags=np.concatenate(flag_columns),
+                  latch=np.concatenate(latch_columns, axis=1))
+
+
+def _progress_bar(progress, t_end):
+    """A tqdm bar over simulated time, or None (progress=None: only on a terminal)."""
+    if progress is None:
+        progress = sys.stderr.isatty()
+    if not progress:
+        return None
+    from tqdm import tqdm
+    return tqdm(total=t_end, unit="s", desc="simulate", leave=False,
+                bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")

@@ -1,0 +1,159 @@
+"""Static figures of a Result (matplotlib, imported only when a figure is made).
+
+Every function takes a :class:`ballc.Result` and returns ``(figure, axes)``; pass
+``ax=`` (or ``axes=``) to draw into existing axes.  Time in s, lengths in m, speeds in
+m/s, energies in J, specific force in g (9.80665 m/s^2).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+PLANE_COLOURS = {"floor": "tab:brown", "ceiling": "tab:cyan"}
+PLANE_MARKERS = {"floor": "o", "ceiling": "^"}
+#: Energy keys drawn first, in this order; any other key (e.g. dissipated_*) follows,
+#: and "total" comes last, thick.
+ENERGY_ORDER = ("kinetic", "potential", "spring")
+
+
+def _pyplot():
+    """matplotlib.pyplot, imported on first use (it picks Agg when there is no display)."""
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def scene_title(scene) -> str:
+    """One line naming the tangential model and its parameters."""
+    model = (f"mixture {scene.mixture:g}" if scene.tangential_model == "mixture"
+             else f"{scene.tangential_model} model")
+    return (f"$c_\\tau$ = {scene.c_tau:g}, $\\mu$ = {scene.friction_coefficient:g}, "
+            f"{model}")
+
+
+def shade_contacts(ax, result) -> None:
+    """Shade the time spans of the contacts (floor brown, ceiling cyan)."""
+    for contact in result.contacts:
+        end = contact.t_end if np.isfinite(contact.t_end) else result.t[-1]
+        ax.axvspan(contact.t_start, end, color=PLANE_COLOURS[contact.plane], alpha=0.2, lw=0)
+
+
+def plot_coordinates(result, axes=None, figsize=(10, 8)):
+    """Centre position, centre velocity and angular velocity against time.
+
+    Returns (figure, array of 3 axes).  Contacts are shaded (floor brown, ceiling cyan).
+    """
+    plt = _pyplot()
+    if axes is None:
+        fig, axes = plt.subplots(3, 1, sharex=True, figsize=figsize, constrained_layout=True)
+    else:
+        fig = axes[0].figure
+    panels = ((result.position, "centre position (m)", ("x", "y", "z")),
+              (result.velocity, "centre velocity (m/s)", ("$v_x$", "$v_y$", "$v_z$")),
+              (result.angular_velocity, "angular velocity (rad/s)",
+               ("$\\omega_x$", "$\\omega_y$", "$\\omega_z$")))
+    for ax, (values, label, names) in zip(axes, panels):
+        for row, name in zip(values, names):
+            ax.plot(result.t, row, label=name, lw=1.2)
+        shade_contacts(ax, result)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper right", fontsize="small", ncol=3)
+    axes[-1].set_xlabel("time (s)")
+    axes[0].set_title("Ball centre (shaded: contacts, brown floor, cyan ceiling)\n"
+                      + scene_title(result.scene))
+    return fig, axes
+
+
+def plot_energy(result, ax=None, figsize=(10, 5)):
+    """Every entry of ``result.energy`` against time (J); "total" thick and last."""
+    plt = _pyplot()
+    fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
+               else (ax.figure, ax))
+    energy = result.energy
+    names = [k for k in ENERGY_ORDER if k in energy]
+    names += [k for k in energy if k not in names and k != "total"]
+    for name in names:
+        ax.plot(result.t, energy[name], label=name.replace("_", " "), lw=1.2)
+    if "total" in energy:
+        ax.plot(result.t, energy["total"], label="total", color="k", lw=2)
+    shade_contacts(ax, result)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("energy (J)")
+    ax.set_title("Energies (shaded: contacts)\n" + scene_title(result.scene))
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper right")
+    return fig, ax
+
+
+def contact_points(result) -> np.ndarray:
+    """(k, 3) where each contact started: the point of the plane under/over the centre (m)."""
+    points = np.empty((len(result.contacts), 3))
+    for i, contact in enumerate(result.contacts):
+        x = np.interp(contact.t_start, result.t, result.position[0])
+        y = np.interp(contact.t_start, result.t, result.position[1])
+        z = 0.0 if contact.plane == "floor" else result.scene.ceiling_height
+        points[i] = (x, y, z)
+    return points
+
+
+def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
+    """Top view (x, y): the centre's path and the contact points coloured by time,
+    numbered, with arrows from each to the next (floor o, ceiling ^)."""
+    plt = _pyplot()
+    fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
+               else (ax.figure, ax))
+    ax.plot(result.position[0], result.position[1], color="0.6", lw=0.8,
+            label="centre path")
+    ax.plot(*result.position[:2, 0], "kx", ms=8, label="start")
+    points = contact_points(result)
+    times = np.array([c.t_start for c in result.contacts])
+    if len(points):
+        norm = plt.Normalize(0.0, max(result.t[-1], 1e-12))
+        cmap = plt.get_cmap("plasma")
+        for plane in ("floor", "ceiling"):
+            chosen = [i for i, c in enumerate(result.contacts) if c.plane == plane]
+            if chosen:
+                ax.scatter(points[chosen, 0], points[chosen, 1], c=times[chosen], cmap=cmap,
+                           norm=norm, marker=PLANE_MARKERS[plane], s=80, edgecolors="k",
+                           zorder=3, label=f"{plane} contact")
+        for i, (x, y, _) in enumerate(points, 1):
+            ax.annotate(str(i), (x, y), textcoords="offset points", xytext=(6, 6),
+                        fontsize=9)
+        for (x0, y0, _), (x1, y1, _), t in zip(points[:-1], points[1:], times[1:]):
+            ax.annotate("", (x1, y1), (x0, y0), arrowprops=dict(
+                arrowstyle="->", color=cmap(norm(t)), lw=1.5, shrinkA=6, shrinkB=6))
+        fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
+                     label="contact start time (s)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title("Contact points, top view\n" + scene_title(result.scene))
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    return fig, ax
+
+
+def plot_observer(result, axes=None, figsize=(10, 7)):
+    """The observer's specific force (acceleration - gravity) in g: ball-frame
+    components (what an accelerometer inside the ball reads) and inertial ones."""
+    plt = _pyplot()
+    if axes is None:
+        fig, axes = plt.subplots(2, 1, sharex=True, figsize=figsize, constrained_layout=True)
+    else:
+        fig = axes[0].figure
+    inertial = result.observer_specific_force
+    ball = result.observer_specific_force_ball
+    magnitude = np.linalg.norm(inertial, axis=0)
+    for ax, values, frame in ((axes[0], ball, "ball frame"), (axes[1], inertial, "inertial")):
+        for row, axis in zip(values, "xyz"):
+            ax.plot(result.t, row, lw=1.0, label=f"{axis}")
+        ax.plot(result.t, magnitude, color="k", lw=0.8, ls="--", label="|f|")
+        shade_contacts(ax, result)
+        ax.set_ylabel(f"specific force, {frame} (g)")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper right", fontsize="small", ncol=4)
+    axes[-1].set_xlabel("time (s)")
+    alpha, beta, gamma = result.scene.observer_position
+    axes[0].set_title(f"What the observer at ({alpha:g}, {beta:g}, {gamma:g}) r feels: "
+                      "acceleration - gravity, in g (0 in free flight without spin)\n"
+                      + scene_title(result.scene))
+    return fig, axes
