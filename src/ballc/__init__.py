@@ -9,7 +9,8 @@ from .io import load
 from .result import Contact, Result
 from .scene import TANGENTIAL_MODELS, Scene, SceneError
 from .simulate import simulate
+from .sweep import sweep
 
 __version__ = "0.1.0"
 __all__ = ["Contact", "PARAMETER_NAMES", "Result", "STATE_NAMES", "Scene", "SceneError",
-           "TANGENTIAL_MODELS", "load", "simulate"]
+           "TANGENTIAL_MODELS", "load", "simulate", "sweep"]

@@ -136,21 +136,11 @@ def _to_dataset(result):
         variables["flags"] = (("time",), np.asarray(result.flags, dtype=np.int32))
         variables["latch"] = (("latch_name", "time"), result.latch)
     for name, values in _contact_arrays(result.contacts).items():
-        dims = ("contact", "axis") if values.ndim == 2 else ("contact",)
-        if values.ndim == 1 and values.size == 0 and name in _vector_contact_fields():
-            values, dims = values.reshape(0, 3), ("contact", "axis")
+        dims = ("contact", f"{name}_component") if values.ndim == 2 else ("contact",)
         variables[f"contact_{name}"] = (dims, values)
     coords = {"time": ("time", result.t, {"units": "s"}),
-              "state": list(result.state_names), "latch_name": list(_core.LATCH_NAMES),
-              "axis": ["x", "y", "z"]}
+              "state": list(result.state_names), "latch_name": list(_core.LATCH_NAMES)}
     return xr.Dataset(variables, coords=coords, attrs=_header(result))
-
-
-def _vector_contact_fields() -> set:
-    probe = Contact(plane="floor", t_start=0.0, velocity_before=np.zeros(3),
-                    angular_velocity_before=np.zeros(3), penetration_rate_at_impact=0.0,
-                    digin_direction=np.zeros(3))
-    return {name for name in _CONTACT_FIELDS if np.ndim(getattr(probe, name)) == 1}
 
 
 def _from_dataset(path) -> Result:

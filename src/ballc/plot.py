@@ -72,7 +72,8 @@ def plot_energy(result, ax=None, figsize=(10, 5)):
     names = [k for k in ENERGY_ORDER if k in energy]
     names += [k for k in energy if k not in names and k != "total"]
     for name in names:
-        ax.plot(result.t, energy[name], label=name.replace("_", " "), lw=1.2)
+        style = "--" if name.startswith("dissipated") else ":" if name == "balance" else "-"
+        ax.plot(result.t, energy[name], label=name.replace("_", " "), lw=1.2, ls=style)
     if "total" in energy:
         ax.plot(result.t, energy["total"], label="total", color="k", lw=2)
     shade_contacts(ax, result)
@@ -80,7 +81,7 @@ def plot_energy(result, ax=None, figsize=(10, 5)):
     ax.set_ylabel("energy (J)")
     ax.set_title("Energies (shaded: contacts)\n" + scene_title(result.scene))
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper right")
+    ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5))
     return fig, ax
 
 
@@ -157,3 +158,44 @@ def plot_observer(result, axes=None, figsize=(10, 7)):
                       "acceleration - gravity, in g (0 in free flight without spin)\n"
                       + scene_title(result.scene))
     return fig, axes
+
+
+def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
+                   figsize=(8, 6)):
+    """Heat map of ``value`` over a two-parameter sweep table (``ballc.sweep``).
+
+    Each cell is one scene; for "came_back" the colour says yes/no and the text gives
+    the fraction of energy lost (%).  Failed runs (status != 0) are marked with "!".
+    """
+    plt = _pyplot()
+    fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
+               else (ax.figure, ax))
+    xs = sorted(table[x].unique())
+    ys = sorted(table[y].unique())
+    grid = np.full((len(ys), len(xs)), np.nan)
+    for _, row in table.iterrows():
+        grid[ys.index(row[y]), xs.index(row[x])] = float(row[value])
+    boolean = value == "came_back"
+    cmap = plt.get_cmap("RdYlGn" if boolean else "viridis")
+    image = ax.imshow(grid, origin="lower", cmap=cmap, aspect="auto",
+                      vmin=0 if boolean else None, vmax=1 if boolean else None)
+    for _, row in table.iterrows():
+        i, j = ys.index(row[y]), xs.index(row[x])
+        text = (f"{100 * row['energy_lost_fraction']:.0f}%" if boolean
+                else f"{row[value]:.3g}")
+        if row["status"] != 0:
+            text += "!"
+        ax.text(j, i, text, ha="center", va="center", fontsize=7, color="k")
+    ax.set_xticks(range(len(xs)), [f"{v:g}" for v in xs], rotation=45)
+    ax.set_yticks(range(len(ys)), [f"{v:g}" for v in ys])
+    ax.set_xlabel(x.replace("_", " "))
+    ax.set_ylabel(y.replace("_", " "))
+    if boolean:
+        bar = fig.colorbar(image, ax=ax, ticks=[0, 1])
+        bar.ax.set_yticklabels(["no", "yes"])
+        bar.set_label("came back (x-velocity reversed after 3 contacts)")
+        ax.set_title("Does the throw come back?  (cell text: energy lost; !: run failed)")
+    else:
+        fig.colorbar(image, ax=ax, label=value.replace("_", " "))
+        ax.set_title(f"{value.replace('_', ' ')} over the sweep")
+    return fig, ax

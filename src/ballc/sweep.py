@@ -1,0 +1,224 @@
+"""Parameter sweeps: every combination of some scene fields, run in parallel.
+
+    table = ballc.sweep(ballc.Scene(), {"mixture": [0, 0.5, 1],
+                                        "friction_coefficient": [0.0, 0.1]}, t_end=1.2)
+
+runs on a local process pool by default (``workers``: number of processes, default all
+cores; 1 runs in this process), and on a Dask distributed cluster when given
+``client=`` (a ``distributed.Client`` or a scheduler address such as
+"tcp://host:8786"; the workers need ballc installed).  The same call either way, and
+the same table: one row per scene, in the order of the combinations.
+"""
+from __future__ import annotations
+
+import itertools
+import os
+import sys
+from pathlib import Path
+
+from .outcome import summary
+from .scene import Scene, SceneError, read_toml
+
+#: Columns every row has besides the swept parameters (see ballc.outcome.summary).
+SUMMARY_COLUMNS = ("contacts", "came_back", "first_reversal_time", "energy_initial",
+                   "energy_final", "energy_lost", "energy_lost_fraction", "t_final",
+                   "status", "message")
+
+
+def _run_one(changes: dict, scene: dict, t_end: float, options: dict, outputs: dict) -> dict:
+    """One simulation -> one row (runs in a worker; module-level so it pickles)."""
+    from .simulate import simulate
+    row = dict(changes)
+    try:
+        result = simulate(Scene.from_dict(scene), t_end, progress=False, **options)
+    except Exception as error:    # one failed scene must not lose the sweep
+        row.update({name: float("nan") for name in SUMMARY_COLUMNS})
+        row.update(status=-1, message=f"{type(error).__name__}: {error}",
+                   **{name: float("nan") for name in outputs})
+        return row
+    row.update(summary(result))
+    row.update({name: function(result) for name, function in outputs.items()})
+    return row
+
+
+def _named_outputs(outputs) -> dict:
+    if outputs is None:
+        return {}
+    if callable(outputs):
+        outputs = [outputs]
+    if not isinstance(outputs, dict):
+        outputs = {function.__name__: function for function in outputs}
+    for name, function in outputs.items():
+        if not callable(function):
+            raise TypeError(f"output {name!r} must be a function of a Result, got {function!r}")
+    return dict(outputs)
+
+
+def combinations(base_scene: Scene, parameters: dict) -> list:
+    """[(changes, scene)] for every combination, validated before anything runs."""
+    if not isinstance(base_scene, Scene):
+        raise TypeError(f"base_scene must be a ballc.Scene, got {type(base_scene).__name__}")
+    names = list(parameters)
+    grids = [list(parameters[name]) for name in names]
+    for name, grid in zip(names, grids):
+        if not grid:
+            raise SceneError(f"sweep parameter {name!r} has no values")
+    cases = []
+    for values in itertools.product(*grids):
+        changes = dict(zip(names, values))
+        cases.append((changes, base_scene.replace(**changes)))   # validates ("did you mean")
+    return cases
+
+
+def sweep(base_scene: Scene, parameters: dict, t_end: float, *, outputs=None,
+          workers: int | None = None, client=None, progress: bool | None = None,
+          **simulate_options):
+    """Simulate every combination of ``parameters`` on top of ``base_scene``.
+
+    Parameters
+    ----------
+    base_scene : Scene
+    parameters : dict
+        Scene field -> list of values, e.g. ``{"mixture": [0, 0.5], "c_tau": [0.8, 0.9]}``.
+    t_end : float
+        Simulated time of each run (s).
+    outputs : callable, list of callables or dict name -> callable, optional
+        Extra columns: functions of a Result returning a number (must pickle: define
+        them at module level).
+    workers : int, optional
+        Local processes (default: all cores); 1 runs serially in this process.
+    client : distributed.Client or str, optional
+        Run on this Dask cluster (a scheduler address is connected to and closed after).
+    progress : bool, optional
+        tqdm bar over finished runs; None: only when stderr is a terminal.
+    **simulate_options
+        Passed to :func:`ballc.simulate` (method, rtol, atol, max_step).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per combination, in ``itertools.product`` order: the swept values, then
+        contacts, came_back, first_reversal_time (s), energies (J), t_final (s), status,
+        message, and the extra outputs.
+    """
+    import pandas as pd
+
+    cases = combinations(base_scene, parameters)
+    named = _named_outputs(outputs)
+    tasks = [(changes, scene.to_dict(), float(t_end), simulate_options, named)
+             for changes, scene in cases]
+    if progress is None:
+        progress = sys.stderr.isatty()
+    if client is not None:
+        rows = _on_dask(client, tasks, progress)
+    elif workers == 1 or len(tasks) == 1:
+        rows = [_run_one(*task) for task in _bar(tasks, progress, len(tasks))]
+    else:
+        rows = _on_local_pool(tasks, workers, progress)
+    return pd.DataFrame(rows)
+
+
+def _bar(iterable, progress, total):
+    if not progress:
+        return iterable
+    from tqdm import tqdm
+    return tqdm(iterable, total=total, desc="sweep", unit="run")
+
+
+def _on_local_pool(tasks, workers, progress):
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    workers = workers or os.cpu_count() or 1
+    with ProcessPoolExecutor(max_workers=min(workers, len(tasks))) as pool:
+        futures = {pool.submit(_run_one, *task): i for i, task in enumerate(tasks)}
+        rows = [None] * len(tasks)
+        for future in _bar(as_completed(futures), progress, len(tasks)):
+            rows[futures[future]] = future.result()
+    return rows
+
+
+def _on_dask(client, tasks, progress):
+    try:
+        from distributed import Client, as_completed
+    except ModuleNotFoundError:
+        raise ModuleNotFoundError("client= needs Dask distributed: "
+                                  "pip install 'ballc[dask]'") from None
+    own = isinstance(client, str)
+    if own:
+        client = Client(client)
+    try:
+        futures = [client.submit(_run_one, *task, pure=False) for task in tasks]
+        index = {future.key: i for i, future in enumerate(futures)}
+        rows = [None] * len(tasks)
+        for future in _bar(as_completed(futures), progress, len(tasks)):
+            rows[index[future.key]] = future.result()
+        return rows
+    finally:
+        if own:
+            client.close()
+
+
+# --- sweep files (``ballc sweep sweep.toml``) ---
+
+def load_sweep_file(path) -> dict:
+    """Read a sweep file::
+
+        t_end = 1.2                 # s, each run
+        workers = 2                 # optional, local processes
+        base = "seed.toml"          # optional scene file (relative to this file) ...
+        [scene]                     # ... and/or scene fields overriding it
+        c_tau = 0.9
+        [parameters]                # scene field -> values; every combination is run
+        mixture = [0.0, 0.5, 1.0]
+        friction_coefficient = [0.0, 0.1]
+
+    Returns {"base_scene", "parameters", "t_end", "workers"}.
+    """
+    path = Path(path)
+    data = read_toml(path)
+    known = {"t_end", "workers", "base", "scene", "parameters", "simulate"}
+    for key in data:
+        if key not in known:
+            raise SceneError(f"{path}: unknown sweep key {key!r}; allowed: {sorted(known)}")
+    if not data.get("parameters"):
+        raise SceneError(f"{path}: needs a [parameters] table (scene field -> list of values)")
+    scene = Scene()
+    if "base" in data:
+        scene = Scene.from_toml(path.parent / data["base"])
+    if "scene" in data:
+        try:
+            scene = scene.replace(**data["scene"])
+        except SceneError as error:
+            raise SceneError(f"{path}: [scene]: {error}") from None
+    return {"base_scene": scene, "parameters": data["parameters"],
+            "t_end": float(data.get("t_end", 5.0)), "workers": data.get("workers")}
+
+
+def run_sweep_file(path, *, out=None, workers=None, scheduler=None) -> int:
+    """``ballc sweep``: run a sweep file, write sweep.csv (+ a heat map for 2 parameters)."""
+    spec = load_sweep_file(path)
+    out = Path(out) if out else Path(Path(path).stem)
+    out.mkdir(parents=True, exist_ok=True)
+    names = list(spec["parameters"])
+    count = 1
+    for values in spec["parameters"].values():
+        count *= len(values)
+    where = f"Dask scheduler {scheduler}" if scheduler else \
+        f"{workers or spec['workers'] or os.cpu_count()} local processes"
+    print(f"ballc sweep {path}: {count} runs of {spec['t_end']:g} s over {', '.join(names)} "
+          f"on {where} -> {out}/")
+    table = sweep(spec["base_scene"], spec["parameters"], spec["t_end"],
+                  workers=workers or spec["workers"], client=scheduler)
+    table.to_csv(out / "sweep.csv", index=False)
+    written = [out / "sweep.csv"]
+    if len(names) == 2:
+        import matplotlib
+        matplotlib.use("Agg")
+        from .plot import plot_sweep_map
+        fig, _ = plot_sweep_map(table, x=names[1], y=names[0])
+        fig.savefig(out / "came_back.png", dpi=100)
+        written.append(out / "came_back.png")
+    came = int((table["came_back"] == True).sum())   # noqa: E712 (NaN for failed runs)
+    print(f"{came} of {len(table)} scenes came back; "
+          f"{int((table['status'] != 0).sum())} did not reach t_end")
+    print("wrote " + ", ".join(str(p) for p in written))
+    return 0

@@ -1,0 +1,70 @@
+"""Sweeps: validated up front; 2 local workers and a Dask cluster give exactly the serial table."""
+import pandas as pd
+import pytest
+
+import ballc
+
+BASE = ballc.Scene()
+GRID = {"mixture": [0.0, 1.0], "friction_coefficient": [0.0, 0.1]}
+T_END = 0.7
+
+
+def final_height(result):
+    """An extra output column (module level, so it pickles)."""
+    return float(result.position[2, -1])
+
+
+@pytest.fixture(scope="module")
+def serial():
+    return ballc.sweep(BASE, GRID, T_END, workers=1, outputs=[final_height])
+
+
+def test_serial_table_has_one_row_per_combination(serial):
+    assert len(serial) == 4
+    assert list(serial[["mixture", "friction_coefficient"]].itertuples(index=False, name=None)) \
+        == [(0.0, 0.0), (0.0, 0.1), (1.0, 0.0), (1.0, 0.1)]
+    for column in ("contacts", "came_back", "energy_lost", "status", "message", "final_height"):
+        assert column in serial
+    assert (serial["status"] == 0).all() and (serial["contacts"] == 2).all()
+    one = ballc.simulate(BASE.replace(mixture=1.0, friction_coefficient=0.1), T_END)
+    assert serial["final_height"].iloc[3] == one.position[2, -1]
+
+
+def test_two_local_workers_equal_serial_exactly(serial):
+    parallel = ballc.sweep(BASE, GRID, T_END, workers=2, outputs=[final_height])
+    pd.testing.assert_frame_equal(parallel, serial, check_exact=True)
+
+
+def test_dask_cluster_equals_serial_exactly(serial):
+    distributed = pytest.importorskip("distributed", reason="Dask is the optional 'dask' extra")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            on_client = ballc.sweep(BASE, GRID, T_END, client=client, outputs=[final_height])
+        by_address = ballc.sweep(BASE, GRID, T_END, client=cluster.scheduler_address,
+                                 outputs=[final_height])
+    pd.testing.assert_frame_equal(on_client, serial, check_exact=True)
+    pd.testing.assert_frame_equal(by_address, serial, check_exact=True)
+
+
+def test_bad_parameters_fail_before_anything_runs():
+    with pytest.raises(ballc.SceneError, match="did you mean 'mixture'"):
+        ballc.sweep(BASE, {"mixtur": [0.1]}, T_END)
+    with pytest.raises(ballc.SceneError, match="mixture"):
+        ballc.sweep(BASE, {"mixture": [0.5, 2.0]}, T_END)
+
+
+def test_sweep_file_runs_from_the_command_line(tmp_path):
+    import os
+    import subprocess
+    import sys
+    BASE.to_toml(tmp_path / "base.toml")
+    (tmp_path / "s.toml").write_text(
+        't_end = 0.7\nworkers = 2\nbase = "base.toml"\n[parameters]\n'
+        'mixture = [0.0, 1.0]\nfriction_coefficient = [0.0, 0.1]\n')
+    done = subprocess.run([sys.executable, "-m", "ballc", "sweep", "s.toml", "--out", "o"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+    assert done.returncode == 0, done.stderr
+    table = pd.read_csv(tmp_path / "o" / "sweep.csv")
+    assert len(table) == 4 and (tmp_path / "o" / "came_back.png").stat().st_size > 0
