@@ -11,8 +11,11 @@ import time
 from pathlib import Path
 
 from .emit import GENERATOR_VERSION, SIGNATURE, BallcPrinter, c_string_array, header_comment, kernel_c
-from .kernels import MASS_LAYOUT, build_kernels
-from .model import LATCH_FIELDS, LATCH_NAMES, PARAMETER_NAMES, PARAMETERS, PLANES, STATE_NAMES
+from .kernels import CONTACT_LAW_LAYOUT, MASS_LAYOUT, build_kernels
+from .model import (LATCH_FIELDS, LATCH_NAMES, MECHANICAL_STATE_NAMES, PARAMETER_NAMES,
+                    PARAMETERS, PLANES, STATE_NAMES)
+
+CONTACT_LAW_NOUT = 13
 
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
@@ -46,6 +49,13 @@ def render(verbose=False) -> dict[str, str]:
          f"#define BALLC_N_LATCH_PER_PLANE {len(LATCH_FIELDS)}",
          f"#define BALLC_N_PLANES {len(PLANES)}",
          f"#define BALLC_MASS_SIZE {len(MASS_LAYOUT)}",
+         *[f"#define BALLC_STATE_{name.upper()} {i}" for i, name in enumerate(STATE_NAMES)],
+         f"#define BALLC_N_MECHANICAL_STATES {len(MECHANICAL_STATE_NAMES)}",
+         f"#define BALLC_CONTACT_LAW_NOUT {CONTACT_LAW_NOUT}",
+         "/* contact-law kernel outputs: " + "; ".join(CONTACT_LAW_LAYOUT) + " */",
+         "#define BALLC_LAW_FORCE 6",
+         "#define BALLC_LAW_DISSIPATION 9",
+         "#define BALLC_LAW_DEFLECTION_RATE 11",
          *sizes, "",
          c_string_array("BALLC_STATE_NAMES", STATE_NAMES).rstrip(),
          c_string_array("BALLC_PARAMETER_NAMES", PARAMETER_NAMES).rstrip(),

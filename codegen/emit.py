@@ -12,7 +12,7 @@ multiply with), ``out`` the kernel's outputs, written (never accumulated).
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import sympy as sm
@@ -34,6 +34,47 @@ class Kernel:
     outputs: list          # flat list of sympy expressions
     extra: list            # symbols read from ``extra`` (may be empty)
     extra_doc: str = ""
+    definitions: list = field(default_factory=list)  # [(symbol, expr)] emitted first, in order
+
+
+def forward_jacobian(outputs, variables, prefix="j"):
+    """Jacobian of ``outputs`` by the chain rule over their CSE (symbolic forward mode).
+
+    Differentiating the expanded trees repeats every shared subexpression in every
+    derivative; instead each CSE temporary gets its gradient as new temporaries.
+    Returns (definitions [(symbol, expr)] in dependency order, flat row-major Jacobian).
+    """
+    temps, reduced = sm.cse(list(outputs), symbols=sm.numbered_symbols(f"{prefix}c"),
+                            order="canonical")
+    names = sm.numbered_symbols(f"{prefix}d")
+    definitions, gradients = [], {}
+
+    def gradient(expr):
+        result = {}
+        inner = [s for s in expr.free_symbols if s in gradients]
+        for k, var in enumerate(variables):
+            d = expr.diff(var) if expr.has(var) else sm.S.Zero
+            for s in inner:
+                if k in gradients[s]:
+                    d += expr.diff(s) * gradients[s][k]
+            if d != 0:
+                result[k] = d
+        return result
+
+    for symbol, expr in temps:
+        definitions.append((symbol, expr))
+        gradients[symbol] = {}
+        for k, d in gradient(expr).items():
+            if not d.is_Atom:
+                name = next(names)
+                definitions.append((name, d))
+                d = name
+            gradients[symbol][k] = d
+    jac = []
+    for expr in reduced:
+        g = gradient(expr)
+        jac += [g.get(k, sm.S.Zero) for k in range(len(variables))]
+    return definitions, jac
 
 
 class BallcPrinter(C99CodePrinter):
@@ -63,22 +104,26 @@ def kernel_c(kernel: Kernel, state_syms, param_syms, printer=None) -> tuple[str,
     plain_states = [sm.Symbol(s.func.__name__) for s in state_syms]
     replacements = dict(zip(state_syms, plain_states))
     outputs = [_plain(e, replacements) for e in kernel.outputs]
+    definitions = [(s, _plain(e, replacements)) for s, e in kernel.definitions]
 
     inputs = {}
     for array, syms in (("state", plain_states), ("params", param_syms), ("extra", kernel.extra)):
         for i, s in enumerate(syms):
             inputs[s] = (array, i)
-    missing = set().union(*(e.free_symbols for e in outputs)) - set(inputs)
-    leftovers = [e for e in outputs if e.has(sm.Derivative) or e.atoms(AppliedUndef)]
+    defined = {s for s, _ in definitions}
+    everything = outputs + [e for _, e in definitions]
+    missing = set().union(*(e.free_symbols for e in everything)) - set(inputs) - defined
+    leftovers = [e for e in everything if e.has(sm.Derivative) or e.atoms(AppliedUndef)]
     if missing or leftovers:
         raise ValueError(f"kernel {kernel.name}: unknown symbols {sorted(map(str, missing))}"
                          f" or unresolved derivatives")
 
     temps = sm.numbered_symbols("t", start=0)
     subexpressions, reduced = sm.cse(outputs, symbols=temps, order="canonical")
-    used = set().union(*(e.free_symbols for _, e in subexpressions),
+    used = set().union(*(e.free_symbols for _, e in definitions + subexpressions),
                        *(e.free_symbols for e in reduced)) & set(inputs)
-    ops = sum(sm.count_ops(e) for _, e in subexpressions) + sum(sm.count_ops(e) for e in reduced)
+    ops = sum(sm.count_ops(e) for _, e in definitions + subexpressions)
+    ops += sum(sm.count_ops(e) for e in reduced)
 
     lines = [f"/* {kernel.doc}"]
     if kernel.extra:
@@ -90,7 +135,7 @@ def kernel_c(kernel: Kernel, state_syms, param_syms, printer=None) -> tuple[str,
     for sym in sorted(used, key=lambda s: (("state", "params", "extra").index(inputs[s][0]), inputs[s][1])):
         array, i = inputs[sym]
         lines.append(f"    const double {sym} = {array}[{i}];")
-    for sym, expr in subexpressions:
+    for sym, expr in definitions + subexpressions:
         lines.append(f"    const double {sym} = {printer.doprint(expr)};")
     for i, expr in enumerate(reduced):
         lines.append(f"    out[{i}] = {printer.doprint(expr)};")

@@ -19,12 +19,16 @@ import sympy as sm
 import sympy.physics.mechanics as me
 
 from . import contact
-from .emit import Kernel
+from .emit import Kernel, forward_jacobian
 from .model import PLANES, STATE_NAMES, Model, bodies, build_model, gravity_loads, kanes_equations
 
 MASS_LAYOUT = ("J00", "J01", "J02", "J11", "J12", "J22",
                "B00", "B01", "B02", "B10", "B11", "B12", "B20", "B21", "B22", "D")
 J_INDEX = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+#: Outputs of every contact-law kernel, in order.
+CONTACT_LAW_LAYOUT = ("generalized force (6)", "force on the ball at the contact point (3)",
+                      "dissipation rate normal (1)", "dissipation rate tangential (1)",
+                      "deflection rate x, y (2)")
 
 
 def pack_mass(M: sm.Matrix) -> list:
@@ -71,26 +75,47 @@ def derive(model: Model | None = None):
     }
     for plane in PLANES:
         G = F.jacobian(sm.Matrix(contact_forces[plane]))   # generalized-force map, 6x3
-        for law, function in contact.TANGENTIAL_LAWS.items():
-            point, force = function(model, plane)
-            f = sm.Matrix([me.dot(force, v) for v in (N.x, N.y, N.z)])
-            pieces[f"{plane}_{law}"] = G * f
+        for name, function in contact.TANGENTIAL_LAWS.items():
+            law = function(model, plane)
+            f = sm.Matrix([me.dot(law.force, v) for v in (N.x, N.y, N.z)])
+            dissipation = contact.dissipation_rates(model, plane, law)
+            deflection = law.deflection_rate or [0, 0]
+            pieces[f"{plane}_{name}"] = sm.Matrix([*(G * f), *f, *dissipation, *deflection])
     return model, pieces
 
 
+def plain(model, exprs):
+    """Expressions with the state dynamicsymbols replaced by plain symbols."""
+    return [sm.sympify(e).xreplace(dict(zip(model.states, plain_states(model)))) for e in exprs]
+
+
+def plain_states(model):
+    return [sm.Symbol(s.func.__name__) for s in model.states]
+
+
+def jacobian_kernel(model, name, doc, outputs, extra=(), extra_doc="", prefix="j"):
+    """Kernel of d(outputs)/d(state), row-major, by forward_jacobian."""
+    definitions, jac = forward_jacobian(plain(model, outputs), plain_states(model), prefix)
+    return Kernel(name, doc, jac, list(extra), extra_doc, definitions)
+
+
 def _dynamics_kernels(model, name, M, F, what):
-    x = model.states
-    q = model.coordinates[:4]
+    n = len(model.states)
     a = sm.symbols("a0:6")
     mass = pack_mass(M)
     Ma = M * sm.Matrix(a)
+    # d(M a)/dq is only needed for the 4 quaternion components: take the first 4
+    # columns of the full Jacobian of M a.
+    dF = jacobian_kernel(model, f"{name}_jac", "", list(F), prefix="f")
+    dMa = jacobian_kernel(model, f"{name}_jac", "", list(Ma), prefix="m")
+    dMa_q = [dMa.outputs[i * n + k] for i in range(6) for k in range(4)]
     return [
         Kernel(name, f"{what}: mass blocks (16, MASS_LAYOUT) then forcing (6).",
                mass + list(F), []),
         Kernel(f"{name}_jac",
-               f"{what}: dF/dx (6x13 row-major) then d(M a)/dq (6x4 row-major).",
-               list(F.jacobian(x)) + list(Ma.jacobian(q)), list(a),
-               "a (6): the vector M is multiplied with (udot)"),
+               f"{what}: dF/dx (6x{n} row-major) then d(M a)/dq (6x4 row-major).",
+               dF.outputs + dMa_q, list(a), "a (6): the vector M is multiplied with (udot)",
+               dF.definitions + dMa.definitions),
     ]
 
 
@@ -101,23 +126,24 @@ def build_kernels():
     kernels = [
         Kernel("kinematics", "Time derivatives of qw qx qy qz x y z (7).",
                list(model.kinematics), []),
-        Kernel("kinematics_jac", "d(kinematics)/dx (7x13 row-major).",
-               list(model.kinematics.jacobian(x)), []),
+        jacobian_kernel(model, "kinematics_jac", f"d(kinematics)/dx (7x{len(x)} row-major).",
+                        list(model.kinematics)),
     ]
     kernels += _dynamics_kernels(model, "ball", pieces["M_ball"], pieces["F_ball"], "Ball")
     kernels += _dynamics_kernels(model, "observer", pieces["M_observer"],
                                  pieces["F_observer"], "Observer particle")
+    n = len(x)
     for plane in PLANES:
         latch = contact.latch_symbols(model, plane)
         for law in contact.TANGENTIAL_LAWS:
-            gf = pieces[f"{plane}_{law}"]
+            outputs = pieces[f"{plane}_{law}"]
             doc = f"{plane} contact, {law} law (weighted):"
             extra_doc = "latched rhodot^-, d_x, d_y, d_z of this plane"
-            kernels.append(Kernel(f"{plane}_{law}", f"{doc} generalized forces (6).",
-                                  list(gf), list(latch), extra_doc))
-            kernels.append(Kernel(f"{plane}_{law}_jac", f"{doc} d(generalized forces)/dx"
-                                  " (6x13 row-major).", list(gf.jacobian(x)), list(latch),
-                                  extra_doc))
+            kernels.append(Kernel(f"{plane}_{law}", f"{doc} {', '.join(CONTACT_LAW_LAYOUT)}.",
+                                  list(outputs), list(latch), extra_doc))
+            kernels.append(jacobian_kernel(model, f"{plane}_{law}_jac", f"{doc} d(outputs)/dx "
+                                           f"({len(outputs)}x{n} row-major).", list(outputs),
+                                           latch, extra_doc))
     kernels += output_kernels(model)
     return model, kernels
 
@@ -128,8 +154,9 @@ def output_kernels(model: Model):
     ball, observer = bodies(model)
     g = model.p["gravity"]
     kinetic = ball.kinetic_energy(N) + observer.kinetic_energy(N)
-    potential = ball.mass*g*model.states[6] + observer.mass*g*me.dot(
-        model.observer.pos_from(model.centre), N.z) + observer.mass*g*model.states[6]
+    z = model.state("z")
+    potential = ball.mass*g*z + observer.mass*g*(z + me.dot(
+        model.observer.pos_from(model.centre), N.z))
     energy = [kinetic, potential] + [contact.spring_energy(model, plane) for plane in PLANES]
 
     kin = []
@@ -138,8 +165,8 @@ def output_kernels(model: Model):
         kin += [rho, rhodot] + [me.dot(velocity, v) for v in (N.x, N.y, N.z)]
 
     rel = model.observer.pos_from(model.centre)
-    observer_position = [model.states[4 + i] + me.dot(rel, v)
-                         for i, v in enumerate((N.x, N.y, N.z))]
+    observer_position = [model.state(c) + me.dot(rel, v)
+                         for c, v in zip("xyz", (N.x, N.y, N.z))]
     return [
         Kernel("energy", "Energies (J): kinetic, potential, spring floor, spring ceiling.",
                energy, []),
@@ -149,4 +176,4 @@ def output_kernels(model: Model):
     ]
 
 
-__all__ = ["MASS_LAYOUT", "STATE_NAMES", "build_kernels", "derive"]
+__all__ = ["CONTACT_LAW_LAYOUT", "MASS_LAYOUT", "STATE_NAMES", "build_kernels", "derive"]

@@ -30,12 +30,21 @@ T = me.dynamicsymbols._t
 # ---------------------------------------------------------------------------
 # Names.  The order of these tuples IS the argument layout of the generated C.
 # ---------------------------------------------------------------------------
-STATE_NAMES = (
+MECHANICAL_STATE_NAMES = (
     "qw", "qx", "qy", "qz",
     "x", "y", "z",
     "omega_x", "omega_y", "omega_z",
     "vx", "vy", "vz",
 )
+#: States that ride along with the mechanics: dissipated work (J), integrated so that
+#: kinetic + potential + spring + dissipated is conserved, and the elastic tangential
+#: deflection (m) of the compliant contact model on each plane.
+AUXILIARY_STATE_NAMES = (
+    "dissipated_normal", "dissipated_tangential",
+    "floor_deflection_x", "floor_deflection_y",
+    "ceiling_deflection_x", "ceiling_deflection_y",
+)
+STATE_NAMES = MECHANICAL_STATE_NAMES + AUXILIARY_STATE_NAMES
 
 #: (name, seed symbol, unit, description)
 PARAMETERS = (
@@ -58,7 +67,11 @@ PARAMETERS = (
     ("c_tau", "ctau", "1", "Hunt-Crossley restitution constant"),
     ("friction_coefficient", "mu", "1", "Coulomb friction coefficient"),
     ("friction_regularization_speed", "-", "m/s",
-     "slip speed below which Coulomb friction becomes viscous: max(|v_t|, this)"),
+     "slip speed scale v_s of the Coulomb regularisation"),
+    ("smooth_friction", "-", "1",
+     "0: seed's v_t / max(|v_t|, v_s); 1: smooth v_t / sqrt(|v_t|^2 + v_s^2)"),
+    ("tangential_stiffness_ratio", "-", "1",
+     "compliant model: tangential / normal contact stiffness (Mindlin: 2(1-nu)/(2-nu))"),
 )
 PARAMETER_NAMES = tuple(p[0] for p in PARAMETERS)
 
@@ -78,7 +91,7 @@ LATCH_NAMES = tuple(f"{plane}_{f[0]}" for plane in PLANES for f in LATCH_FIELDS)
 class Model:
     """Symbols and sympy expressions of the ball model."""
 
-    states: list          # 13 dynamicsymbols in STATE_NAMES order
+    states: list          # dynamicsymbols in STATE_NAMES order
     parameters: list      # sympy Symbols in PARAMETER_NAMES order
     latches: list         # sympy Symbols in LATCH_NAMES order
     frame: me.ReferenceFrame
@@ -95,7 +108,10 @@ class Model:
 
     @property
     def speeds(self):
-        return self.states[7:]
+        return self.states[7:13]
+
+    def state(self, name):
+        return self.states[STATE_NAMES.index(name)]
 
 
 def quaternion_dcm(qw, qx, qy, qz):
@@ -111,7 +127,7 @@ def quaternion_dcm(qw, qx, qy, qz):
 def build_model() -> Model:
     """Frames, points, speeds and kinematics (no forces yet)."""
     states = list(me.dynamicsymbols(" ".join(STATE_NAMES)))
-    qw, qx, qy, qz, x, y, z, wx, wy, wz, vx, vy, vz = states
+    qw, qx, qy, qz, x, y, z, wx, wy, wz, vx, vy, vz = states[:len(MECHANICAL_STATE_NAMES)]
     p = {name: sm.Symbol(name) for name in PARAMETER_NAMES}
     latches = [sm.Symbol(name) for name in LATCH_NAMES]
 

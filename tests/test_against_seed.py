@@ -59,7 +59,9 @@ def random_state(rng, scene, where):
     omega = rng.uniform(-10, 10, 3)
     velocity = rng.uniform(-10, 10, 3)
     seed_y = np.concatenate([angles, position, omega, velocity])
-    y = np.concatenate([quaternion_from_angles_123(angles), position, omega, velocity])
+    deflections = rng.uniform(-1e-3, 1e-3, 4) * r     # compliant model's tangential springs
+    auxiliary = np.concatenate([rng.uniform(-10, 10, 2), deflections])   # dissipated, deflections
+    y = np.concatenate([quaternion_from_angles_123(angles), position, omega, velocity, auxiliary])
     latch = np.empty(8)
     for k in range(2):
         direction = rng.normal(size=3)
@@ -67,7 +69,9 @@ def random_state(rng, scene, where):
         latch[4 * k + 1:4 * k + 4] = direction / np.linalg.norm(direction)
     flags = _core.FLAGS["observer"] if scene.observer_mass else 0
     mixture = scene.effective_mixture
-    if where != "free":
+    if where != "free" and scene.tangential_model == "compliant":
+        flags |= _core.FLAGS[f"{where}_compliant"]
+    elif where != "free":
         if mixture < 1:
             flags |= _core.FLAGS[f"{where}_friction"]
         if mixture > 0:
@@ -101,7 +105,7 @@ def test_speed_derivatives_match_seed(seed_model, rng, where, model):
             continue
         ours = _core.rhs(y, scene.parameter_vector(), latch, flags)
         theirs = seed_state_derivative(seed_y, seed_parameters(scene, latch))
-        np.testing.assert_allclose(ours[7:], theirs[6:], rtol=1e-9,
+        np.testing.assert_allclose(ours[7:13], theirs[6:], rtol=1e-9,
                                    atol=1e-9 * np.abs(theirs[6:]).max())
         # the centre's kinematics are the seed's too
         np.testing.assert_allclose(ours[4:7], theirs[3:6], rtol=1e-15)
@@ -153,7 +157,7 @@ def test_orientation_conversions_match_sympy_dcm(rng):
 
 
 @pytest.mark.parametrize("where", ["free", "floor", "ceiling"])
-@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("model", MODELS + ("compliant",))
 def test_analytic_jacobian_matches_finite_differences(rng, where, model):
     for _ in range(8):
         scene = random_scene(rng, model)
@@ -163,9 +167,10 @@ def test_analytic_jacobian_matches_finite_differences(rng, where, model):
         p = scene.parameter_vector()
         jac = _core.jacobian(y, p, latch, flags)
         fd = np.empty_like(jac)
-        for j in range(13):
-            h = 1e-6 * max(1.0, abs(y[j]))
-            e = np.zeros(13)
+        n = _core.N_STATES
+        for j in range(n):
+            h = 1e-6 * max(1.0, abs(y[j])) if j < 13 else 1e-9
+            e = np.zeros(n)
             e[j] = h
             fd[:, j] = (_core.rhs(y + e, p, latch, flags) - _core.rhs(y - e, p, latch, flags)) / (2 * h)
         scale = np.abs(fd).max(axis=1, keepdims=True) + 1e-12

@@ -123,9 +123,8 @@ def test_flags_and_time_of_wrong_type_raise():
         _core.System(P, L, 0)("0.0", Y)
 
 
-#: State components the equations of motion depend on (x and y never appear;
-#: z only through the contact laws).
-_DYNAMIC = [n for n in _core.STATE_NAMES if n not in ("x", "y", "z")]
+#: Every state component: the C layer rejects non-finite inputs before computing.
+_DYNAMIC = list(_core.STATE_NAMES)
 
 
 @pytest.mark.parametrize("flags", [0, ALL_FLAGS], ids=["free", "all-contacts"])
@@ -140,10 +139,6 @@ def test_non_finite_state_raises_or_gives_nan(name, bad, flags):
     assert np.all(np.isnan(_core.System(P, L, flags)(0.0, y)))
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "defect (issue 6 report): ballc_rhs checks finiteness of its outputs only; with the "
-    "contact laws on, a NaN height z takes the branch-free 'no contact' path and yields a "
-    "finite derivative. Fix in _system.c: reject non-finite state/params/latch on input."))
 def test_nan_height_with_contact_laws_on_is_not_silently_accepted():
     y = Y.copy()
     y[_core.STATE_NAMES.index("z")] = np.nan
@@ -151,10 +146,6 @@ def test_nan_height_with_contact_laws_on_is_not_silently_accepted():
         _core.rhs(y, P, L, ALL_FLAGS)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "defect (issue 6 report): a NaN contact parameter (moduli, Poisson ratios, c_tau, "
-    "ceiling height) gives a finite RHS out of contact; the C layer does not check its "
-    "inputs. Scene validation prevents it through the public API."))
 def test_nan_contact_parameter_is_not_silently_accepted():
     p = P.copy()
     p[_core.PARAMETER_NAMES.index("c_tau")] = np.nan

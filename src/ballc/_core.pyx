@@ -21,9 +21,11 @@ cdef extern from "ballc_kernels.h":
 cdef extern from "_system.h":
     int BALLC_WITH_OBSERVER, BALLC_FLOOR_FRICTION, BALLC_FLOOR_DIGIN
     int BALLC_CEILING_FRICTION, BALLC_CEILING_DIGIN
+    int BALLC_FLOOR_COMPLIANT, BALLC_CEILING_COMPLIANT
     int BALLC_OK
     int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
     int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
+    int ballc_contact_forces(const double *, const double *, const double *, int, double *) nogil
 
 N_STATES = BALLC_N_STATES
 N_PARAMETERS = BALLC_N_PARAMETERS
@@ -40,6 +42,8 @@ FLAGS = {
     "floor_digin": BALLC_FLOOR_DIGIN,
     "ceiling_friction": BALLC_CEILING_FRICTION,
     "ceiling_digin": BALLC_CEILING_DIGIN,
+    "floor_compliant": BALLC_FLOOR_COMPLIANT,
+    "ceiling_compliant": BALLC_CEILING_COMPLIANT,
 }
 ENERGY_NOUT = BALLC_ENERGY_NOUT
 CONTACT_KINEMATICS_NOUT = BALLC_CONTACT_KINEMATICS_NOUT
@@ -83,6 +87,16 @@ cdef class System:
         self.nfev = 0
         self.njev = 0
         self.failures = 0
+
+    @property
+    def params(self):
+        """The parameter vector (a copy)."""
+        return np.array(self._params)
+
+    @property
+    def latch(self):
+        """The latched values (a copy)."""
+        return np.array(self._latch)
 
     def __call__(self, double t, const double[:] y):
         cdef double ys[BALLC_MAX_STATES]
@@ -163,3 +177,19 @@ def contact_kinematics(const double[:, ::1] states, const double[::1] params):
 def observer_positions(const double[:, ::1] states, const double[::1] params):
     """(n, 3): observer position in the inertial frame (m)."""
     return _per_row(ballc_observer_position, BALLC_OBSERVER_POSITION_NOUT, states, params)
+
+
+def contact_forces(const double[:, ::1] states, const double[::1] params,
+                   const double[::1] latch, int flags):
+    """(n, 6): sum of the contact forces on the ball (N), floor x y z then ceiling x y z,
+    at each state row, for the contact laws selected by ``flags``."""
+    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check("latch", latch.shape[0], BALLC_N_LATCH)
+    out = np.empty((states.shape[0], 6))
+    cdef double[:, ::1] o = out
+    cdef Py_ssize_t i
+    for i in range(states.shape[0]):
+        if ballc_contact_forces(&states[i, 0], &params[0], &latch[0], flags, &o[i, 0]) != BALLC_OK:
+            o[i, :] = np.nan
+    return out

@@ -11,16 +11,32 @@
 typedef void (*kernel_fn)(const double *restrict, const double *restrict,
                           const double *restrict, double *restrict);
 
-/* Contact laws: which flag switches them on, their kernels, their plane's latch. */
-static const struct { int flag; kernel_fn value, jac; int latch_offset; } CONTACT_LAWS[] = {
+/* Contact laws: which flag switches them on, their kernels, their plane. */
+static const struct { int flag; kernel_fn value, jac; int plane; } CONTACT_LAWS[] = {
     {BALLC_FLOOR_FRICTION, ballc_floor_friction, ballc_floor_friction_jac, 0},
     {BALLC_FLOOR_DIGIN, ballc_floor_digin, ballc_floor_digin_jac, 0},
-    {BALLC_CEILING_FRICTION, ballc_ceiling_friction, ballc_ceiling_friction_jac,
-     BALLC_N_LATCH_PER_PLANE},
-    {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac,
-     BALLC_N_LATCH_PER_PLANE},
+    {BALLC_FLOOR_COMPLIANT, ballc_floor_compliant, ballc_floor_compliant_jac, 0},
+    {BALLC_CEILING_FRICTION, ballc_ceiling_friction, ballc_ceiling_friction_jac, 1},
+    {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac, 1},
+    {BALLC_CEILING_COMPLIANT, ballc_ceiling_compliant, ballc_ceiling_compliant_jac, 1},
 };
 #define N_CONTACT_LAWS (sizeof CONTACT_LAWS / sizeof CONTACT_LAWS[0])
+#define LAW_NOUT BALLC_CONTACT_LAW_NOUT
+
+/* Where a law's auxiliary outputs (dissipation normal, tangential, deflection rate x, y)
+ * go in the state derivative. */
+static void auxiliary_targets(int plane, int target[4])
+{
+    target[0] = BALLC_STATE_DISSIPATED_NORMAL;
+    target[1] = BALLC_STATE_DISSIPATED_TANGENTIAL;
+    target[2] = plane == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X;
+    target[3] = target[2] + 1;
+}
+
+static const double *law_latch(const double *latch, int plane)
+{
+    return latch + plane * BALLC_N_LATCH_PER_PLANE;
+}
 
 typedef struct {
     double L[6];   /* Cholesky factor of S, packed lower: L00 L10 L11 L20 L21 L22 */
@@ -35,12 +51,21 @@ static int all_finite(const double *v, int n)
     return 1;
 }
 
-/* Mass blocks (16) and forcing (6) of everything that acts under ``flags``. */
+/* Every input the equations may read must be finite: a NaN would otherwise slip
+ * through branch-free code (e.g. a NaN height reads as "no contact"). */
+static int inputs_finite(const double *state, const double *params, const double *latch)
+{
+    return all_finite(state, NS) && all_finite(params, BALLC_N_PARAMETERS)
+        && all_finite(latch, BALLC_N_LATCH);
+}
+
+/* Mass blocks (16) and forcing (6) of everything that acts under ``flags``; the rates
+ * of the auxiliary states go to ``auxiliary`` (indexed by state, may be NULL). */
 static void assemble(const double *state, const double *params, const double *latch,
-                     int flags, double *mass, double *force)
+                     int flags, double *mass, double *force, double *xdot)
 {
     double buf[BALLC_BALL_NOUT];
-    double gf[6];
+    double out[LAW_NOUT];
     ballc_ball(state, params, NULL, buf);
     memcpy(mass, buf, BALLC_MASS_SIZE * sizeof(double));
     memcpy(force, buf + BALLC_MASS_SIZE, NU * sizeof(double));
@@ -49,11 +74,32 @@ static void assemble(const double *state, const double *params, const double *la
         for (int i = 0; i < BALLC_MASS_SIZE; i++) mass[i] += buf[i];
         for (int i = 0; i < NU; i++) force[i] += buf[BALLC_MASS_SIZE + i];
     }
+    if (xdot)
+        for (int i = BALLC_N_MECHANICAL_STATES; i < NS; i++) xdot[i] = 0.0;
     for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
         if (!(flags & CONTACT_LAWS[k].flag)) continue;
-        CONTACT_LAWS[k].value(state, params, latch + CONTACT_LAWS[k].latch_offset, gf);
-        for (int i = 0; i < NU; i++) force[i] += gf[i];
+        int plane = CONTACT_LAWS[k].plane, target[4];
+        CONTACT_LAWS[k].value(state, params, law_latch(latch, plane), out);
+        for (int i = 0; i < NU; i++) force[i] += out[i];
+        if (!xdot) continue;
+        auxiliary_targets(plane, target);
+        for (int i = 0; i < 4; i++) xdot[target[i]] += out[BALLC_LAW_DISSIPATION + i];
     }
+}
+
+int ballc_contact_forces(const double *state, const double *params, const double *latch,
+                         int flags, double *forces)
+{
+    double out[LAW_NOUT];
+    for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
+    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
+    for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
+        if (!(flags & CONTACT_LAWS[k].flag)) continue;
+        int plane = CONTACT_LAWS[k].plane;
+        CONTACT_LAWS[k].value(state, params, law_latch(latch, plane), out);
+        for (int i = 0; i < 3; i++) forces[3 * plane + i] += out[BALLC_LAW_FORCE + i];
+    }
+    return all_finite(forces, 3 * BALLC_N_PLANES) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 /* Factor S = J - B B^T / D. */
@@ -108,10 +154,10 @@ static void schur_solve(const schur_t *f, double *b)
 }
 
 static int accelerations(const double *state, const double *params, const double *latch,
-                         int flags, schur_t *factor, double *udot)
+                         int flags, schur_t *factor, double *udot, double *xdot)
 {
     double mass[BALLC_MASS_SIZE];
-    assemble(state, params, latch, flags, mass, udot);
+    assemble(state, params, latch, flags, mass, udot, xdot);
     int status = schur_factor(mass, factor);
     if (status != BALLC_OK) return status;
     schur_solve(factor, udot);
@@ -122,9 +168,13 @@ int ballc_rhs(const double *state, const double *params, const double *latch,
               int flags, double *xdot)
 {
     schur_t factor;
+    if (!inputs_finite(state, params, latch)) {
+        for (int i = 0; i < NS; i++) xdot[i] = NAN;
+        return BALLC_NOT_FINITE;
+    }
     ballc_kinematics(state, params, NULL, xdot);
-    int status = accelerations(state, params, latch, flags, &factor, xdot + NQ);
-    if (status == BALLC_OK && !all_finite(xdot, NQ)) status = BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, xdot + NQ, xdot);
+    if (status == BALLC_OK && !all_finite(xdot, NS)) status = BALLC_NOT_FINITE;
     return status;
 }
 
@@ -132,7 +182,7 @@ int ballc_rhs(const double *state, const double *params, const double *latch,
 static void add_dynamics_jac(kernel_fn kernel, const double *state, const double *params, const double *udot,
                              double *dF, double *dMa)
 {
-    double buf[BALLC_BALL_JAC_NOUT];
+    double buf[BALLC_BALL_JAC_NOUT];   /* ball and observer kernels have equal sizes */
     kernel(state, params, udot, buf);
     for (int i = 0; i < NU * NS; i++) dF[i] += buf[i];
     for (int i = 0; i < NU * 4; i++) dMa[i] += buf[NU * NS + i];
@@ -143,19 +193,26 @@ int ballc_jacobian(const double *state, const double *params, const double *latc
 {
     schur_t factor;
     double udot[NU];
-    int status = accelerations(state, params, latch, flags, &factor, udot);
+    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, udot, NULL);
     if (status != BALLC_OK) return status;
 
+    for (int i = 0; i < NS * NS; i++) jac[i] = 0.0;
     ballc_kinematics_jac(state, params, NULL, jac);   /* rows 0..6 */
 
-    double dF[NU * NS] = {0}, dMa[NU * 4] = {0}, buf[NU * NS];
+    double dF[NU * NS] = {0}, dMa[NU * 4] = {0}, buf[LAW_NOUT * NS];
     add_dynamics_jac(ballc_ball_jac, state, params, udot, dF, dMa);
     if (flags & BALLC_WITH_OBSERVER)
         add_dynamics_jac(ballc_observer_jac, state, params, udot, dF, dMa);
     for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
         if (!(flags & CONTACT_LAWS[k].flag)) continue;
-        CONTACT_LAWS[k].jac(state, params, latch + CONTACT_LAWS[k].latch_offset, buf);
+        int plane = CONTACT_LAWS[k].plane, target[4];
+        CONTACT_LAWS[k].jac(state, params, law_latch(latch, plane), buf);
         for (int i = 0; i < NU * NS; i++) dF[i] += buf[i];
+        auxiliary_targets(plane, target);
+        for (int i = 0; i < 4; i++)
+            for (int j = 0; j < NS; j++)
+                jac[target[i] * NS + j] += buf[(BALLC_LAW_DISSIPATION + i) * NS + j];
     }
     /* d udot / dx_j = M^-1 (dF/dx_j - d(M udot)/dx_j); M depends on q only. */
     for (int j = 0; j < NS; j++) {

@@ -16,17 +16,25 @@ enum {
     BALLC_FLOOR_FRICTION = 2,
     BALLC_FLOOR_DIGIN = 4,
     BALLC_CEILING_FRICTION = 8,
-    BALLC_CEILING_DIGIN = 16
+    BALLC_CEILING_DIGIN = 16,
+    BALLC_FLOOR_COMPLIANT = 32,
+    BALLC_CEILING_COMPLIANT = 64
 };
+
+/* Sum of the contact forces on the ball, per plane (floor x y z, ceiling x y z). */
+int ballc_contact_forces(const double *state, const double *params, const double *latch,
+                         int flags, double *forces);
 
 /* Return codes. */
 enum { BALLC_OK = 0, BALLC_NOT_POSITIVE_DEFINITE = 1, BALLC_NOT_FINITE = 2 };
 
-/* xdot (13) = f(state); latch holds BALLC_N_LATCH values (floor then ceiling). */
+/* xdot (BALLC_N_STATES) = f(state); latch holds BALLC_N_LATCH values (floor, ceiling).
+ * The auxiliary states (dissipated work, tangential deflections) get the rates of the
+ * active contact laws; a plane's deflection is constant while it is not in contact. */
 int ballc_rhs(const double *state, const double *params, const double *latch,
               int flags, double *xdot);
 
-/* jac (13 x 13, row-major) = d f / d state. */
+/* jac (BALLC_N_STATES^2, row-major) = d f / d state. */
 int ballc_jacobian(const double *state, const double *params, const double *latch,
                    int flags, double *jac);
 

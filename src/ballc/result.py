@@ -8,6 +8,8 @@ import numpy as np
 from . import _core
 from .orientation import angles_123_from_quaternion
 
+_STATE = {name: i for i, name in enumerate(_core.STATE_NAMES)}
+
 
 @dataclass
 class Contact:
@@ -28,6 +30,13 @@ class Contact:
     velocity_after: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
     angular_velocity_after: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
     max_penetration: float = 0.0     # m
+    #: centre (x, y) when the penetration was largest: the contact point (m)
+    contact_point: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
+    peak_normal_force: float = np.nan      # N, largest F . n over the stored samples
+    energy_lost_normal: float = np.nan     # J, dissipated by the normal force
+    energy_lost_tangential: float = np.nan  # J, dissipated by the tangential force
+    time_sticking: float = np.nan          # s, |F_t| below the Coulomb cap mu F_n
+    time_slipping: float = np.nan          # s, |F_t| at the cap
 
     @property
     def duration(self) -> float:
@@ -36,6 +45,12 @@ class Contact:
     def as_dict(self) -> dict:
         row = {"plane": self.plane, "t_start": self.t_start, "t_end": self.t_end,
                "duration": self.duration, "max_penetration": self.max_penetration,
+               "contact_point_x": float(self.contact_point[0]),
+               "contact_point_y": float(self.contact_point[1]),
+               "peak_normal_force": self.peak_normal_force,
+               "energy_lost_normal": self.energy_lost_normal,
+               "energy_lost_tangential": self.energy_lost_tangential,
+               "time_sticking": self.time_sticking, "time_slipping": self.time_slipping,
                "penetration_rate_at_impact": self.penetration_rate_at_impact}
         for name in ("velocity_before", "velocity_after", "angular_velocity_before",
                      "angular_velocity_after"):
@@ -111,13 +126,36 @@ class Result:
 
     @property
     def energy(self) -> dict:
-        """name -> (n,) array (J): kinetic, potential, spring, total."""
+        """name -> (n,) array (J).
+
+        ``kinetic``, ``potential`` (gravity), ``spring`` (Hertz, 2/5 k0 rho^(5/2)) and
+        their sum ``total`` (the seed's total energy); ``dissipated_normal`` and
+        ``dissipated_tangential``: work dissipated by the contact forces since t = 0
+        (integrated with the motion; negative where a model injects energy, as dig-in
+        does), ``dissipated`` their sum, and ``balance`` = total + dissipated, which
+        stays at the initial energy to integration tolerance for every model.
+        """
         if self._energy is None:
             e = _core.energies(np.ascontiguousarray(self.y.T), self.scene.parameter_vector())
             spring = e[:, 2] + e[:, 3]
+            total = e[:, 0] + e[:, 1] + spring
+            normal = self.y[_STATE["dissipated_normal"]]
+            tangential = self.y[_STATE["dissipated_tangential"]]
             self._energy = {"kinetic": e[:, 0], "potential": e[:, 1], "spring": spring,
-                            "total": e[:, 0] + e[:, 1] + spring}
+                            "total": total, "dissipated_normal": normal,
+                            "dissipated_tangential": tangential,
+                            "dissipated": normal + tangential,
+                            "balance": total + normal + tangential}
         return self._energy
+
+    def contacts_dataframe(self):
+        """The contact table as a pandas DataFrame, one row per contact (SI units)."""
+        import pandas as pd
+        return pd.DataFrame([c.as_dict() for c in self.contacts])
+
+    def contacts_csv(self, path) -> None:
+        """Write the contact table to a CSV file."""
+        self.contacts_dataframe().to_csv(path, index_label="contact")
 
     # --- the observer: what a sensor inside the ball records (see ballc.observer) ---
 

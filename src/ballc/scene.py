@@ -23,6 +23,8 @@ mixture                            mixtur          1            0.375
 tangential_model                   -               -            "mixture"
 friction_regularization_speed      (1e-10 in the   m/s          1e-10
                                    seed's code)
+friction_regularization            -               -            "max" (or "smooth")
+tangential_stiffness_ratio         -               1            Mindlin (compliant)
 position (centre)                  m1, m2, m3      m            (0, 0, 5)
 velocity (centre)                  um1, um2, um3   m/s          (-5, 5, -25)
 angles (body-fixed 123)            q1, q2, q3      rad          (0, 0, 0)
@@ -30,7 +32,13 @@ angular_velocity (inertial comps)  u1, u2, u3      rad/s        (0, 0, 0)
 =================================  ==============  ===========  ====================
 
 ``tangential_model`` is "mixture" (force = (1 - mixture) friction + mixture dig-in),
-"friction" (mixture taken as 0) or "dig-in" (mixture taken as 1).
+"friction" (mixture taken as 0), "dig-in" (mixture taken as 1) or "compliant"
+(ballc's tangential-compliance model: an elastic tangential spring of stiffness
+``tangential_stiffness_ratio`` times the normal contact stiffness, damped like the
+normal force, capped at mu F_n; default ratio: Mindlin's, from the Poisson ratios
+and moduli).  ``friction_regularization`` is "max" (the seed's
+v_t / max(|v_t|, v_s)) or "smooth" (v_t / sqrt(|v_t|^2 + v_s^2)), v_s being
+``friction_regularization_speed``.
 The seed's latched values rhodtu, rhodto, ru1..3, ro1..3 are not parameters: ballc
 latches them itself at each contact start.
 """
@@ -46,7 +54,8 @@ import numpy as np
 from . import _core
 from .orientation import quaternion_from_angles_123
 
-TANGENTIAL_MODELS = ("mixture", "friction", "dig-in")
+TANGENTIAL_MODELS = ("mixture", "friction", "dig-in", "compliant")
+FRICTION_REGULARIZATIONS = ("max", "smooth")
 
 #: Scene field -> seed symbol(s).
 SEED_SYMBOLS = {
@@ -90,6 +99,8 @@ class Scene:
     mixture: float = 0.375
     tangential_model: str = "mixture"
     friction_regularization_speed: float = 1e-10
+    friction_regularization: str = "max"
+    tangential_stiffness_ratio: float | None = None
     position: tuple = (0.0, 0.0, 5.0)
     velocity: tuple = (-5.0, 5.0, -25.0)
     angles: tuple = (0.0, 0.0, 0.0)
@@ -117,6 +128,12 @@ class Scene:
             if len(vector) != 3:
                 raise SceneError(f"{name} must be 3 numbers, got {len(vector)}: {value!r}")
             object.__setattr__(self, name, vector)
+        if self.tangential_stiffness_ratio is None:
+            object.__setattr__(self, "tangential_stiffness_ratio",
+                               mindlin_stiffness_ratio(self.ball_poisson_ratio,
+                                                       self.plane_poisson_ratio,
+                                                       self.ball_youngs_modulus,
+                                                       self.plane_youngs_modulus))
         if self.inertia is None:
             try:
                 i = 0.4 * float(self.mass) * float(self.radius) ** 2
@@ -161,8 +178,10 @@ class Scene:
 
     @property
     def effective_mixture(self) -> float:
-        """Weight of the dig-in law actually used (0 for "friction", 1 for "dig-in")."""
-        return {"friction": 0.0, "dig-in": 1.0}.get(self.tangential_model, self.mixture)
+        """Weight of the dig-in law actually used (0 for "friction", 1 for "dig-in"; the
+        compliant model has no dig-in part)."""
+        return {"friction": 0.0, "dig-in": 1.0, "compliant": 0.0}.get(
+            self.tangential_model, self.mixture)
 
     @property
     def hertz_stiffness(self) -> float:
@@ -187,13 +206,34 @@ class Scene:
             "plane_youngs_modulus": self.plane_youngs_modulus,
             "c_tau": self.c_tau, "friction_coefficient": self.friction_coefficient,
             "friction_regularization_speed": self.friction_regularization_speed,
+            "smooth_friction": float(self.friction_regularization == "smooth"),
+            "tangential_stiffness_ratio": self.tangential_stiffness_ratio,
         }
         return np.array([float(values[name]) for name in _core.PARAMETER_NAMES])
 
     def initial_state(self) -> np.ndarray:
         """State vector in the generated layout order (``ballc._core.STATE_NAMES``)."""
-        return np.concatenate([quaternion_from_angles_123(self.angles), self.position,
-                               self.angular_velocity, self.velocity])
+        mechanical = np.concatenate([quaternion_from_angles_123(self.angles), self.position,
+                                     self.angular_velocity, self.velocity])
+        auxiliary = np.zeros(_core.N_STATES - mechanical.size)   # dissipated work, deflections
+        return np.concatenate([mechanical, auxiliary])
+
+
+def mindlin_stiffness_ratio(nu_ball, nu_plane, e_ball, e_plane):
+    """Mindlin's tangential / normal contact stiffness ratio kappa = 4 G* / E*.
+
+    1/E* = (1 - nu_b^2)/E_b + (1 - nu_p^2)/E_p, 1/G* = (2 - nu_b)/G_b + (2 - nu_p)/G_p,
+    G = E / (2 (1 + nu)); for equal materials kappa = 2 (1 - nu) / (2 - nu).
+    Non-numeric inputs give NaN (validation reports them).
+    """
+    try:
+        nu_b, nu_p, e_b, e_p = (float(v) for v in (nu_ball, nu_plane, e_ball, e_plane))
+        g_b, g_p = e_b / (2 * (1 + nu_b)), e_p / (2 * (1 + nu_p))
+        e_star = 1 / ((1 - nu_b ** 2) / e_b + (1 - nu_p ** 2) / e_p)
+        g_star = 1 / ((2 - nu_b) / g_b + (2 - nu_p) / g_p)
+        return 4 * g_star / e_star
+    except (TypeError, ValueError, ZeroDivisionError):
+        return math.nan
 
 
 def _reject_unknown_fields(values) -> None:
@@ -263,6 +303,11 @@ def _validate(s: Scene) -> None:
         fail("c_tau", s.c_tau, "must be in (0, 1]")
     if not 0 <= finite("mixture", s.mixture) <= 1:
         fail("mixture", s.mixture, "must be in [0, 1]")
+    if not finite("tangential_stiffness_ratio", s.tangential_stiffness_ratio) > 0:
+        fail("tangential_stiffness_ratio", s.tangential_stiffness_ratio, "must be > 0")
+    if s.friction_regularization not in FRICTION_REGULARIZATIONS:
+        fail("friction_regularization", s.friction_regularization,
+             f"must be one of {FRICTION_REGULARIZATIONS}")
     if s.tangential_model not in TANGENTIAL_MODELS:
         close = difflib.get_close_matches(str(s.tangential_model), TANGENTIAL_MODELS, n=1)
         hint = f"; did you mean {close[0]!r}?" if close else ""

@@ -14,12 +14,14 @@ import sys
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import _core
+from . import _core, _radau5
 from .result import Contact, Result
 from .scene import Scene, SceneError
 
 SCIPY_METHODS = ("Radau", "BDF", "LSODA", "DOP853", "RK45", "RK23")
 IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+#: "radau5": ballc's compiled Radau IIA (order 5), scipy's Radau step by step in C.
+METHODS = ("radau5",) + SCIPY_METHODS
 PLANES = ("floor", "ceiling")
 
 #: Smallest penetration rate latched at impact (m/s).  A contact that starts
@@ -31,37 +33,78 @@ _STATE = {name: i for i, name in enumerate(_core.STATE_NAMES)}
 _Z, _VZ = _STATE["z"], _STATE["vz"]
 _OMEGA, _V = _STATE["omega_x"], _STATE["vx"]
 _KIN_PER_PLANE = _core.CONTACT_KINEMATICS_NOUT // len(PLANES)
+_DISSIPATED = [_STATE["dissipated_normal"], _STATE["dissipated_tangential"]]
+_DEFLECTION = {plane: [_STATE[f"{plane}_deflection_x"], _STATE[f"{plane}_deflection_y"]]
+               for plane in PLANES}
+
+
+class LinearEvent:
+    """An event that is a linear functional of the state: g(y) = coefficients . y + offset.
+
+    Callable like a solve_ivp event, ``event(t, y)``, with solve_ivp's ``terminal``
+    and ``direction`` attributes; radau5 reads ``coefficients`` and ``offset`` and
+    evaluates it in C.  Every event of the driver is of this form.
+    """
+
+    __slots__ = ("coefficients", "offset", "terminal", "direction", "_index", "_scale")
+
+    def __init__(self, coefficients, offset=0.0, terminal=False, direction=0):
+        self.coefficients = np.array(coefficients, dtype=float)
+        if self.coefficients.shape != (_core.N_STATES,):
+            raise ValueError(f"coefficients must have shape ({_core.N_STATES},), "
+                             f"got {self.coefficients.shape}")
+        self.offset = float(offset)
+        self.terminal = bool(terminal)
+        self.direction = direction
+        nonzero = np.flatnonzero(self.coefficients)
+        # one state only (all of the driver's): skip the dot product when called
+        self._index = int(nonzero[0]) if nonzero.size == 1 else None
+        self._scale = float(self.coefficients[nonzero[0]]) if nonzero.size == 1 else 0.0
+
+    @classmethod
+    def of_state(cls, name, scale=1.0, offset=0.0, terminal=False, direction=0):
+        """g(y) = scale * y[name] + offset."""
+        coefficients = np.zeros(_core.N_STATES)
+        coefficients[_STATE[name]] = scale
+        return cls(coefficients, offset, terminal, direction)
+
+    def shifted(self, delta, terminal, direction):
+        """g(y) + delta, with its own terminal and direction."""
+        return LinearEvent(self.coefficients, self.offset + delta, terminal, direction)
+
+    def __call__(self, t, y):
+        if self._index is not None:
+            return self._scale * y[self._index] + self.offset
+        return float(self.coefficients @ y) + self.offset
+
+    def __repr__(self):
+        terms = " + ".join(f"{c:g}*{_core.STATE_NAMES[i]}"
+                           for i, c in enumerate(self.coefficients) if c)
+        return (f"LinearEvent({terms} + {self.offset:g}, terminal={self.terminal}, "
+                f"direction={self.direction})")
 
 
 def _penetration(plane, scene):
-    """rho(y) of ``plane``: positive when the ball overlaps it (m)."""
+    """rho(y) of ``plane`` (a LinearEvent): positive when the ball overlaps it (m)."""
     r, h = scene.radius, scene.ceiling_height
     if plane == "floor":
-        return lambda t, y: r - y[_Z]
-    return lambda t, y: y[_Z] - (h - r)
-
-
-def _event(function, terminal, direction):
-    function.terminal = terminal
-    function.direction = direction
-    return function
+        return LinearEvent.of_state("z", -1.0, r)
+    return LinearEvent.of_state("z", 1.0, -(h - r))
 
 
 def _segment_events(scene, in_contact):
-    """Events of one segment: [(kind, plane, event function)]."""
+    """Events of one segment: [(kind, plane, LinearEvent)]."""
     events = []
     for plane in PLANES:
         rho = _penetration(plane, scene)
         if in_contact[plane]:
-            r = scene.radius
             normal = 1.0 if plane == "floor" else -1.0
-            events.append(("leave", plane, _event(lambda t, y, rho=rho: rho(t, y), True, -1)))
-            events.append(("through", plane,
-                           _event(lambda t, y, rho=rho, r=r: rho(t, y) - r, True, 1)))
+            events.append(("leave", plane, rho.shifted(0.0, True, -1)))
+            events.append(("through", plane, rho.shifted(-scene.radius, True, 1)))
             events.append(("deepest", plane,
-                           _event(lambda t, y, s=normal: -s * y[_VZ], False, -1)))
+                           LinearEvent.of_state("vz", -normal, 0.0, False, -1)))
         else:
-            events.append(("enter", plane, _event(lambda t, y, rho=rho: rho(t, y), True, 1)))
+            events.append(("enter", plane, rho.shifted(0.0, True, 1)))
     return events
 
 
@@ -70,6 +113,9 @@ def _flags(scene, in_contact):
     mixture = scene.effective_mixture
     for plane in PLANES:
         if not in_contact[plane]:
+            continue
+        if scene.tangential_model == "compliant":
+            flags |= _core.FLAGS[f"{plane}_compliant"]
             continue
         if mixture < 1:
             flags |= _core.FLAGS[f"{plane}_friction"]
@@ -96,9 +142,15 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
 
     This is the one seam between the driver and an integrator.  The solution must
     have ``t, y, t_events, y_events, status (0 reached t1, 1 terminal event, -1
-    failure), message, nfev, njev, nlu``.  Events are solve_ivp-style callables with
-    ``terminal`` and ``direction`` attributes.
+    failure), message, nfev, njev, nlu``.  Events are :class:`LinearEvent` (callable
+    like solve_ivp events, with ``terminal`` and ``direction``).  ``method`` "radau5"
+    runs ballc's compiled Radau IIA on the system's C right-hand side and Jacobian;
+    any other is handed to scipy's solve_ivp (with the analytic Jacobian when implicit).
     """
+    if method == "radau5":
+        return _radau5.solve_system(system.params, system.latch, system.flags, (t0, t1), y0,
+                                    rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
+                                    events=events)
     options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
     return solve_ivp(system, (t0, t1), y0, method=method, rtol=rtol, atol=atol,
                      t_eval=t_eval, events=events, max_step=max_step, **options)
@@ -120,8 +172,8 @@ def _check_options(scene, t_end, method, rtol, atol, max_step=np.inf):
         raise SceneError(f"t_end = {t_end!r} is not allowed: must be a number > 0") from None
     if not (math.isfinite(t_end) and t_end > 0):
         raise SceneError(f"t_end = {t_end!r} is not allowed: must be finite and > 0")
-    if method not in SCIPY_METHODS:
-        raise SceneError(f"method = {method!r} is not allowed: must be one of {SCIPY_METHODS}")
+    if method not in METHODS:
+        raise SceneError(f"method = {method!r} is not allowed: must be one of {METHODS}")
     for name, value in (("rtol", rtol), ("atol", atol)):
         try:
             array = np.asarray(value, dtype=float)
@@ -198,6 +250,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
     t = 0.0
     in_contact = {plane: False for plane in PLANES}
     open_contacts: dict[str, Contact] = {}
+    dissipated_at_start: dict[str, np.ndarray] = {}
     contacts: list[Contact] = []
     ts, ys = [np.array([t])], [y[:, None]]
     if t_eval is not None:
@@ -232,9 +285,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
         latch_columns.append(np.repeat(latch[:, None], ts[-1].size, axis=1))
         for (kind, plane, _), t_hits, y_hits in zip(events, sol.t_events, sol.y_events):
             if kind == "deepest" and len(t_hits):
-                depth = max(_penetration(plane, scene)(0, yy) for yy in y_hits)
-                open_contacts[plane].max_penetration = max(
-                    open_contacts[plane].max_penetration, depth)
+                for yy in y_hits:
+                    _record_depth(open_contacts[plane], _penetration(plane, scene)(0, yy), yy)
 
         if sol.status == -1:
             status, message = -1, f"integrator failed at t = {sol.t[-1]:.6g} s: {sol.message}"
@@ -252,18 +304,23 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
             k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE
             latch[k] = rate
             latch[k + 1:k + 4] = direction
+            y[_DEFLECTION[plane]] = 0.0      # the tangential spring starts relaxed
             in_contact[plane] = True
             contact = Contact(plane=plane, t_start=t, velocity_before=y[_V:_V + 3].copy(),
                               angular_velocity_before=y[_OMEGA:_OMEGA + 3].copy(),
                               penetration_rate_at_impact=rate, digin_direction=direction)
+            _record_depth(contact, 0.0, y)
             open_contacts[plane] = contact
             contacts.append(contact)
+            dissipated_at_start[plane] = y[_DISSIPATED].copy()
         elif kind == "leave":
             in_contact[plane] = False
             contact = open_contacts.pop(plane)
             contact.t_end = t
             contact.velocity_after = y[_V:_V + 3].copy()
             contact.angular_velocity_after = y[_OMEGA:_OMEGA + 3].copy()
+            lost = y[_DISSIPATED] - dissipated_at_start.pop(plane)
+            contact.energy_lost_normal, contact.energy_lost_tangential = map(float, lost)
         else:  # "through"
             open_contacts[plane].max_penetration = scene.radius
             status = 1
@@ -275,12 +332,56 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
         bar.update((t_end if status == 0 else t) - bar.n)
         bar.close()
     for plane, contact in open_contacts.items():   # still in contact at the end
-        depth = _penetration(plane, scene)(0, ys[-1][:, -1]) if ys[-1].size else 0.0
-        contact.max_penetration = max(contact.max_penetration, depth)
-    return Result(t=np.concatenate(ts), y=np.concatenate(ys, axis=1), scene=scene,
-                  status=status, message=message, nfev=nfev, njev=njev, nlu=nlu,
-                  contacts=contacts, flags=np.concatenate(flag_columns),
-                  latch=np.concatenate(latch_columns, axis=1))
+        if ys[-1].size:
+            _record_depth(contact, _penetration(plane, scene)(0, ys[-1][:, -1]), ys[-1][:, -1])
+    result = Result(t=np.concatenate(ts), y=np.concatenate(ys, axis=1), scene=scene,
+                    status=status, message=message, nfev=nfev, njev=njev, nlu=nlu,
+                    contacts=contacts, flags=np.concatenate(flag_columns),
+                    latch=np.concatenate(latch_columns, axis=1))
+    summarize_contact_forces(result)
+    return result
+
+
+def _record_depth(contact, depth, y):
+    """Keep the deepest penetration of a contact and where it happened."""
+    if depth >= contact.max_penetration:
+        contact.max_penetration = float(depth)
+        contact.contact_point = y[[_STATE["x"], _STATE["y"]]].copy()
+
+
+#: |F_t| >= STICK_SLIP_THRESHOLD * mu F_n counts as slipping (at the Coulomb cap).
+STICK_SLIP_THRESHOLD = 0.999
+
+
+def summarize_contact_forces(result):
+    """Peak normal force and sticking / slipping time of every contact, from the
+    stored samples (solver steps, or t_eval: the resolution is that of the samples)."""
+    scene = result.scene
+    params = scene.parameter_vector()
+    mu = scene.friction_coefficient
+    for contact in result.contacts:
+        end = contact.t_end if np.isfinite(contact.t_end) else result.t[-1]
+        inside = np.flatnonzero((result.t >= contact.t_start) & (result.t <= end))
+        if inside.size == 0:
+            continue
+        k = PLANES.index(contact.plane)
+        normal = 1.0 if contact.plane == "floor" else -1.0
+        states = np.ascontiguousarray(result.y[:, inside].T)
+        forces = np.empty((inside.size, 3))
+        for j, i in enumerate(inside):
+            f = _core.contact_forces(states[j:j + 1], params,
+                                     np.ascontiguousarray(result.latch[:, i]),
+                                     int(result.flags[i]))[0]
+            forces[j] = f[3 * k:3 * k + 3]
+        f_n = forces[:, 2] * normal
+        f_t = np.hypot(forces[:, 0], forces[:, 1])
+        contact.peak_normal_force = float(f_n.max())
+        slipping = (f_t >= STICK_SLIP_THRESHOLD * mu * f_n) & (f_n > 0)
+        t = result.t[inside]
+        dt = np.diff(t)
+        slip_fraction = 0.5 * (slipping[1:].astype(float) + slipping[:-1])
+        contact.time_slipping = float(np.sum(dt * slip_fraction))
+        contact.time_sticking = float(np.sum(dt) - contact.time_slipping)
 
 
 def _progress_bar(progress, t_end):
