@@ -52,3 +52,25 @@ def test_a_result_without_contacts_round_trips(tmp_path):
     quiet.save(tmp_path / "q.npz")
     again = ballc.load(tmp_path / "q.npz")
     assert again.contacts == [] and np.array_equal(again.y, quiet.y)
+
+
+def test_scene_toml_round_trip(tmp_path):
+    scene = ballc.Scene(mixture=0.123456789, velocity=(-1.0, 2.5e-3, -7.0), mass=2,
+                        tangential_model="friction", c_tau=1.0)
+    scene.to_toml(tmp_path / "s.toml")
+    assert ballc.Scene.from_toml(tmp_path / "s.toml") == scene
+
+
+@pytest.mark.parametrize("name", ["seed.toml", "superball.toml"])
+def test_example_scene_files_load(name):
+    from pathlib import Path
+    scene = ballc.Scene.from_toml(Path(__file__).parents[1] / "examples" / name)
+    assert isinstance(scene, ballc.Scene)
+    if name == "seed.toml":
+        assert scene == ballc.Scene()
+
+
+def test_invalid_toml_names_the_file(tmp_path):
+    (tmp_path / "x.toml").write_text("mixture = [\n")
+    with pytest.raises(ballc.SceneError, match="x.toml: not valid TOML"):
+        ballc.Scene.from_toml(tmp_path / "x.toml")
