@@ -7,10 +7,12 @@
 from ._core import PARAMETER_NAMES, STATE_NAMES
 from .io import load
 from .result import Contact, Result
+from .rigid import RigidImpact, hunt_crossley_restitution, rigid_impact
 from .scene import TANGENTIAL_MODELS, Scene, SceneError
 from .simulate import simulate
 from .sweep import sweep
 
 __version__ = "0.1.0"
-__all__ = ["Contact", "PARAMETER_NAMES", "Result", "STATE_NAMES", "Scene", "SceneError",
-           "TANGENTIAL_MODELS", "load", "simulate", "sweep"]
+__all__ = ["Contact", "PARAMETER_NAMES", "Result", "RigidImpact", "STATE_NAMES", "Scene",
+           "SceneError", "TANGENTIAL_MODELS", "hunt_crossley_restitution", "load",
+           "rigid_impact", "simulate", "sweep"]

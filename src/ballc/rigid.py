@@ -1,0 +1,120 @@
+"""Rigid impact map of a sphere on a plane (Walton / Garwin-style), in closed form.
+
+One instantaneous impact: normal restitution ``e`` (exit/entry normal speed),
+Coulomb friction ``mu`` and tangential restitution ``e_t`` of the contact point's
+tangential velocity.  Used as the stiff-material limit of the compliant models and
+as a quick estimate.
+
+With n the plane's normal towards the ball, c = -r n the contact point relative to
+the centre, u = v_t + omega x c the tangential velocity of the contact point and
+m_t = 1 / (1/m + r^2/I) the effective tangential mass of a sphere:
+
+* normal impulse ``P_n = m (1 + e) |v . n|`` (the ball must be approaching);
+* tangential impulse ``P_t = -m_t (1 + e_t) u`` if ``|P_t| <= mu P_n`` (the contact
+  point sticks: it leaves with ``-e_t u``; e_t = 0 is rolling), otherwise the contact
+  slides throughout and ``P_t = -mu P_n u / |u|``.
+
+So with e_t = 0 the contact point ends rolling exactly when
+``|u| <= mu (1 + e) |v_n| (1 + m r^2 / I)`` — ``3.5 mu (1 + e) |v_n|`` for a solid sphere.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class RigidImpact:
+    """Velocities after one rigid impact (SI units, inertial components)."""
+
+    velocity: np.ndarray           # centre velocity after (m/s)
+    angular_velocity: np.ndarray   # angular velocity after (rad/s)
+    normal_impulse: float          # N s
+    tangential_impulse: np.ndarray  # N s, in the plane
+    sticking: bool                 # True: the contact point stuck (left with -e_t u)
+
+
+def _vector(name, value):
+    v = np.asarray(value, dtype=float)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} = {value!r} is not allowed: must be 3 finite numbers")
+    return v
+
+
+def rigid_impact(velocity, angular_velocity, *, mass=1.0, radius=1.0, inertia=None,
+                 restitution=1.0, friction_coefficient=0.0, tangential_restitution=0.0,
+                 plane="floor") -> RigidImpact:
+    """Post-impact velocity and spin of a sphere hitting ``plane`` ("floor"/"ceiling").
+
+    Parameters
+    ----------
+    velocity, angular_velocity : 3 floats
+        Centre velocity (m/s) and angular velocity (rad/s) just before the impact.
+    mass, radius : float
+        kg, m.
+    inertia : float, optional
+        Central moment of inertia (kg m^2); default 2/5 m r^2 (solid sphere).
+    restitution : float
+        Normal restitution e in [0, 1].
+    friction_coefficient : float
+        Coulomb mu >= 0.
+    tangential_restitution : float
+        e_t in [-1, 1]: 0 = the contact point ends rolling when it sticks (pure
+        Coulomb), 1 = its tangential velocity is reversed (a perfect superball).
+    """
+    v = _vector("velocity", velocity)
+    w = _vector("angular_velocity", angular_velocity)
+    if plane not in ("floor", "ceiling"):
+        raise ValueError(f"plane = {plane!r} is not allowed: must be 'floor' or 'ceiling'")
+    for name, value, low, high in (("mass", mass, 0, np.inf), ("radius", radius, 0, np.inf)):
+        if not (np.isfinite(value) and value > low):
+            raise ValueError(f"{name} = {value!r} is not allowed: must be finite and > 0")
+    inertia = 0.4 * mass * radius ** 2 if inertia is None else float(inertia)
+    if not (np.isfinite(inertia) and inertia > 0):
+        raise ValueError(f"inertia = {inertia!r} is not allowed: must be finite and > 0")
+    if not 0 <= restitution <= 1:
+        raise ValueError(f"restitution = {restitution!r} is not allowed: must be in [0, 1]")
+    if not friction_coefficient >= 0:
+        raise ValueError(f"friction_coefficient = {friction_coefficient!r} is not allowed: "
+                         "must be >= 0")
+    if not -1 <= tangential_restitution <= 1:
+        raise ValueError(f"tangential_restitution = {tangential_restitution!r} is not "
+                         "allowed: must be in [-1, 1]")
+
+    n = np.array([0.0, 0.0, 1.0 if plane == "floor" else -1.0])
+    approach = -v @ n
+    if approach <= 0:
+        raise ValueError(f"velocity = {velocity!r}: the ball is not moving towards the {plane}")
+    arm = -radius * n
+    u = v + np.cross(w, arm)
+    u = u - (u @ n) * n
+    p_n = mass * (1 + restitution) * approach
+    tangential_mass = 1.0 / (1.0 / mass + radius ** 2 / inertia)
+    p_t = -tangential_mass * (1 + tangential_restitution) * u
+    sticking = np.linalg.norm(p_t) <= friction_coefficient * p_n
+    if not sticking:
+        speed = np.linalg.norm(u)
+        p_t = -friction_coefficient * p_n * u / speed if speed > 0 else np.zeros(3)
+    impulse = p_n * n + p_t
+    return RigidImpact(velocity=v + impulse / mass,
+                       angular_velocity=w + np.cross(arm, p_t) / inertia,
+                       normal_impulse=float(p_n), tangential_impulse=p_t,
+                       sticking=bool(sticking))
+
+
+def hunt_crossley_restitution(c_tau: float) -> float:
+    """Exit/entry speed ratio e of one Hunt-Crossley impact (no gravity, no clamp active).
+
+    Solves a (1 + e) = ln((1 + a) / (1 - a e)), a = 3/2 (1 - c_tau): e depends on c_tau
+    only, not on the speed or the stiffness.  c_tau = 1 gives e = 1.
+    """
+    from scipy.optimize import brentq
+    if not 0 < c_tau <= 1:
+        raise ValueError(f"c_tau = {c_tau!r} is not allowed: must be in (0, 1]")
+    a = 1.5 * (1 - c_tau)
+    if a == 0:
+        return 1.0
+    upper = min(1.0, 1.0 / a) * (1 - 1e-15)
+    return brentq(lambda e: a * (1 + e) - np.log((1 + a) / (1 - a * e)), 1e-300, upper,
+                  xtol=1e-15, rtol=4 * np.finfo(float).eps)
