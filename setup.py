@@ -9,4 +9,14 @@ core = Extension(
     extra_compile_args=["-O2", "-std=c99"],
 )
 
-setup(ext_modules=cythonize([core], compiler_directives={"language_level": 3}))
+# The compiled Radau IIA integrator; it calls ballc_rhs / ballc_jacobian directly, so it
+# links its own copy of the system and kernels.  LAPACK comes from scipy at run time.
+radau5 = Extension(
+    "ballc._radau5",
+    sources=["src/ballc/_radau5.pyx", "src/ballc/_radau5_solver.c", "src/ballc/_system.c",
+             "generated/ballc_kernels.c"],
+    include_dirs=["generated", "src/ballc"],
+    extra_compile_args=["-O2", "-std=c99"],
+)
+
+setup(ext_modules=cythonize([core, radau5], compiler_directives={"language_level": 3}))

@@ -1,0 +1,283 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
+"""Bridge to the compiled Radau IIA (order 5) integrator in ``_radau5_solver.c``.
+
+Private: use ``ballc.simulate(..., method="radau5")``.  This module checks and
+converts arguments, hands LAPACK's addresses (from ``scipy.linalg.cython_lapack``)
+and a C right-hand side to ``radau5_solve`` and turns its buffers into arrays.
+The whole integration runs in C without the GIL: no Python per step.
+
+``solve_system`` integrates ballc's equations (``ballc_rhs`` / ``ballc_jacobian``);
+``solve_linear`` integrates y' = A y (a generic entry point, used to test the
+integrator against the matrix exponential).
+"""
+import warnings
+
+import numpy as np
+from scipy.optimize import OptimizeResult
+
+from libc.string cimport memcpy
+from scipy.linalg.cython_lapack cimport dgetrf, dgetrs, zgetrf, zgetrs
+
+
+cdef extern from "ballc_kernels.h":
+    int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH
+
+cdef extern from "_system.h":
+    int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
+    int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
+
+cdef extern from "_radau5_solver.h":
+    ctypedef int (*radau5_fun)(void *, double, const double *, double *) noexcept nogil
+    ctypedef int (*radau5_jac)(void *, double, const double *, double *) noexcept nogil
+    ctypedef struct radau5_lapack:
+        pass
+    ctypedef struct radau5_problem:
+        int n
+        radau5_fun fun
+        radau5_jac jac
+        void *ctx
+        double t0, t_bound
+        const double *y0
+        double rtol
+        const double *atol
+        double max_step, first_step
+        const double *t_eval
+        long n_eval
+        int n_events
+        const double *ev_coef
+        const double *ev_offset
+        const int *ev_terminal
+        const int *ev_direction
+        radau5_lapack lapack
+    ctypedef struct radau5_result:
+        int status
+        char message[240]
+        long nfev, njev, nlu, nstep, nreject
+        long n_out
+        double *t_out
+        double *y_out
+        long n_hits
+        int *hit_event
+        double *hit_t
+        double *hit_y
+    void radau5_set_lapack(radau5_lapack *, void *, void *, void *, void *) nogil
+    int radau5_solve(const radau5_problem *, radau5_result *) nogil
+    void radau5_free(radau5_result *) nogil
+
+
+EPS = np.finfo(float).eps
+
+# ---- C adapters: the systems radau5 can integrate ----
+
+ctypedef struct ball_ctx:
+    const double *params
+    const double *latch
+    int flags
+
+cdef int _ball_fun(void *ctx, double t, const double *y, double *f) noexcept nogil:
+    cdef ball_ctx *c = <ball_ctx *>ctx
+    return ballc_rhs(y, c.params, c.latch, c.flags, f)
+
+cdef int _ball_jac(void *ctx, double t, const double *y, double *jac) noexcept nogil:
+    cdef ball_ctx *c = <ball_ctx *>ctx
+    return ballc_jacobian(y, c.params, c.latch, c.flags, jac)
+
+ctypedef struct linear_ctx:
+    int n
+    const double *A
+
+cdef int _linear_fun(void *ctx, double t, const double *y, double *f) noexcept nogil:
+    cdef linear_ctx *c = <linear_ctx *>ctx
+    cdef int i, j
+    cdef double s
+    for i in range(c.n):
+        s = 0
+        for j in range(c.n):
+            s += c.A[i * c.n + j] * y[j]
+        f[i] = s
+    return 0
+
+cdef int _linear_jac(void *ctx, double t, const double *y, double *jac) noexcept nogil:
+    cdef linear_ctx *c = <linear_ctx *>ctx
+    memcpy(jac, c.A, c.n * c.n * sizeof(double))
+    return 0
+
+
+# ---- argument checks ----
+
+def _vector(name, value, n):
+    a = np.ascontiguousarray(value, dtype=float)
+    if a.shape != (n,):
+        raise ValueError(f"{name} must have shape ({n},), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} = {value!r} is not allowed: must be finite")
+    return a
+
+
+def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
+    t0, t1 = float(t0), float(t1)
+    if not (np.isfinite(t0) and np.isfinite(t1)):
+        raise ValueError(f"t_span = ({t0}, {t1}) is not allowed: must be finite")
+    rtol = float(rtol) if np.ndim(rtol) == 0 else rtol
+    if not isinstance(rtol, float) or not (np.isfinite(rtol) and rtol > 0):
+        raise ValueError(f"rtol = {rtol!r} is not allowed: must be one finite number > 0")
+    if rtol < 100 * EPS:   # as scipy's validate_tol
+        warnings.warn(f"At least one element of `rtol` is too small. "
+                      f"Setting `rtol = np.maximum(rtol, {100 * EPS})`.", stacklevel=3)
+        rtol = 100 * EPS
+    atol_v = np.ascontiguousarray(np.broadcast_to(np.asarray(atol, dtype=float), (n,)))
+    if not (np.all(np.isfinite(atol_v)) and np.all(atol_v >= 0)):
+        raise ValueError(f"atol = {atol!r} is not allowed: must be finite and >= 0")
+    max_step = float(max_step)
+    if not max_step > 0:
+        raise ValueError(f"max_step = {max_step!r} is not allowed: must be > 0")
+    first = 0.0 if first_step is None else float(first_step)
+    if first_step is not None and not (np.isfinite(first) and 0 < first <= abs(t1 - t0)):
+        raise ValueError(f"first_step = {first_step!r} is not allowed: must be in "
+                         f"(0, {abs(t1 - t0)}]")
+    if t_eval is not None:
+        t_eval = np.ascontiguousarray(t_eval, dtype=float)
+        d = 1.0 if t1 >= t0 else -1.0
+        lo, hi = min(t0, t1), max(t0, t1)
+        if (t_eval.ndim != 1 or np.any(d * np.diff(t_eval) <= 0)
+                or (t_eval.size and (t_eval.min() < lo or t_eval.max() > hi))):
+            raise ValueError("t_eval must be 1-D, strictly monotonic in the direction of "
+                             f"integration and within t_span = ({t0}, {t1})")
+    return t0, t1, rtol, atol_v, max_step, t_eval, first
+
+
+def _event_arrays(events, n):
+    m = len(events)
+    coef = np.zeros((max(m, 1), n))
+    offset = np.zeros(max(m, 1))
+    terminal = np.zeros(max(m, 1), dtype=np.intc)
+    direction = np.zeros(max(m, 1), dtype=np.intc)
+    for k, e in enumerate(events):
+        for attr in ("coefficients", "offset"):
+            if not hasattr(e, attr):
+                raise TypeError(f"events[{k}] = {e!r} is not a linear event: radau5 needs "
+                                "`coefficients` and `offset` (g(y) = coefficients . y + offset)")
+        coef[k] = _vector(f"events[{k}].coefficients", e.coefficients, n)
+        offset[k] = float(e.offset)
+        terminal[k] = bool(getattr(e, "terminal", False))
+        dirn = float(getattr(e, "direction", 0))
+        direction[k] = (dirn > 0) - (dirn < 0)
+    return m, coef, offset, terminal, direction
+
+
+cdef object _run(radau5_problem *p, int n, int m):
+    cdef radau5_result r
+    cdef int rc
+    cdef double[::1] tv, htv
+    cdef double[:, ::1] yv, hyv
+    cdef int[::1] hev
+    radau5_set_lapack(&p.lapack, <void *>dgetrf, <void *>dgetrs, <void *>zgetrf,
+                      <void *>zgetrs)
+    with nogil:
+        rc = radau5_solve(p, &r)
+    try:
+        if rc != 0:
+            raise MemoryError(r.message.decode())
+        t = np.empty(r.n_out)
+        y = np.empty((r.n_out, n))
+        if r.n_out:
+            tv = t
+            yv = y
+            memcpy(&tv[0], r.t_out, r.n_out * sizeof(double))
+            memcpy(&yv[0, 0], r.y_out, r.n_out * n * sizeof(double))
+        hit_event = np.empty(r.n_hits, dtype=np.intc)
+        hit_t = np.empty(r.n_hits)
+        hit_y = np.empty((r.n_hits, n))
+        if r.n_hits:
+            hev = hit_event
+            htv = hit_t
+            hyv = hit_y
+            memcpy(&hev[0], r.hit_event, r.n_hits * sizeof(int))
+            memcpy(&htv[0], r.hit_t, r.n_hits * sizeof(double))
+            memcpy(&hyv[0, 0], r.hit_y, r.n_hits * n * sizeof(double))
+        status, message = r.status, r.message.decode()
+        counts = dict(nfev=r.nfev, njev=r.njev, nlu=r.nlu, nstep=r.nstep, nreject=r.nreject)
+    finally:
+        radau5_free(&r)
+    t_events = [hit_t[hit_event == k] for k in range(m)]
+    y_events = [hit_y[hit_event == k].reshape(-1, n) for k in range(m)]
+    return OptimizeResult(t=t, y=np.ascontiguousarray(y.T), t_events=t_events,
+                          y_events=y_events, status=status, message=message,
+                          success=status >= 0, sol=None, **counts)
+
+
+cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
+                   rtol, atol, max_step, t_eval, events, first_step):
+    cdef radau5_problem p
+    t0, t1 = t_span
+    t0, t1, rtol, atol_v, max_step, t_eval, first = _options(
+        n, t0, t1, rtol, atol, max_step, t_eval, first_step)
+    y0 = _vector("y0", y0, n)
+    m, coef, offset, terminal, direction = _event_arrays(list(events or ()), n)
+    cdef double[::1] y0v = y0, atolv = atol_v, offv = offset
+    cdef double[:, ::1] coefv = coef
+    cdef int[::1] termv = terminal, dirv = direction
+    cdef double[::1] tev
+    p.n = n
+    p.fun = fun
+    p.jac = jac
+    p.ctx = ctx
+    p.t0 = t0
+    p.t_bound = t1
+    p.y0 = &y0v[0]
+    p.rtol = rtol
+    p.atol = &atolv[0]
+    p.max_step = max_step
+    p.first_step = first
+    p.t_eval = NULL
+    p.n_eval = 0
+    if t_eval is not None:
+        p.n_eval = t_eval.size
+        if t_eval.size:
+            tev = t_eval
+            p.t_eval = &tev[0]
+        else:
+            p.t_eval = &y0v[0]   # any non-NULL address: store no point at all
+    p.n_events = m
+    p.ev_coef = &coefv[0, 0]
+    p.ev_offset = &offv[0]
+    p.ev_terminal = &termv[0]
+    p.ev_direction = &dirv[0]
+    return _run(&p, n, m)
+
+
+def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
+                 max_step=np.inf, t_eval=None, events=(), first_step=None):
+    """Integrate ballc's equations (N_STATES states) over ``t_span`` with radau5.
+
+    ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
+    ``_core.System``.  ``events``: objects with ``coefficients`` (N_STATES),
+    ``offset``, ``terminal`` and ``direction`` -- g(y) = coefficients . y + offset.
+    Returns a solve_ivp-shaped OptimizeResult (t, y, t_events, y_events, status,
+    message, success, nfev, njev, nlu) plus nstep and nreject.
+    """
+    cdef ball_ctx ctx
+    params = _vector("params", params, BALLC_N_PARAMETERS)
+    latch = _vector("latch", latch, BALLC_N_LATCH)
+    cdef double[::1] pv = params, lv = latch
+    ctx.params = &pv[0]
+    ctx.latch = &lv[0]
+    ctx.flags = flags
+    return _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
+                  max_step, t_eval, events, first_step)
+
+
+def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),
+                 first_step=None):
+    """Integrate y' = A y (A: n x n) with radau5; same result as ``solve_system``."""
+    cdef linear_ctx ctx
+    A = np.ascontiguousarray(A, dtype=float)
+    if A.ndim != 2 or A.shape[0] != A.shape[1] or A.shape[0] == 0:
+        raise ValueError(f"A must be a non-empty square matrix, got shape {A.shape}")
+    if not np.all(np.isfinite(A)):
+        raise ValueError("A must be finite")
+    cdef double[:, ::1] av = A
+    ctx.n = A.shape[0]
+    ctx.A = &av[0, 0]
+    return _solve(_linear_fun, _linear_jac, &ctx, ctx.n, t_span, y0, rtol, atol,
+                  max_step, t_eval, events, first_step)

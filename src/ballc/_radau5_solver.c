@@ -1,0 +1,718 @@
+/* See _radau5_solver.h.  A line-by-line port of scipy.integrate.Radau (scipy 1.17,
+ * scipy/integrate/_ivp/radau.py) and of solve_ivp's event and output logic
+ * (scipy/integrate/_ivp/ivp.py), for dense Jacobians and linear events.
+ * Comments name the scipy function each part mirrors. */
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "_radau5_solver.h"
+
+#define NEWTON_MAXITER 6   /* Maximum number of Newton iterations. */
+#define MIN_FACTOR 0.2     /* Minimum allowed decrease in a step size. */
+#define MAX_FACTOR 10.0    /* Maximum allowed increase in a step size. */
+#define EPS DBL_EPSILON
+
+typedef double _Complex cplx;
+
+/* radau.py module constants (computed as scipy computes them). */
+typedef struct {
+    double C[3], E[3], T[3][3], TI[3][3], P[3][3];
+    double mu_real;
+    cplx mu_complex, ti_complex[3];
+} constants_t;
+
+static void init_constants(constants_t *k)
+{
+    const double S6 = sqrt(6.0);
+    k->C[0] = (4 - S6) / 10; k->C[1] = (4 + S6) / 10; k->C[2] = 1;
+    k->E[0] = (-13 - 7 * S6) / 3; k->E[1] = (-13 + 7 * S6) / 3; k->E[2] = -1.0 / 3;
+    k->mu_real = 3 + pow(3, 2.0 / 3) - pow(3, 1.0 / 3);
+    k->mu_complex = (3 + 0.5 * (pow(3, 1.0 / 3) - pow(3, 2.0 / 3)))
+                    - 0.5 * I * (pow(3, 5.0 / 6) + pow(3, 7.0 / 6));
+    const double T[3][3] = {
+        {0.09443876248897524, -0.14125529502095421, 0.03002919410514742},
+        {0.25021312296533332, 0.20412935229379994, -0.38294211275726192},
+        {1, 1, 0}};
+    const double TI[3][3] = {
+        {4.17871859155190428, 0.32768282076106237, 0.52337644549944951},
+        {-4.17871859155190428, -0.32768282076106237, 0.47662355450055044},
+        {0.50287263494578682, -2.57192694985560522, 0.59603920482822492}};
+    const double P[3][3] = {
+        {13.0 / 3 + 7 * S6 / 3, -23.0 / 3 - 22 * S6 / 3, 10.0 / 3 + 5 * S6},
+        {13.0 / 3 - 7 * S6 / 3, -23.0 / 3 + 22 * S6 / 3, 10.0 / 3 - 5 * S6},
+        {1.0 / 3, -8.0 / 3, 10.0 / 3}};
+    memcpy(k->T, T, sizeof T);
+    memcpy(k->TI, TI, sizeof TI);
+    memcpy(k->P, P, sizeof P);
+    for (int j = 0; j < 3; j++) k->ti_complex[j] = TI[1][j] + I * TI[2][j];
+}
+
+/* Everything the integration carries from step to step. */
+typedef struct {
+    const radau5_problem *p;
+    radau5_result *r;
+    constants_t k;
+    int n;
+    double direction, newton_tol;
+    /* solver state (Radau attributes) */
+    double t, t_old, h_abs, h_abs_old, error_norm_old;
+    int have_h_abs_old, have_error_norm_old, have_sol, current_jac, lu_valid;
+    double *y, *f, *y_old, *J, *Z, *Q;      /* Z, Q: of the last accepted step */
+    double *LU_real; int *piv_real;
+    cplx *LU_complex; int *piv_complex;
+    /* scratch */
+    double *y_new, *f_new, *scale, *Z0, *Znew, *W, *F, *dW, *tmp, *err, *ZE;
+    cplx *ctmp;
+    /* events */
+    double *g, *g_new, *roots;
+    int *active, *count;
+    size_t cap_out, cap_hits;
+} solver_t;
+
+/* common.norm: RMS norm. */
+static double rms(const double *x, int n)
+{
+    double s = 0;
+    for (int i = 0; i < n; i++) s += x[i] * x[i];
+    return sqrt(s / n);
+}
+
+static int call_fun(solver_t *s, double t, const double *y, double *f)
+{
+    s->r->nfev++;
+    if (s->p->fun(s->p->ctx, t, y, f) != 0) return -1;
+    for (int i = 0; i < s->n; i++)
+        if (!isfinite(f[i])) return -1;
+    return 0;
+}
+
+static int call_jac(solver_t *s, double t, const double *y)
+{
+    s->r->njev++;
+    if (s->p->jac(s->p->ctx, t, y, s->J) != 0) return -1;
+    for (int i = 0; i < s->n * s->n; i++)
+        if (!isfinite(s->J[i])) return -1;
+    return 0;
+}
+
+/* LU of MU_REAL / h I - J and MU_COMPLEX / h I - J (column-major for LAPACK). */
+static int factor(solver_t *s, double h)
+{
+    int n = s->n, info_r = 0, info_c = 0;
+    double mr = s->k.mu_real / h;
+    cplx mc = s->k.mu_complex / h;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            double a = -s->J[i * n + j];
+            s->LU_real[i + j * n] = a + (i == j ? mr : 0.0);
+            s->LU_complex[i + j * n] = a + (i == j ? mc : 0.0);
+        }
+    s->p->lapack.dgetrf(&n, &n, s->LU_real, &n, s->piv_real, &info_r);
+    s->p->lapack.zgetrf(&n, &n, s->LU_complex, &n, s->piv_complex, &info_c);
+    s->r->nlu += 2;
+    s->lu_valid = 1;
+    return (info_r == 0 && info_c == 0) ? 0 : -1;
+}
+
+static void solve_real(solver_t *s, double *b)
+{
+    int n = s->n, one = 1, info = 0;
+    char trans = 'N';
+    s->p->lapack.dgetrs(&trans, &n, &one, s->LU_real, &n, s->piv_real, b, &n, &info);
+}
+
+static void solve_complex(solver_t *s, cplx *b)
+{
+    int n = s->n, one = 1, info = 0;
+    char trans = 'N';
+    s->p->lapack.zgetrs(&trans, &n, &one, s->LU_complex, &n, s->piv_complex, b, &n, &info);
+}
+
+/* radau.solve_collocation_system: Z (3 x n) starts as Z0 and ends as the solution. */
+static int solve_collocation(solver_t *s, double t, double h, double *Z,
+                             int *n_iter, double *rate_out, int *have_rate_out)
+{
+    const constants_t *k = &s->k;
+    const int n = s->n;
+    double M_real = k->mu_real / h;
+    cplx M_complex = k->mu_complex / h;
+    double *W = s->W, *F = s->F, *dW = s->dW, *yi = s->tmp;
+    cplx *fc = s->ctmp;
+    for (int i = 0; i < 3; i++)
+        for (int c = 0; c < n; c++)
+            W[i * n + c] = k->TI[i][0] * Z[c] + k->TI[i][1] * Z[n + c] + k->TI[i][2] * Z[2 * n + c];
+    double dW_norm_old = 0, rate = 0;
+    int have_old = 0, have_rate = 0, converged = 0, it;
+    for (it = 0; it < NEWTON_MAXITER; it++) {
+        int finite = 1;
+        for (int i = 0; i < 3 && finite; i++) {
+            for (int c = 0; c < n; c++) yi[c] = s->y[c] + Z[i * n + c];
+            if (call_fun(s, t + h * k->C[i], yi, F + i * n) != 0) finite = 0;
+        }
+        if (!finite) break;
+        for (int c = 0; c < n; c++) {
+            double f0 = F[c], f1 = F[n + c], f2 = F[2 * n + c];
+            dW[c] = f0 * k->TI[0][0] + f1 * k->TI[0][1] + f2 * k->TI[0][2] - M_real * W[c];
+            fc[c] = f0 * k->ti_complex[0] + f1 * k->ti_complex[1] + f2 * k->ti_complex[2]
+                    - M_complex * (W[n + c] + I * W[2 * n + c]);
+        }
+        solve_real(s, dW);
+        solve_complex(s, fc);
+        double sum = 0;
+        for (int c = 0; c < n; c++) {
+            dW[n + c] = creal(fc[c]);
+            dW[2 * n + c] = cimag(fc[c]);
+            for (int i = 0; i < 3; i++) {
+                double v = dW[i * n + c] / s->scale[c];
+                sum += v * v;
+            }
+        }
+        double dW_norm = sqrt(sum / (3 * n));
+        if (!isfinite(dW_norm)) break;
+        if (have_old) {
+            rate = dW_norm / dW_norm_old;
+            have_rate = 1;
+        }
+        if (have_rate && (rate >= 1 ||
+                          pow(rate, NEWTON_MAXITER - it) / (1 - rate) * dW_norm > s->newton_tol))
+            break;
+        for (int i = 0; i < 3 * n; i++) W[i] += dW[i];
+        for (int i = 0; i < 3; i++)
+            for (int c = 0; c < n; c++)
+                Z[i * n + c] = k->T[i][0] * W[c] + k->T[i][1] * W[n + c] + k->T[i][2] * W[2 * n + c];
+        if (dW_norm == 0 || (have_rate && rate / (1 - rate) * dW_norm < s->newton_tol)) {
+            converged = 1;
+            break;
+        }
+        dW_norm_old = dW_norm;
+        have_old = 1;
+    }
+    *n_iter = (it < NEWTON_MAXITER ? it : NEWTON_MAXITER - 1) + 1;
+    *rate_out = rate;
+    *have_rate_out = have_rate;
+    return converged;
+}
+
+/* radau.predict_factor */
+static double predict_factor(double h_abs, double h_abs_old, int have_h_abs_old,
+                             double error_norm, double error_norm_old, int have_error_norm_old)
+{
+    double multiplier;
+    if (!have_error_norm_old || !have_h_abs_old || error_norm == 0)
+        multiplier = 1;
+    else
+        multiplier = h_abs / h_abs_old * pow(error_norm_old / error_norm, 0.25);
+    return fmin(1, multiplier) * pow(error_norm, -0.25);   /* inf when error_norm == 0 */
+}
+
+/* RadauDenseOutput of the last accepted step at time tt. */
+static void dense(const solver_t *s, double tt, double *out)
+{
+    const int n = s->n;
+    double x = (tt - s->t_old) / (s->t - s->t_old);
+    double p1 = x, p2 = x * x, p3 = x * x * x;
+    for (int c = 0; c < n; c++)
+        out[c] = s->y_old[c] + s->Q[3 * c] * p1 + s->Q[3 * c + 1] * p2 + s->Q[3 * c + 2] * p3;
+}
+
+/* Radau._step_impl.  Returns 1 on success, 0 on failure (message set). */
+static int step(solver_t *s)
+{
+    const radau5_problem *p = s->p;
+    const constants_t *k = &s->k;
+    const int n = s->n;
+    const double t = s->t;
+    double *y = s->y;
+
+    double min_step = 10 * fabs(nextafter(t, s->direction * INFINITY) - t);
+    double h_abs, h_abs_old = 0, error_norm_old = 0;
+    int have_h_abs_old = 0, have_error_norm_old = 0;
+    if (s->h_abs > p->max_step) {
+        h_abs = p->max_step;
+    } else if (s->h_abs < min_step) {
+        h_abs = min_step;
+    } else {
+        h_abs = s->h_abs;
+        h_abs_old = s->h_abs_old; have_h_abs_old = s->have_h_abs_old;
+        error_norm_old = s->error_norm_old; have_error_norm_old = s->have_error_norm_old;
+    }
+
+    int rejected = 0, converged = 0, n_iter = 0, have_rate = 0;
+    double rate = 0, h = 0, t_new = t, error_norm = 0, safety = 0;
+    double *Z = s->Znew, *y_new = s->y_new, *err = s->err, *ZE = s->ZE;
+    for (;;) {   /* while not step_accepted */
+        if (h_abs < min_step) {
+            snprintf(s->r->message, sizeof s->r->message,
+                     "Required step size is less than spacing between numbers.");
+            return 0;
+        }
+        h = h_abs * s->direction;
+        t_new = t + h;
+        if (s->direction * (t_new - p->t_bound) > 0) t_new = p->t_bound;
+        h = t_new - t;
+        h_abs = fabs(h);
+
+        if (!s->have_sol) {
+            memset(s->Z0, 0, 3 * n * sizeof(double));
+        } else {
+            for (int i = 0; i < 3; i++) {
+                dense(s, t + h * k->C[i], s->Z0 + i * n);
+                for (int c = 0; c < n; c++) s->Z0[i * n + c] -= y[c];
+            }
+        }
+        for (int c = 0; c < n; c++) s->scale[c] = p->atol[c] + fabs(y[c]) * p->rtol;
+
+        converged = 0;
+        while (!converged) {
+            int lu_ok = 1;
+            if (!s->lu_valid) lu_ok = factor(s, h) == 0;
+            memcpy(Z, s->Z0, 3 * n * sizeof(double));
+            converged = lu_ok && solve_collocation(s, t, h, Z, &n_iter, &rate, &have_rate);
+            if (!lu_ok) n_iter = 0;
+            if (!converged) {
+                if (s->current_jac) break;
+                if (call_jac(s, t, y) != 0) {
+                    snprintf(s->r->message, sizeof s->r->message,
+                             "the Jacobian cannot be evaluated at t = %.17g", t);
+                    return 0;
+                }
+                s->current_jac = 1;
+                s->lu_valid = 0;
+            }
+        }
+        if (!converged) {
+            h_abs *= 0.5;
+            s->lu_valid = 0;
+            continue;
+        }
+
+        for (int c = 0; c < n; c++) {
+            y_new[c] = y[c] + Z[2 * n + c];
+            ZE[c] = (Z[c] * k->E[0] + Z[n + c] * k->E[1] + Z[2 * n + c] * k->E[2]) / h;
+            err[c] = s->f[c] + ZE[c];
+        }
+        solve_real(s, err);
+        for (int c = 0; c < n; c++) {
+            s->scale[c] = p->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * p->rtol;
+            s->tmp[c] = err[c] / s->scale[c];
+        }
+        error_norm = rms(s->tmp, n);
+        safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter);
+
+        if (rejected && error_norm > 1) {
+            for (int c = 0; c < n; c++) s->tmp[c] = y[c] + err[c];
+            if (call_fun(s, t, s->tmp, err) != 0) {
+                error_norm = INFINITY;   /* scipy would go on with NaN; reject instead */
+            } else {
+                for (int c = 0; c < n; c++) err[c] += ZE[c];
+                solve_real(s, err);
+                for (int c = 0; c < n; c++) s->tmp[c] = err[c] / s->scale[c];
+                error_norm = rms(s->tmp, n);
+            }
+        }
+        if (!(error_norm <= 1)) {
+            double fac = predict_factor(h_abs, h_abs_old, have_h_abs_old, error_norm,
+                                        error_norm_old, have_error_norm_old);
+            h_abs *= fmax(MIN_FACTOR, safety * fac);
+            s->lu_valid = 0;
+            rejected = 1;
+            s->r->nreject++;
+            continue;
+        }
+        /* f at the new point: needed for the next step's error estimate. */
+        if (call_fun(s, t_new, y_new, s->f_new) != 0) {
+            h_abs *= 0.5;   /* not in scipy (it would carry NaN): treat as a failed step */
+            s->lu_valid = 0;
+            rejected = 1;
+            s->r->nreject++;
+            continue;
+        }
+        break;   /* step_accepted */
+    }
+
+    int recompute_jac = n_iter > 2 && have_rate && rate > 1e-3;
+    double fac = predict_factor(h_abs, h_abs_old, have_h_abs_old, error_norm,
+                                error_norm_old, have_error_norm_old);
+    fac = fmin(MAX_FACTOR, safety * fac);
+    if (!recompute_jac && fac < 1.2)
+        fac = 1;
+    else
+        s->lu_valid = 0;
+
+    if (recompute_jac) {
+        if (call_jac(s, t_new, y_new) != 0) {
+            snprintf(s->r->message, sizeof s->r->message,
+                     "the Jacobian cannot be evaluated at t = %.17g", t_new);
+            return 0;
+        }
+        s->current_jac = 1;
+    } else {
+        s->current_jac = 0;
+    }
+    s->h_abs_old = s->h_abs;
+    s->have_h_abs_old = 1;
+    s->error_norm_old = error_norm;
+    s->have_error_norm_old = 1;
+    s->h_abs = h_abs * fac;
+
+    memcpy(s->y_old, y, n * sizeof(double));
+    memcpy(y, y_new, n * sizeof(double));
+    memcpy(s->f, s->f_new, n * sizeof(double));
+    memcpy(s->Z, Z, 3 * n * sizeof(double));
+    s->t_old = t;
+    s->t = t_new;
+    /* _compute_dense_output: Q = Z^T P (n x 3) */
+    for (int c = 0; c < n; c++)
+        for (int j = 0; j < 3; j++)
+            s->Q[3 * c + j] = Z[c] * k->P[0][j] + Z[n + c] * k->P[1][j] + Z[2 * n + c] * k->P[2][j];
+    s->have_sol = 1;
+    s->r->nstep++;
+    return 1;
+}
+
+/* common.select_initial_step with order 3. */
+static double initial_step(solver_t *s)
+{
+    const radau5_problem *p = s->p;
+    const int n = s->n;
+    double interval = fabs(p->t_bound - p->t0);
+    if (interval == 0) return 0;
+    double d0 = 0, d1 = 0, d2 = 0;
+    for (int c = 0; c < n; c++) {
+        s->scale[c] = p->atol[c] + fabs(s->y[c]) * p->rtol;
+        d0 += (s->y[c] / s->scale[c]) * (s->y[c] / s->scale[c]);
+        d1 += (s->f[c] / s->scale[c]) * (s->f[c] / s->scale[c]);
+    }
+    d0 = sqrt(d0 / n);
+    d1 = sqrt(d1 / n);
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    h0 = fmin(h0, interval);
+    for (int c = 0; c < n; c++) s->tmp[c] = s->y[c] + h0 * s->direction * s->f[c];
+    if (call_fun(s, p->t0 + h0 * s->direction, s->tmp, s->f_new) == 0) {
+        for (int c = 0; c < n; c++) {
+            double v = (s->f_new[c] - s->f[c]) / s->scale[c];
+            d2 += v * v;
+        }
+        d2 = sqrt(d2 / n) / h0;
+    }
+    double h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? fmax(1e-6, h0 * 1e-3)
+                                             : pow(0.01 / fmax(d1, d2), 1.0 / 4);
+    return fmin(fmin(100 * h0, h1), fmin(interval, p->max_step));
+}
+
+/* ---- output buffers ---- */
+
+static int store_point(solver_t *s, double t, const double *y)
+{
+    radau5_result *r = s->r;
+    if ((size_t)r->n_out == s->cap_out) {
+        size_t cap = s->cap_out ? 2 * s->cap_out : 256;
+        double *tt = realloc(r->t_out, cap * sizeof(double));
+        if (!tt) return -1;
+        r->t_out = tt;
+        double *yy = realloc(r->y_out, cap * s->n * sizeof(double));
+        if (!yy) return -1;
+        r->y_out = yy;
+        s->cap_out = cap;
+    }
+    r->t_out[r->n_out] = t;
+    memcpy(r->y_out + r->n_out * s->n, y, s->n * sizeof(double));
+    r->n_out++;
+    return 0;
+}
+
+static int store_hit(solver_t *s, int event, double t, const double *y)
+{
+    radau5_result *r = s->r;
+    if ((size_t)r->n_hits == s->cap_hits) {
+        size_t cap = s->cap_hits ? 2 * s->cap_hits : 16;
+        int *e = realloc(r->hit_event, cap * sizeof(int));
+        if (!e) return -1;
+        r->hit_event = e;
+        double *tt = realloc(r->hit_t, cap * sizeof(double));
+        if (!tt) return -1;
+        r->hit_t = tt;
+        double *yy = realloc(r->hit_y, cap * s->n * sizeof(double));
+        if (!yy) return -1;
+        r->hit_y = yy;
+        s->cap_hits = cap;
+    }
+    r->hit_event[r->n_hits] = event;
+    r->hit_t[r->n_hits] = t;
+    memcpy(r->hit_y + r->n_hits * s->n, y, s->n * sizeof(double));
+    r->n_hits++;
+    return 0;
+}
+
+/* ---- events ---- */
+
+static double event_value(const solver_t *s, int e, const double *y)
+{
+    const double *c = s->p->ev_coef + (size_t)e * s->n;
+    double g = s->p->ev_offset[e];
+    for (int i = 0; i < s->n; i++) g += c[i] * y[i];
+    return g;
+}
+
+/* g_e on the last step's dense output: a cubic in x = (t - t_old) / h. */
+typedef struct { double a[4], t_old, h; } cubic_t;
+
+static double cubic_at(const cubic_t *q, double tt)
+{
+    double x = (tt - q->t_old) / q->h;
+    return q->a[0] + x * (q->a[1] + x * (q->a[2] + x * q->a[3]));
+}
+
+/* scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c), xtol = rtol = 4 eps as in
+ * solve_ivp's solve_event_equation. */
+static double brentq(const cubic_t *q, double xa, double xb)
+{
+    const double xtol = 4 * EPS, rtol = 4 * EPS;
+    double xpre = xa, xcur = xb, xblk = 0, fblk = 0, spre = 0, scur = 0;
+    double fpre = cubic_at(q, xpre), fcur = cubic_at(q, xcur);
+    if (fpre == 0) return xpre;
+    if (fcur == 0) return xcur;
+    if (signbit(fpre) == signbit(fcur))   /* rounding at a bracket end: take the nearer */
+        return fabs(fpre) < fabs(fcur) ? xpre : xcur;
+    for (int i = 0; i < 100; i++) {
+        if (fpre != 0 && fcur != 0 && signbit(fpre) != signbit(fcur)) {
+            xblk = xpre;
+            fblk = fpre;
+            spre = scur = xcur - xpre;
+        }
+        if (fabs(fblk) < fabs(fcur)) {
+            xpre = xcur; xcur = xblk; xblk = xpre;
+            fpre = fcur; fcur = fblk; fblk = fpre;
+        }
+        double delta = (xtol + rtol * fabs(xcur)) / 2;
+        double sbis = (xblk - xcur) / 2;
+        if (fcur == 0 || fabs(sbis) < delta) return xcur;
+        if (fabs(spre) > delta && fabs(fcur) < fabs(fpre)) {
+            double stry;
+            if (xpre == xblk) {
+                stry = -fcur * (xcur - xpre) / (fcur - fpre);
+            } else {
+                double dpre = (fpre - fcur) / (xpre - xcur);
+                double dblk = (fblk - fcur) / (xblk - xcur);
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre));
+            }
+            if (2 * fabs(stry) < fmin(fabs(spre), 3 * fabs(sbis) - delta)) {
+                spre = scur;
+                scur = stry;
+            } else {
+                spre = sbis;
+                scur = sbis;
+            }
+        } else {
+            spre = sbis;
+            scur = sbis;
+        }
+        xpre = xcur;
+        fpre = fcur;
+        xcur += fabs(scur) > delta ? scur : (sbis > 0 ? delta : -delta);
+        fcur = cubic_at(q, xcur);
+    }
+    return xcur;
+}
+
+static double event_root(const solver_t *s, int e)
+{
+    const double *c = s->p->ev_coef + (size_t)e * s->n;
+    cubic_t q = {{event_value(s, e, s->y_old), 0, 0, 0}, s->t_old, s->t - s->t_old};
+    for (int i = 0; i < s->n; i++)
+        for (int j = 0; j < 3; j++) q.a[j + 1] += c[i] * s->Q[3 * i + j];
+    return brentq(&q, s->t_old, s->t);
+}
+
+/* ivp.find_active_events + handle_events after a step.  Returns 1 when a terminal
+ * event stopped the integration (then *t_stop is its time), 0 otherwise, -1 on
+ * out of memory. */
+static int handle_events(solver_t *s, double *t_stop)
+{
+    const radau5_problem *p = s->p;
+    int m = 0, terminate = 0;
+    for (int e = 0; e < p->n_events; e++) {
+        double g = s->g[e], gn = s->g_new[e];
+        int up = g <= 0 && gn >= 0, down = g >= 0 && gn <= 0;
+        int dir = p->ev_direction[e];
+        if ((up && dir > 0) || (down && dir < 0) || ((up || down) && dir == 0))
+            s->active[m++] = e;
+    }
+    if (m == 0) return 0;
+    for (int i = 0; i < m; i++) {
+        s->count[s->active[i]]++;
+        s->roots[i] = event_root(s, s->active[i]);
+        if (p->ev_terminal[s->active[i]]) terminate = 1;
+    }
+    if (terminate) {
+        /* order by time (in the direction of integration), keep up to the first terminal */
+        for (int i = 1; i < m; i++) {
+            int a = s->active[i];
+            double rt = s->roots[i];
+            int j = i - 1;
+            while (j >= 0 && s->direction * (s->roots[j] - rt) > 0) {
+                s->active[j + 1] = s->active[j];
+                s->roots[j + 1] = s->roots[j];
+                j--;
+            }
+            s->active[j + 1] = a;
+            s->roots[j + 1] = rt;
+        }
+        for (int i = 0; i < m; i++)
+            if (p->ev_terminal[s->active[i]]) {
+                m = i + 1;
+                break;
+            }
+    }
+    for (int i = 0; i < m; i++) {
+        dense(s, s->roots[i], s->tmp);
+        if (store_hit(s, s->active[i], s->roots[i], s->tmp) != 0) return -1;
+    }
+    if (terminate) *t_stop = s->roots[m - 1];
+    return terminate;
+}
+
+/* ---- driver (solve_ivp's loop) ---- */
+
+void radau5_set_lapack(radau5_lapack *lapack, void *dgetrf, void *dgetrs, void *zgetrf,
+                       void *zgetrs)
+{
+    lapack->dgetrf = (radau5_dgetrf)dgetrf;
+    lapack->dgetrs = (radau5_dgetrs)dgetrs;
+    lapack->zgetrf = (radau5_zgetrf)zgetrf;
+    lapack->zgetrs = (radau5_zgetrs)zgetrs;
+}
+
+void radau5_free(radau5_result *r)
+{
+    free(r->t_out); free(r->y_out);
+    free(r->hit_event); free(r->hit_t); free(r->hit_y);
+    r->t_out = r->y_out = r->hit_t = r->hit_y = NULL;
+    r->hit_event = NULL;
+    r->n_out = r->n_hits = 0;
+}
+
+int radau5_solve(const radau5_problem *p, radau5_result *r)
+{
+    memset(r, 0, sizeof *r);
+    const int n = p->n, m = p->n_events;
+    r->status = RADAU5_FAILED;
+    if (n <= 0 || m < 0) {
+        snprintf(r->message, sizeof r->message, "n = %d and n_events = %d: need n > 0, n_events >= 0", n, m);
+        return -1;
+    }
+
+    solver_t s;
+    memset(&s, 0, sizeof s);
+    s.p = p;
+    s.r = r;
+    s.n = n;
+    init_constants(&s.k);
+    s.direction = p->t_bound >= p->t0 ? 1.0 : -1.0;
+    s.newton_tol = fmax(10 * EPS / p->rtol, fmin(0.03, sqrt(p->rtol)));
+
+    /* one block of doubles, one of complex, one of ints */
+    size_t nd = (size_t)n * (1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1) /* y f y_old y_new f_new scale tmp err ZE */
+         + (size_t)n * n * 2                                /* J, LU_real */
+         + (size_t)n * 3 * 7                                /* Z Q Z0 Znew W F dW */
+         + (size_t)m * 3;                                   /* g g_new roots */
+    double *dblock = calloc(nd, sizeof(double));
+    cplx *cblock = calloc((size_t)n * n + n, sizeof(cplx));
+    int *iblock = calloc(2 * (size_t)n + 2 * (size_t)m + 2, sizeof(int));
+    int rc = 0;
+    if (!dblock || !cblock || !iblock) goto oom;
+    double *d = dblock;
+    s.y = d; d += n; s.f = d; d += n; s.y_old = d; d += n; s.y_new = d; d += n;
+    s.f_new = d; d += n; s.scale = d; d += n; s.tmp = d; d += n; s.err = d; d += n;
+    s.ZE = d; d += n;
+    s.J = d; d += n * n; s.LU_real = d; d += n * n;
+    s.Z = d; d += 3 * n; s.Q = d; d += 3 * n; s.Z0 = d; d += 3 * n; s.Znew = d; d += 3 * n;
+    s.W = d; d += 3 * n; s.F = d; d += 3 * n; s.dW = d; d += 3 * n;
+    s.g = d; d += m; s.g_new = d; d += m; s.roots = d; d += m;
+    s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n;
+    s.piv_real = iblock; s.piv_complex = iblock + n;
+    s.active = iblock + 2 * n; s.count = iblock + 2 * n + m;
+
+    s.t = p->t0;
+    memcpy(s.y, p->y0, n * sizeof(double));
+    long i_eval = 0;
+    if (p->t_eval == NULL) {
+        if (store_point(&s, s.t, s.y) != 0) goto oom;
+    }
+    for (int e = 0; e < m; e++) s.g[e] = event_value(&s, e, s.y);
+
+    if (call_fun(&s, s.t, s.y, s.f) != 0) {
+        snprintf(r->message, sizeof r->message,
+                 "the right-hand side cannot be evaluated at the initial state (t = %.17g)", s.t);
+        r->status = RADAU5_FAILED;
+        goto done;
+    }
+    s.h_abs = p->first_step > 0 ? p->first_step : initial_step(&s);
+    if (call_jac(&s, s.t, s.y) != 0) {
+        snprintf(r->message, sizeof r->message,
+                 "the Jacobian cannot be evaluated at the initial state (t = %.17g)", s.t);
+        r->status = RADAU5_FAILED;
+        goto done;
+    }
+    s.current_jac = 1;
+    if (s.t == p->t_bound) {   /* empty interval: nothing to integrate */
+        r->status = RADAU5_REACHED;
+        snprintf(r->message, sizeof r->message,
+                 "The solver successfully reached the end of the integration interval.");
+        goto done;
+    }
+
+    for (;;) {
+        if (!step(&s)) {
+            r->status = RADAU5_FAILED;
+            break;
+        }
+        int finished = s.direction * (s.t - p->t_bound) >= 0;
+        double t_out = s.t;
+        const double *y_out = s.y;
+        int terminate = 0;
+        if (m > 0) {
+            for (int e = 0; e < m; e++) s.g_new[e] = event_value(&s, e, s.y);
+            terminate = handle_events(&s, &t_out);
+            if (terminate < 0) goto oom;
+            if (terminate) {
+                dense(&s, t_out, s.tmp);
+                y_out = s.tmp;
+            }
+            memcpy(s.g, s.g_new, m * sizeof(double));
+        }
+        if (p->t_eval == NULL) {
+            if (store_point(&s, t_out, y_out) != 0) goto oom;
+        } else {
+            while (i_eval < p->n_eval && s.direction * (p->t_eval[i_eval] - t_out) <= 0) {
+                dense(&s, p->t_eval[i_eval], s.err);
+                if (store_point(&s, p->t_eval[i_eval], s.err) != 0) goto oom;
+                i_eval++;
+            }
+        }
+        if (terminate) {
+            r->status = RADAU5_EVENT;
+            snprintf(r->message, sizeof r->message, "A termination event occurred.");
+            break;
+        }
+        if (finished) {
+            r->status = RADAU5_REACHED;
+            snprintf(r->message, sizeof r->message,
+                     "The solver successfully reached the end of the integration interval.");
+            break;
+        }
+    }
+    goto done;
+oom:
+    rc = -1;
+    r->status = RADAU5_FAILED;
+    snprintf(r->message, sizeof r->message, "out of memory");
+done:
+    free(dblock);
+    free(cblock);
+    free(iblock);
+    return rc;
+}

@@ -1,0 +1,88 @@
+/* radau5: compiled Radau IIA (order 5) integrator with linear events.
+ *
+ * The same method and error control as scipy.integrate.Radau
+ * (scipy/integrate/_ivp/radau.py): the same constants, simplified Newton
+ * iteration on the transformed collocation system (one real and one complex
+ * linear system per iteration), third-order embedded error estimate (with the
+ * extra solve after a rejection), predictive (Gustafsson) step-size controller,
+ * Jacobian / LU reuse strategy and collocation-polynomial dense output.  The
+ * event logic is solve_ivp's (find_active_events, handle_events, brentq with
+ * xtol = rtol = 4 eps), for events that are linear functionals of the state,
+ * g(y) = c . y + d: on one step g(t) is then a cubic in t.
+ *
+ * Generic in the system: the right-hand side and Jacobian are C callbacks, the
+ * dimension is a run-time value.  Linear algebra is LAPACK's dgetrf/dgetrs and
+ * zgetrf/zgetrs, whose addresses the caller supplies (ballc takes them from
+ * scipy.linalg.cython_lapack, so no LAPACK is linked at build time).
+ */
+#ifndef BALLC_RADAU5_H
+#define BALLC_RADAU5_H
+
+#include <complex.h>
+
+/* f (n) = rhs(t, y); jac (n x n, row-major) = d rhs / d y.  Return 0 on success,
+ * anything else when the function cannot be evaluated at (t, y). */
+typedef int (*radau5_fun)(void *ctx, double t, const double *y, double *f);
+typedef int (*radau5_jac)(void *ctx, double t, const double *y, double *jac);
+
+typedef void (*radau5_dgetrf)(int *m, int *n, double *a, int *lda, int *ipiv, int *info);
+typedef void (*radau5_dgetrs)(char *trans, int *n, int *nrhs, double *a, int *lda,
+                              int *ipiv, double *b, int *ldb, int *info);
+typedef void (*radau5_zgetrf)(int *m, int *n, double _Complex *a, int *lda, int *ipiv,
+                              int *info);
+typedef void (*radau5_zgetrs)(char *trans, int *n, int *nrhs, double _Complex *a, int *lda,
+                              int *ipiv, double _Complex *b, int *ldb, int *info);
+
+typedef struct {
+    radau5_dgetrf dgetrf;
+    radau5_dgetrs dgetrs;
+    radau5_zgetrf zgetrf;
+    radau5_zgetrs zgetrs;
+} radau5_lapack;
+
+typedef struct {
+    int n;                    /* number of states */
+    radau5_fun fun;
+    radau5_jac jac;
+    void *ctx;                /* passed to fun and jac */
+    double t0, t_bound;       /* t_bound may be < t0 (integration backwards) */
+    const double *y0;         /* n */
+    double rtol;              /* > 0 (the caller applies scipy's 100 eps floor) */
+    const double *atol;       /* n values, >= 0 */
+    double max_step;          /* > 0, may be INFINITY */
+    double first_step;        /* 0: chosen as scipy's select_initial_step (order 3) */
+    const double *t_eval;     /* NULL: store every step; else n_eval times, sorted in */
+    long n_eval;              /*   the direction of integration, within the interval */
+    int n_events;             /* events g_k(y) = coef[k*n:(k+1)*n] . y + offset[k] */
+    const double *ev_coef;
+    const double *ev_offset;
+    const int *ev_terminal;   /* nonzero: stop at the first occurrence */
+    const int *ev_direction;  /* +1 rising only, -1 falling only, 0 both */
+    radau5_lapack lapack;
+} radau5_problem;
+
+enum { RADAU5_REACHED = 0, RADAU5_EVENT = 1, RADAU5_FAILED = -1 };
+
+typedef struct {
+    int status;               /* RADAU5_REACHED, RADAU5_EVENT or RADAU5_FAILED */
+    char message[240];
+    long nfev, njev, nlu, nstep, nreject;
+    long n_out;               /* stored points: t_out (n_out), y_out (n_out x n) */
+    double *t_out;
+    double *y_out;
+    long n_hits;              /* event occurrences, in the order found */
+    int *hit_event;
+    double *hit_t;
+    double *hit_y;            /* n_hits x n */
+} radau5_result;
+
+/* Fill ``lapack`` from untyped addresses (as Cython hands them over). */
+void radau5_set_lapack(radau5_lapack *lapack, void *dgetrf, void *dgetrs, void *zgetrf,
+                       void *zgetrs);
+
+/* Integrate; returns 0, or -1 when memory ran out (result->message says so).
+ * The result always holds what was computed; release it with radau5_free. */
+int radau5_solve(const radau5_problem *problem, radau5_result *result);
+void radau5_free(radau5_result *result);
+
+#endif
