@@ -125,7 +125,7 @@ def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
         warnings.warn(f"At least one element of `rtol` is too small. "
                       f"Setting `rtol = np.maximum(rtol, {100 * EPS})`.", stacklevel=3)
         rtol = 100 * EPS
-    atol_v = np.ascontiguousarray(np.broadcast_to(np.asarray(atol, dtype=float), (n,)))
+    atol_v = np.array(np.broadcast_to(np.asarray(atol, dtype=float), (n,)))   # a writable copy
     if not (np.all(np.isfinite(atol_v)) and np.all(atol_v >= 0)):
         raise ValueError(f"atol = {atol!r} is not allowed: must be finite and >= 0")
     max_step = float(max_step)

@@ -449,21 +449,39 @@ static int store_hit(solver_t *s, int event, double t, const double *y)
 
 /* ---- events ---- */
 
-static double event_value(const solver_t *s, int e, const double *y)
+/* A directional event only counts a crossing while g moves in its direction:
+ * where dg/dt has the wrong sign (or is 0), g is reported as -tiny (rising events)
+ * or +tiny (falling events) if it is 0 or beyond.  Away from g = 0 nothing changes.
+ * This keeps a segment that starts on a plateau g(t0) = 0 (a contact boundary
+ * located to rounding) from firing again at t0 while the state moves away. */
+static double gated(int direction, double g, double rate)
 {
-    const double *c = s->p->ev_coef + (size_t)e * s->n;
-    double g = s->p->ev_offset[e];
-    for (int i = 0; i < s->n; i++) g += c[i] * y[i];
+    if (direction > 0 && !(rate > 0)) return fmin(g, -1e-300);
+    if (direction < 0 && !(rate < 0)) return fmax(g, 1e-300);
     return g;
 }
 
+/* g_e(y) with the rate c . f (f = dy/dt at y). */
+static double event_value(const solver_t *s, int e, const double *y, const double *f)
+{
+    const double *c = s->p->ev_coef + (size_t)e * s->n;
+    double g = s->p->ev_offset[e], rate = 0;
+    for (int i = 0; i < s->n; i++) {
+        g += c[i] * y[i];
+        rate += c[i] * f[i];
+    }
+    return gated(s->p->ev_direction[e], g, rate);
+}
+
 /* g_e on the last step's dense output: a cubic in x = (t - t_old) / h. */
-typedef struct { double a[4], t_old, h; } cubic_t;
+typedef struct { double a[4], t_old, h; int direction; } cubic_t;
 
 static double cubic_at(const cubic_t *q, double tt)
 {
     double x = (tt - q->t_old) / q->h;
-    return q->a[0] + x * (q->a[1] + x * (q->a[2] + x * q->a[3]));
+    double g = q->a[0] + x * (q->a[1] + x * (q->a[2] + x * q->a[3]));
+    double rate = (q->a[1] + x * (2 * q->a[2] + x * 3 * q->a[3])) / q->h;
+    return gated(q->direction, g, rate);
 }
 
 /* scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c), xtol = rtol = 4 eps as in
@@ -521,7 +539,9 @@ static double brentq(const cubic_t *q, double xa, double xb)
 static double event_root(const solver_t *s, int e)
 {
     const double *c = s->p->ev_coef + (size_t)e * s->n;
-    cubic_t q = {{event_value(s, e, s->y_old), 0, 0, 0}, s->t_old, s->t - s->t_old};
+    cubic_t q = {{s->p->ev_offset[e], 0, 0, 0}, s->t_old, s->t - s->t_old,
+                 s->p->ev_direction[e]};
+    for (int i = 0; i < s->n; i++) q.a[0] += c[i] * s->y_old[i];
     for (int i = 0; i < s->n; i++)
         for (int j = 0; j < 3; j++) q.a[j + 1] += c[i] * s->Q[3 * i + j];
     return brentq(&q, s->t_old, s->t);
@@ -642,14 +662,13 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     if (p->t_eval == NULL) {
         if (store_point(&s, s.t, s.y) != 0) goto oom;
     }
-    for (int e = 0; e < m; e++) s.g[e] = event_value(&s, e, s.y);
-
     if (call_fun(&s, s.t, s.y, s.f) != 0) {
         snprintf(r->message, sizeof r->message,
                  "the right-hand side cannot be evaluated at the initial state (t = %.17g)", s.t);
         r->status = RADAU5_FAILED;
         goto done;
     }
+    for (int e = 0; e < m; e++) s.g[e] = event_value(&s, e, s.y, s.f);
     s.h_abs = p->first_step > 0 ? p->first_step : initial_step(&s);
     if (call_jac(&s, s.t, s.y) != 0) {
         snprintf(r->message, sizeof r->message,
@@ -675,7 +694,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         const double *y_out = s.y;
         int terminate = 0;
         if (m > 0) {
-            for (int e = 0; e < m; e++) s.g_new[e] = event_value(&s, e, s.y);
+            for (int e = 0; e < m; e++) s.g_new[e] = event_value(&s, e, s.y, s.f);
             terminate = handle_events(&s, &t_out);
             if (terminate < 0) goto oom;
             if (terminate) {

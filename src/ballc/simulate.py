@@ -200,7 +200,7 @@ def _check_options(scene, t_end, method, rtol, atol, max_step=np.inf):
     return t_end
 
 
-def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float = 1e-10,
+def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float = 1e-10,
              atol: float = 1e-10, t_eval=None, max_step: float = np.inf,
              progress: bool | None = None) -> Result:
     """Simulate ``scene`` from t = 0 to ``t_end`` (s).
@@ -211,8 +211,10 @@ def simulate(scene: Scene, t_end: float, *, method: str = "Radau", rtol: float =
     t_end : float
         End time (s), > 0.
     method : str
-        A scipy.integrate.solve_ivp method: "Radau" (default), "BDF", "LSODA" (given
-        the analytic Jacobian), "DOP853", "RK45", "RK23".
+        "radau5" (default): ballc's compiled Radau IIA (order 5) -- scipy's Radau
+        algorithm in C, same error control and events, ~40-70x less CPU.  Or a
+        scipy.integrate.solve_ivp method: "Radau" (the reference radau5 is tested
+        against), "BDF", "LSODA" (given the analytic Jacobian), "DOP853", "RK45", "RK23".
     rtol, atol : float
         Tolerances per segment, as in solve_ivp.
     t_eval : array_like, optional

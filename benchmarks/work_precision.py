@@ -1,0 +1,290 @@
+"""Work-precision: CPU time against error, per integrator, on three scenes.
+
+    python -m benchmarks.work_precision [--quick] [--budget SECONDS]
+
+For each scene a reference is computed with radau5 at rtol = atol = 1e-13 (its
+distance to radau5 at 1e-12 is printed as the reference's own uncertainty).  Then
+for each tolerance rtol = atol (1e-3 .. 1e-12) and each method -- ballc with
+radau5 and with scipy's Radau, BDF, LSODA, DOP853 -- it measures CPU seconds
+(time.process_time around ``ballc.simulate``, best of 2 when a run is short), the
+final-state error (max |difference| of centre position (m) and velocity (m/s) at
+t_end) and the contact-time error (max |difference| of contact start/end times, s;
+"count" when the number of contacts differs).  Each run happens in a child process
+with a CPU-time budget: a run that exceeds it is reported as such (at loose
+tolerances the 1e-10 m/s friction regularisation makes every implicit method
+crawl -- see docs/work_precision.md).
+
+The seed's own pipeline (lambdify + numpy + scipy Radau, ``codegen.seed_reference``)
+is the baseline on the seed scene, only at rtol = atol = 1e-6, 1e-9, 1e-12 (with
+--quick: 1e-12 only): it costs 10-30 s per run.  Its contacts come from 1-ms
+samples, so only its final-state error is reported.
+
+Also measured: the per-scene specialisations (contact kernels skipped in free
+flight, observer kernels skipped when observer_mass = 0), as CPU per RHS call of the
+same trajectory with the kernels switched on and off.
+
+Writes docs/work_precision.png and docs/work_precision.md.
+"""
+from __future__ import annotations
+
+import argparse
+import multiprocessing as mp
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+import ballc
+from ballc import _core, _radau5
+
+T_END = 5.0
+SCENES = {
+    "seed": ballc.Scene(),
+    "conservative oblique": ballc.Scene(c_tau=1.0, friction_coefficient=0.0, mixture=0.0,
+                                        velocity=(3.0, 1.0, -20.0)),
+    "friction only": ballc.Scene(tangential_model="friction"),
+}
+SCENE_NOTES = {
+    "seed": "the seed's defaults (mixture 0.375, mu 0.1, c_tau 0.9)",
+    "conservative oblique": "c_tau = 1, mu = 0, mixture = 0, velocity (3, 1, -20) m/s",
+    "friction only": "tangential_model = friction: every contact ends rolling",
+}
+METHODS = ("radau5", "Radau", "BDF", "LSODA", "DOP853")
+TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
+QUICK_TOLERANCES = (1e-6, 1e-9, 1e-12)
+SEED_TOLERANCES = (1e-6, 1e-9, 1e-12)
+_IDX = [_core.STATE_NAMES.index(n) for n in ("x", "y", "z", "vx", "vy", "vz")]
+DOCS = Path(__file__).resolve().parent.parent / "docs"
+
+
+def _summary(result):
+    return {"final": result.y[_IDX, -1].copy(), "status": result.status,
+            "contacts": np.array([[c.t_start, c.t_end] for c in result.contacts]),
+            "nfev": result.nfev}
+
+
+def _run_ballc(scene_name, method, tol):
+    scene = SCENES[scene_name]
+    best, result = np.inf, None
+    for _ in range(2):
+        started = time.process_time()
+        result = ballc.simulate(scene, T_END, method=method, rtol=tol, atol=tol)
+        best = min(best, time.process_time() - started)
+        if best > 1.0:
+            break
+    return {"cpu": best, **_summary(result)}
+
+
+def _run_seed(tol):
+    from codegen.seed_reference import build_seed_model, run_seed_pipeline
+    build_seed_model()
+    seed = run_seed_pipeline(T_END, rtol=tol, atol=tol)
+    final = np.concatenate([seed["y"][3:6, -1], seed["y"][9:12, -1]])
+    return {"cpu": seed["cpu_seconds"], "final": final, "status": seed["status"],
+            "contacts": None, "nfev": seed["nfev"]}
+
+
+def _child(queue, fn, args):
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    try:
+        queue.put(fn(*args))
+    except Exception as exc:   # reported in the table, not hidden
+        queue.put({"error": f"{type(exc).__name__}: {exc}"})
+
+
+def _bounded(fn, args, budget):
+    """fn(*args) in a child process; None when it exceeds ``budget`` seconds."""
+    ctx = mp.get_context("fork")
+    queue = ctx.Queue()
+    proc = ctx.Process(target=_child, args=(queue, fn, args))
+    proc.start()
+    try:
+        return queue.get(timeout=budget)
+    except Exception:
+        return None
+    finally:
+        if proc.is_alive():
+            proc.terminate()
+        proc.join()
+
+
+def _errors(run, ref):
+    final = float(np.abs(run["final"] - ref["final"]).max())
+    if run["contacts"] is None:
+        contact = None
+    elif run["contacts"].shape != ref["contacts"].shape:
+        contact = "count"
+    else:
+        contact = float(np.nanmax(np.abs(run["contacts"] - ref["contacts"])))
+    return final, contact
+
+
+def _specialisation_rows():
+    """CPU per RHS call of the same radau5 integration with kernels on and off."""
+    rows = []
+    scene = ballc.Scene(observer_mass=0.0)
+    params, latch, y0 = scene.parameter_vector(), np.zeros(_core.N_LATCH), scene.initial_state()
+    contact = 0
+    for name in ("floor_friction", "floor_digin", "ceiling_friction", "ceiling_digin"):
+        contact |= _core.FLAGS[name]
+    cases = [
+        ("observer kernels (observer_mass = 0, free flight)", 0, _core.FLAGS["observer"]),
+        ("contact kernels in free flight (observer_mass = 0)", 0, contact),
+    ]
+    for label, off, on in cases:
+        cost = {}
+        for flags in (off, off | on):
+            best = np.inf
+            for _ in range(5):
+                started = time.process_time()
+                for _ in range(20):
+                    sol = _radau5.solve_system(params, latch, flags, (0.0, 0.15), y0,
+                                               rtol=1e-12, atol=1e-12)
+                best = min(best, (time.process_time() - started) / 20)
+            cost[flags] = (best, sol.nfev, sol.y[:, -1])
+        (t_off, n_off, y_off), (t_on, n_on, y_on) = cost[off], cost[off | on]
+        same = np.array_equal(y_off, y_on) and n_off == n_on
+        rows.append((label, t_on / n_on * 1e6, t_off / n_off * 1e6, t_on / t_off, same))
+    return rows
+
+
+def _fmt(x, digits=2):
+    return "–" if x is None else (x if isinstance(x, str) else f"{x:.{digits}e}")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true",
+                        help="3 tolerances, seed pipeline at 1e-12 only (a few minutes)")
+    parser.add_argument("--budget", type=float, default=None,
+                        help="seconds per ballc run before it is reported as too slow "
+                             "(default 20, quick 10)")
+    parser.add_argument("--no-seed", action="store_true", help="skip the seed's pipeline")
+    args = parser.parse_args(argv)
+    tolerances = QUICK_TOLERANCES if args.quick else TOLERANCES
+    seed_tolerances = () if args.no_seed else ((1e-12,) if args.quick else SEED_TOLERANCES)
+    budget = args.budget or (10.0 if args.quick else 20.0)
+    started_all = time.time()
+
+    results = {}   # (scene, method) -> list of (tol, run or None)
+    references = {}
+    for scene_name in SCENES:
+        ref = _bounded(_run_ballc, (scene_name, "radau5", 1e-13), 120)
+        check = _bounded(_run_ballc, (scene_name, "radau5", 1e-12), 120)
+        references[scene_name] = (ref, _errors(check, ref))
+        print(f"{scene_name}: reference radau5 1e-13, {ref['cpu']:.3f} s; vs 1e-12: "
+              f"final {references[scene_name][1][0]:.1e}, contacts "
+              f"{_fmt(references[scene_name][1][1], 1)}", flush=True)
+        for method in METHODS:
+            rows = []
+            for tol in tolerances:
+                run = _bounded(_run_ballc, (scene_name, method, tol), budget)
+                rows.append((tol, run))
+                print(f"  {method:7s} {tol:.0e}: "
+                      + ("> budget" if run is None else
+                         run.get("error") or f"{run['cpu']:.3f} s, final err "
+                         f"{_errors(run, ref)[0]:.1e}"), flush=True)
+            results[(scene_name, method)] = rows
+    seed_rows = []
+    for tol in seed_tolerances:
+        run = _bounded(_run_seed, (tol,), 240)
+        seed_rows.append((tol, run))
+        print(f"  seed pipeline {tol:.0e}: "
+              + ("> 240 s" if run is None else f"{run['cpu']:.2f} s"), flush=True)
+    results[("seed", "seed pipeline")] = seed_rows
+    special = _specialisation_rows()
+    elapsed = time.time() - started_all
+
+    DOCS.mkdir(exist_ok=True)
+    _plot(results, references, DOCS / "work_precision.png")
+    _write_markdown(results, references, special, budget, elapsed, args,
+                    DOCS / "work_precision.md")
+    print(f"wrote {DOCS / 'work_precision.png'} and {DOCS / 'work_precision.md'} "
+          f"({elapsed:.0f} s)")
+
+
+def _plot(results, references, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, len(SCENES), figsize=(5.2 * len(SCENES), 4.4))
+    styles = {"radau5": "o-", "Radau": "s--", "BDF": "^--", "LSODA": "v--", "DOP853": "d--",
+              "seed pipeline": "X:"}
+    for ax, scene_name in zip(axes, SCENES):
+        ref = references[scene_name][0]
+        for (name, method), rows in results.items():
+            if name != scene_name:
+                continue
+            pts = [(run["cpu"], max(_errors(run, ref)[0], 1e-16), tol) for tol, run in rows
+                   if run is not None and "error" not in run]
+            if not pts:
+                continue
+            cpu, err, tols = zip(*pts)
+            ax.loglog(cpu, err, styles[method], label=method, ms=4)
+            if method in ("radau5", "seed pipeline"):
+                for c, e, t in zip(cpu, err, tols):
+                    ax.annotate(f"{t:.0e}", (c, e), fontsize=6, xytext=(3, 3),
+                                textcoords="offset points")
+        ax.set_title(scene_name)
+        ax.set_xlabel("CPU time (s)")
+        ax.set_ylabel("final-state error (m, m/s)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"ballc work-precision, {T_END:g} s, rtol = atol (labels), "
+                 "error vs radau5 at 1e-13")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+def _write_markdown(results, references, special, budget, elapsed, args, path):
+    lines = ["# Work-precision", "",
+             f"Generated by `python -m benchmarks.work_precision{' --quick' if args.quick else ''}`"
+             f" ({elapsed:.0f} s wall, 2-core machine shared with other work: CPU times are "
+             "`time.process_time()`, best of 2 for runs under 1 s).  Scenes: 5 s each.", "",
+             "Error: final-state error = max |difference| of the centre position (m) and "
+             "velocity (m/s) at t = 5 s; contact error = max |difference| of contact start/end "
+             "times (s), \"count\" when the number of contacts differs.  Reference: radau5 at "
+             "rtol = atol = 1e-13.  `> budget`: the run exceeded "
+             f"{budget:g} s (wall) and was stopped.", "", "![work-precision](work_precision.png)", ""]
+    for scene_name in SCENES:
+        ref, (ref_final, ref_contact) = references[scene_name]
+        lines += [f"## {scene_name}", "", f"{SCENE_NOTES[scene_name]}.  Reference "
+                  f"uncertainty (radau5 1e-12 vs 1e-13): final {ref_final:.1e}, contacts "
+                  f"{_fmt(ref_contact, 1)}.", "",
+                  "| method | rtol = atol | CPU s | RHS calls | final error | contact error "
+                  "| CPU vs radau5 |", "|---|---|---|---|---|---|---|"]
+        r5 = {tol: run for tol, run in results[(scene_name, "radau5")]}
+        for (name, method), rows in results.items():
+            if name != scene_name:
+                continue
+            for tol, run in rows:
+                if run is None:
+                    lines.append(f"| {method} | {tol:.0e} | > budget | | | | |")
+                    continue
+                if "error" in run:
+                    lines.append(f"| {method} | {tol:.0e} | {run['error']} | | | | |")
+                    continue
+                final, contact = _errors(run, ref)
+                base = r5.get(tol)
+                ratio = (f"{run['cpu'] / base['cpu']:.0f}x" if base is not None
+                         and "error" not in base else "")
+                note = "" if run["status"] == 0 else f" (status {run['status']})"
+                lines.append(f"| {method} | {tol:.0e} | {run['cpu']:.3g}{note} | "
+                             f"{run['nfev']} | {final:.1e} | {_fmt(contact, 1)} | {ratio} |")
+        lines.append("")
+    lines += ["## Skipping what a scene does not need", "",
+              "radau5 on the same 0.15-s free-flight trajectory (observer_mass = 0, "
+              "rtol = atol = 1e-12), with kernels forced on and off; identical results and "
+              "RHS counts, so the ratio is the cost of the kernels alone.", "",
+              "| kernels | µs per RHS call, on | off | CPU ratio on/off | same result |",
+              "|---|---|---|---|---|"]
+    for label, on, off, ratio, same in special:
+        lines.append(f"| {label} | {on:.3f} | {off:.3f} | {ratio:.2f} | {same} |")
+    lines.append("")
+    path.write_text("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,167 @@
+"""radau5 (ballc's compiled Radau IIA) against scipy's Radau, and against exact solutions.
+
+radau5 is a port of scipy's Radau: same method, same error control, same event
+logic.  The two differ only by floating-point rounding (summation order, LAPACK
+called directly instead of through lu_solve), so at rtol = atol = 1e-12 they
+take (nearly) the same steps.  What the tolerances below allow:
+
+* Smooth segments: both solutions are within a few local tolerances of the true
+  one per step, and the contacts amplify differences by a modest factor; at
+  1e-12 a bound of 1e-8 (positions, m) is ~1e4 x the per-step tolerance and
+  the measured differences are 1e-12 .. 1e-10.
+* Contact times: each is an event root (brentq to 4 eps) on a dense output
+  accurate to ~tolerance; the difference between the two integrators is
+  a state difference divided by |vz| ~ 15..25 m/s, so 1e-9 s is generous.
+* The observer-free scene is ill-conditioned: nothing but friction couples the
+  spin, and rolling contacts sit on the 1e-10 m/s friction regularisation, so
+  scipy's Radau itself moves by 7e-4 m (positions) between rtol = 1e-12 and
+  1e-13 there.  radau5 vs Radau at the same 1e-12 differ by 1.5e-5 m; the bound
+  for this scene is 1e-4 m / 1e-3 m/s, below the reference's own uncertainty.
+"""
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+import ballc
+from ballc import _core, _radau5
+from ballc.simulate import LinearEvent, _segment_events
+
+TOL = 1e-12
+
+SCENES = {
+    "seed": ballc.Scene(),
+    "conservative": ballc.Scene(c_tau=1.0, friction_coefficient=0.0, mixture=0.0,
+                                velocity=(3.0, 1.0, -20.0)),
+    "friction": ballc.Scene(tangential_model="friction"),
+    "no observer": ballc.Scene(observer_mass=0.0),
+}
+
+
+def _contact_times(result):
+    return np.array([[c.t_start, c.t_end] for c in result.contacts])
+
+
+@pytest.fixture(scope="module", params=list(SCENES))
+def pair(request):
+    scene = SCENES[request.param]
+    t_eval = np.linspace(0.0, 5.0, 501)
+    ours = ballc.simulate(scene, 5.0, method="radau5", rtol=TOL, atol=TOL, t_eval=t_eval)
+    ref = ballc.simulate(scene, 5.0, method="Radau", rtol=TOL, atol=TOL, t_eval=t_eval)
+    return request.param, ours, ref
+
+
+def test_same_outcome_and_contacts(pair):
+    name, ours, ref = pair
+    assert ours.status == ref.status == 0
+    assert [c.plane for c in ours.contacts] == [c.plane for c in ref.contacts]
+    assert len(ours.contacts) >= 8
+    np.testing.assert_allclose(_contact_times(ours), _contact_times(ref), rtol=0, atol=1e-9)
+
+
+def test_trajectories_agree_at_common_times(pair):
+    name, ours, ref = pair
+    np.testing.assert_array_equal(ours.t, ref.t)
+    loose = name == "no observer"
+    np.testing.assert_allclose(ours.position, ref.position, rtol=0,
+                               atol=1e-4 if loose else 1e-8)
+    np.testing.assert_allclose(ours.velocity, ref.velocity, rtol=0,
+                               atol=1e-3 if loose else 1e-7)
+    np.testing.assert_allclose(ours.angular_velocity, ref.angular_velocity, rtol=0,
+                               atol=1e-3 if loose else 1e-7)
+
+
+def test_work_is_that_of_scipy_radau(pair):
+    """Same algorithm: the RHS-call counts differ by rounding-level step changes only."""
+    name, ours, ref = pair
+    assert abs(ours.nfev - ref.nfev) <= 0.03 * ref.nfev
+
+
+def test_free_flight_is_exactly_ballistic():
+    """No observer, no contact: the centre moves on a parabola and the spin is constant;
+    Radau IIA (order 5) integrates polynomials of degree <= 3 exactly (to rounding)."""
+    scene = ballc.Scene(observer_mass=0.0, velocity=(1.0, -2.0, 3.0), position=(0, 0, 5.0),
+                        angular_velocity=(0.3, -0.2, 0.5))
+    t = np.linspace(0, 0.6, 13)
+    result = ballc.simulate(scene, 0.6, method="radau5", t_eval=t, rtol=1e-6, atol=1e-6)
+    assert result.status == 0 and not result.contacts
+    np.testing.assert_allclose(result.position[2], 5.0 + 3.0 * t - 9.81 / 2 * t ** 2,
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(result.position[0], t, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(result.position[1], -2.0 * t, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(result.angular_velocity,
+                               np.repeat([[0.3], [-0.2], [0.5]], t.size, axis=1), atol=1e-13)
+
+
+def test_linear_system_matches_the_matrix_exponential():
+    """y' = A y with a stiff, oscillatory A: the error follows the tolerance."""
+    A = np.array([[-1.0, 20.0, 0.0], [-20.0, -1.0, 0.0], [0.0, 1.0, -1e4]])
+    y0 = np.array([1.0, 0.0, 1.0])
+    t = np.linspace(0, 2, 9)
+    exact = np.array([expm(A * tt) @ y0 for tt in t]).T
+    for tol, bound in ((1e-6, 1e-4), (1e-10, 1e-8)):
+        sol = _radau5.solve_linear(A, (0, 2), y0, rtol=tol, atol=tol, t_eval=t)
+        assert sol.status == 0
+        np.testing.assert_allclose(sol.y, exact, rtol=0, atol=bound)
+
+
+class _Event:
+    def __init__(self, coefficients, offset, terminal, direction):
+        self.coefficients, self.offset = np.asarray(coefficients, dtype=float), offset
+        self.terminal, self.direction = terminal, direction
+
+
+def test_linear_events_are_located_on_the_dense_output():
+    """y = (cos 3t, -3 sin 3t).  Falling zeros of y0 at t = pi/6, pi/6 + 2pi/3, ...;
+    the terminal event y0 - 0.5 rising first at 3t = 5 pi / 3."""
+    A = np.array([[0.0, 1.0], [-9.0, 0.0]])
+    events = [_Event([1.0, 0.0], 0.0, False, -1), _Event([1.0, 0.0], -0.5, True, 1)]
+    sol = _radau5.solve_linear(A, (0, 3), np.array([1.0, 0.0]), rtol=1e-12, atol=1e-12,
+                               events=events)
+    t_stop = 5 * np.pi / 9
+    assert sol.status == 1 and sol.message == "A termination event occurred."
+    np.testing.assert_allclose(sol.t_events[0], [np.pi / 6], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(sol.t_events[1], [t_stop], rtol=0, atol=1e-10)
+    assert sol.t[-1] == sol.t_events[1][0]
+    np.testing.assert_allclose(sol.y_events[1][0], [0.5, -3 * np.sin(3 * t_stop)],
+                               rtol=0, atol=1e-9)
+
+
+def test_linear_event_objects_serve_both_integrators():
+    scene = ballc.Scene()
+    events = _segment_events(scene, {"floor": True, "ceiling": False})
+    y = scene.initial_state()
+    for kind, plane, event in events:
+        assert isinstance(event, LinearEvent)
+        assert event.coefficients.shape == (_core.N_STATES,)
+        assert event(0.0, y) == pytest.approx(event.coefficients @ y + event.offset)
+    kinds = [k for k, _, _ in events]
+    assert kinds == ["leave", "through", "deepest", "enter"]
+
+
+def test_failure_is_honest_and_returns_what_was_computed():
+    """y' = 1000 y overflows near t = 0.71: status -1, a message, the points so far."""
+    sol = _radau5.solve_linear(np.array([[1000.0]]), (0, 10.0), np.array([1.0]),
+                               rtol=1e-6, atol=1e-6)
+    assert sol.status == -1 and not sol.success
+    assert "step size" in sol.message
+    assert 0.5 < sol.t[-1] < 0.8
+    assert np.all(np.isfinite(sol.y)) and sol.y.shape == (1, sol.t.size)
+    bad = _radau5.solve_linear(np.array([[1e308]]), (0, 1.0), np.array([1e10]),
+                               rtol=1e-6, atol=1e-6)
+    assert bad.status == -1 and "initial state" in bad.message
+    np.testing.assert_array_equal(bad.t, [0.0])
+
+
+def test_bad_options_are_named():
+    A = np.eye(2)
+    with pytest.raises(ValueError, match="rtol"):
+        _radau5.solve_linear(A, (0, 1), [1.0, 1.0], rtol=-1.0, atol=1e-6)
+    with pytest.raises(ValueError, match="max_step"):
+        _radau5.solve_linear(A, (0, 1), [1.0, 1.0], rtol=1e-6, atol=1e-6, max_step=0.0)
+    with pytest.raises(ValueError, match="t_eval"):
+        _radau5.solve_linear(A, (0, 1), [1.0, 1.0], rtol=1e-6, atol=1e-6, t_eval=[0.5, 0.2])
+    with pytest.raises(ValueError, match="y0"):
+        _radau5.solve_linear(A, (0, 1), [1.0], rtol=1e-6, atol=1e-6)
+    with pytest.raises(TypeError, match="linear event"):
+        _radau5.solve_linear(A, (0, 1), [1.0, 1.0], rtol=1e-6, atol=1e-6,
+                             events=[lambda t, y: y[0]])
