@@ -108,6 +108,34 @@ def _segment_events(scene, in_contact):
     return events
 
 
+def _crossing_needs_motion(events):
+    """Issue 6 fix: an enter (leave) event only fires while the ball moves into (out of) the plane.
+
+    rho = r - z (or z - (H - r)) is exactly 0 on a plateau of ~1e-16 m / |vz| seconds
+    around a contact boundary (z rounds to r).  A segment starts on that plateau, and
+    solve_ivp counts g(t0) = 0 as a crossing and brentq returns a point of the plateau:
+    a ball that leaves the floor and comes back within the first free-flight step
+    "re-entered" right after t0 while still moving away, then "left" again, and so on,
+    advancing by one ulp per segment forever (stress case: a stiff ball settling on the
+    floor).  Here enter reports at most -1e-300 while rho_dot <= 0 and leave at least
+    +1e-300 while rho_dot >= 0; away from rho = 0 the values are unchanged.
+    """
+    wrapped = []
+    for kind, plane, fn in events:
+        if kind in ("enter", "leave"):
+            normal = 1.0 if plane == "floor" else -1.0   # rho_dot = -normal * vz
+
+            def g(t, y, fn=fn, normal=normal, entering=kind == "enter"):
+                rho, rho_dot = fn(t, y), -normal * y[_VZ]
+                if entering:
+                    return rho if rho_dot > 0 else min(rho, -1e-300)
+                return rho if rho_dot < 0 else max(rho, 1e-300)
+            g.terminal, g.direction = fn.terminal, fn.direction
+            fn = g
+        wrapped.append((kind, plane, fn))
+    return wrapped
+
+
 def _flags(scene, in_contact):
     flags = _core.FLAGS["observer"] if scene.observer_mass != 0 else 0
     mixture = scene.effective_mixture
@@ -272,6 +300,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             bar.update(t - bar.n)
         system = _core.System(params, latch, _flags(scene, in_contact))
         events = _segment_events(scene, in_contact)
+        if method != "radau5":   # radau5 evaluates LinearEvents in C (see report, issue 6)
+            events = _crossing_needs_motion(events)
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > t) & (t_eval <= t_end)]
@@ -281,8 +311,12 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         njev += sol.njev
         nlu += sol.nlu
         first = 1 if t_eval is None else 0   # the segment's start is already stored
-        ts.append(sol.t[first:])
-        ys.append(sol.y[:, first:])
+        # Issue 6: an event at the segment's very start (a ball that starts touching a
+        # plane and moving into it) ends a zero-length segment whose event sample
+        # repeats t; keep only later samples so that result.t stays strictly increasing.
+        later = sol.t[first:] > t
+        ts.append(sol.t[first:][later])
+        ys.append(sol.y[:, first:][:, later])
         flag_columns.append(np.full(ts[-1].size, system.flags, dtype=np.int32))
         latch_columns.append(np.repeat(latch[:, None], ts[-1].size, axis=1))
         for (kind, plane, _), t_hits, y_hits in zip(events, sol.t_events, sol.y_events):
