@@ -449,28 +449,15 @@ static int store_hit(solver_t *s, int event, double t, const double *y)
 
 /* ---- events ---- */
 
-/* A directional event only counts a crossing while g moves in its direction:
- * where dg/dt has the wrong sign (or is 0), g is reported as -tiny (rising events)
- * or +tiny (falling events) if it is 0 or beyond.  Away from g = 0 nothing changes.
- * This keeps a segment that starts on a plateau g(t0) = 0 (a contact boundary
- * located to rounding) from firing again at t0 while the state moves away. */
-static double gated(int direction, double g, double rate)
-{
-    if (direction > 0 && !(rate > 0)) return fmin(g, -1e-300);
-    if (direction < 0 && !(rate < 0)) return fmax(g, 1e-300);
-    return g;
-}
-
-/* g_e(y) with the rate c . f (f = dy/dt at y). */
+/* g_e(y) = c . y + offset, as solve_ivp evaluates an event (no gating: the driver
+ * keeps segments from starting on an event's zero; see simulate.contact_hysteresis). */
 static double event_value(const solver_t *s, int e, const double *y, const double *f)
 {
+    (void)f;
     const double *c = s->p->ev_coef + (size_t)e * s->n;
-    double g = s->p->ev_offset[e], rate = 0;
-    for (int i = 0; i < s->n; i++) {
-        g += c[i] * y[i];
-        rate += c[i] * f[i];
-    }
-    return gated(s->p->ev_direction[e], g, rate);
+    double g = s->p->ev_offset[e];
+    for (int i = 0; i < s->n; i++) g += c[i] * y[i];
+    return g;
 }
 
 /* g_e on the last step's dense output: a cubic in x = (t - t_old) / h. */
@@ -479,9 +466,7 @@ typedef struct { double a[4], t_old, h; int direction; } cubic_t;
 static double cubic_at(const cubic_t *q, double tt)
 {
     double x = (tt - q->t_old) / q->h;
-    double g = q->a[0] + x * (q->a[1] + x * (q->a[2] + x * q->a[3]));
-    double rate = (q->a[1] + x * (2 * q->a[2] + x * 3 * q->a[3])) / q->h;
-    return gated(q->direction, g, rate);
+    return q->a[0] + x * (q->a[1] + x * (q->a[2] + x * q->a[3]));
 }
 
 /* scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c), xtol = rtol = 4 eps as in
