@@ -8,10 +8,9 @@
  * Jacobian / LU reuse strategy and collocation-polynomial dense output.  The
  * event logic is solve_ivp's (find_active_events, handle_events, brentq with
  * xtol = rtol = 4 eps), for events that are linear functionals of the state,
- * g(y) = c . y + d: on one step g(t) is then a cubic in t.  One addition to
- * solve_ivp: a directional event counts a crossing only while g moves in its
- * direction (see gated() in _radau5_solver.c), so that a segment starting exactly
- * on g = 0 does not fire at its first point while the state moves away.
+ * g(y) = c . y + d: on one step g(t) is then a cubic in t.  Events are evaluated
+ * exactly as solve_ivp evaluates them (the driver keeps segments from starting on
+ * an event's zero; see simulate.py).
  *
  * Generic in the system: the right-hand side and Jacobian are C callbacks, the
  * dimension is a run-time value.  Linear algebra is LAPACK's dgetrf/dgetrs and
