@@ -131,8 +131,8 @@ def test_linear_events_are_located_on_the_dense_output():
 
 def test_linear_event_objects_serve_both_integrators():
     scene = ballc.Scene()
-    events = _segment_events(scene, {"floor": True, "ceiling": False})
     y = scene.initial_state()
+    events = _segment_events(scene, {"floor": True, "ceiling": False}, y)
     for kind, plane, event in events:
         assert isinstance(event, LinearEvent)
         assert event.coefficients.shape == (_core.N_STATES,)

@@ -95,3 +95,31 @@ def test_trajectory_matches_seed_pipeline():
     np.testing.assert_allclose(ours.velocity, seed["y"][9:12], atol=2e-2)
     seed_times = [t for t, _ in seed["contacts"]]
     np.testing.assert_allclose([c.t_start for c in ours.contacts], seed_times, atol=2e-3)
+
+
+@pytest.mark.parametrize("method", ["radau5", "Radau"])
+def test_call_budget_stops_honestly_with_the_results_so_far(method):
+    """A friction contact at a loose tolerance crawls (the seed's 1e-10 m/s Coulomb
+    regularisation); the budget stops it with status -1, the cause and the data."""
+    result = ballc.simulate(ballc.Scene(tangential_model="friction"), 1.0, rtol=1e-6,
+                            atol=1e-6, method=method, max_nfev=50_000)
+    assert result.status == -1 and not result.success
+    assert "max_nfev" in result.message and "regularisation" in result.message
+    assert 0.15 < result.t[-1] < 1.0            # past the first contact's start
+    assert result.nfev <= 50_000 + 100
+    assert np.all(np.isfinite(result.y)) and len(result.contacts) == 1
+
+
+def test_inaccurate_integration_says_so():
+    """At rtol = 1e-4 the friction contact chatters and the passive model gains
+    energy numerically; the integrated energy balance exposes it in the message."""
+    result = ballc.simulate(ballc.Scene(tangential_model="friction"), 2.0, rtol=1e-4, atol=1e-4)
+    assert "energy balance" in result.message and "not accurate" in result.message
+    accurate = ballc.simulate(ballc.Scene(tangential_model="friction"), 2.0)
+    assert "energy balance" not in accurate.message
+
+
+@pytest.mark.parametrize("bad", [0, -5, 1.5, True, "10"])
+def test_bad_call_budget_is_named(bad):
+    with pytest.raises(ballc.SceneError, match="max_nfev"):
+        ballc.simulate(ballc.Scene(), 1.0, max_nfev=bad)

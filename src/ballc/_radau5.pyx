@@ -41,6 +41,7 @@ cdef extern from "_radau5_solver.h":
         double rtol
         const double *atol
         double max_step, first_step
+        long max_nfev
         const double *t_eval
         long n_eval
         int n_events
@@ -207,8 +208,11 @@ cdef object _run(radau5_problem *p, int n, int m):
 
 
 cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
-                   rtol, atol, max_step, t_eval, events, first_step):
+                   rtol, atol, max_step, t_eval, events, first_step, max_nfev):
     cdef radau5_problem p
+    if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
+        raise ValueError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
+                         "integer > 0")
     t0, t1 = t_span
     t0, t1, rtol, atol_v, max_step, t_eval, first = _options(
         n, t0, t1, rtol, atol, max_step, t_eval, first_step)
@@ -229,6 +233,7 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.atol = &atolv[0]
     p.max_step = max_step
     p.first_step = first
+    p.max_nfev = 0 if max_nfev is None else max_nfev
     p.t_eval = NULL
     p.n_eval = 0
     if t_eval is not None:
@@ -247,14 +252,15 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
 
 
 def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
-                 max_step=np.inf, t_eval=None, events=(), first_step=None):
+                 max_step=np.inf, t_eval=None, events=(), first_step=None, max_nfev=None):
     """Integrate ballc's equations (N_STATES states) over ``t_span`` with radau5.
 
     ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
     ``_core.System``.  ``events``: objects with ``coefficients`` (N_STATES),
     ``offset``, ``terminal`` and ``direction`` -- g(y) = coefficients . y + offset.
     Returns a solve_ivp-shaped OptimizeResult (t, y, t_events, y_events, status,
-    message, success, nfev, njev, nlu) plus nstep and nreject.
+    message, success, nfev, njev, nlu) plus nstep and nreject.  ``max_nfev``: give
+    up (status -1, with what was computed) after that many right-hand-side calls.
     """
     cdef ball_ctx ctx
     params = _vector("params", params, BALLC_N_PARAMETERS)
@@ -264,11 +270,11 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ctx.latch = &lv[0]
     ctx.flags = flags
     return _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
-                  max_step, t_eval, events, first_step)
+                  max_step, t_eval, events, first_step, max_nfev)
 
 
 def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),
-                 first_step=None):
+                 first_step=None, max_nfev=None):
     """Integrate y' = A y (A: n x n) with radau5; same result as ``solve_system``."""
     cdef linear_ctx ctx
     A = np.ascontiguousarray(A, dtype=float)
@@ -280,4 +286,4 @@ def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, eve
     ctx.n = A.shape[0]
     ctx.A = &av[0, 0]
     return _solve(_linear_fun, _linear_jac, &ctx, ctx.n, t_span, y0, rtol, atol,
-                  max_step, t_eval, events, first_step)
+                  max_step, t_eval, events, first_step, max_nfev)

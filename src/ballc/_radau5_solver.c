@@ -670,6 +670,13 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     }
 
     for (;;) {
+        if (p->max_nfev > 0 && r->nfev >= p->max_nfev) {
+            r->status = RADAU5_FAILED;
+            snprintf(r->message, sizeof r->message,
+                     "gave up at t = %.9g after %ld right-hand-side evaluations (max_nfev)",
+                     s.t, r->nfev);
+            break;
+        }
         if (!step(&s)) {
             r->status = RADAU5_FAILED;
             break;

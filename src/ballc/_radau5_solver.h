@@ -53,6 +53,7 @@ typedef struct {
     const double *atol;       /* n values, >= 0 */
     double max_step;          /* > 0, may be INFINITY */
     double first_step;        /* 0: chosen as scipy's select_initial_step (order 3) */
+    long max_nfev;            /* > 0: give up (status RADAU5_FAILED) once nfev reaches it */
     const double *t_eval;     /* NULL: store every step; else n_eval times, sorted in */
     long n_eval;              /*   the direction of integration, within the interval */
     int n_events;             /* events g_k(y) = coef[k*n:(k+1)*n] . y + offset[k] */

@@ -24,6 +24,9 @@ IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
 METHODS = ("radau5",) + SCIPY_METHODS
 PLANES = ("floor", "ceiling")
 
+#: Default budget of right-hand-side evaluations of one simulate call.
+DEFAULT_MAX_NFEV = 20_000_000
+
 #: Smallest penetration rate latched at impact (m/s).  A contact that starts
 #: with a smaller rate (grazing, or a ball settling) uses this instead, so that
 #: Hunt-Crossley's damping chi = 3/2 (1 - c_tau) k0 / |rhodot^-| stays finite.
@@ -92,35 +95,42 @@ def _penetration(plane, scene):
     return LinearEvent.of_state("z", 1.0, -(h - r))
 
 
-def contact_hysteresis(scene):
-    """Half-width (m) of the band around rho = 0 between contact start and end.
+def contact_threshold(scene, plane, rho0, entering):
+    """How far past rho = 0 a contact's start (or end) event sits, for a segment that
+    starts at penetration ``rho0`` (m).
 
-    A contact starts when rho rises through +h and ends when it falls through -h,
-    h = 64 ulp of the largest height.  Without the band a segment starting on a
-    boundary sits on the ~1-ulp plateau where rho rounds to exactly 0, which the event
-    search counts as a crossing: a ball leaving slowly would "re-enter" at once while
-    still moving away, then "leave" again, one ulp per segment, for ever.  With it,
-    every segment starts strictly on the far side of its events (|g(t0)| >= h), so
-    only a real crossing can fire.  h is about 1e-13 m for the seed scene: the contact
-    force it leaves out, k0 h^(3/2), is below 1e-15 N.
+    The event is g = rho - threshold (start) or rho + threshold (end), and the threshold
+    puts g(t0) strictly (by >= 4 ulp of the boundary height) on the near side of its
+    zero.  Without it a segment starting on a boundary sits on the ~1-ulp plateau where
+    rho rounds to exactly 0, which the event search counts as a crossing at t0: a ball
+    leaving slowly would "re-enter" at once while still moving away, then "leave"
+    again, one ulp per segment, for ever.  A segment that starts a little on the far
+    side (an event root located to ~1e-14 m) raises the threshold past rho0, so that a
+    crossing within the first step cannot be masked by a second one.  The thresholds
+    are of order 1e-15 .. 1e-13 m: the contact force they leave out is negligible.
     """
-    return 64 * np.spacing(scene.ceiling_height + scene.radius)
+    boundary = scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
+    base = 4 * np.spacing(boundary)
+    far_side = rho0 if entering else -rho0
+    return max(base, far_side + base)
 
 
-def _segment_events(scene, in_contact):
-    """Events of one segment: [(kind, plane, LinearEvent)]."""
+def _segment_events(scene, in_contact, y0):
+    """Events of one segment starting at state y0: [(kind, plane, LinearEvent)]."""
     events = []
-    band = contact_hysteresis(scene)
     for plane in PLANES:
         rho = _penetration(plane, scene)
+        rho0 = rho(0.0, y0)
         if in_contact[plane]:
             normal = 1.0 if plane == "floor" else -1.0
-            events.append(("leave", plane, rho.shifted(band, True, -1)))
+            threshold = contact_threshold(scene, plane, rho0, entering=False)
+            events.append(("leave", plane, rho.shifted(threshold, True, -1)))
             events.append(("through", plane, rho.shifted(-scene.radius, True, 1)))
             events.append(("deepest", plane,
                            LinearEvent.of_state("vz", -normal, 0.0, False, -1)))
         else:
-            events.append(("enter", plane, rho.shifted(-band, True, 1)))
+            threshold = contact_threshold(scene, plane, rho0, entering=True)
+            events.append(("enter", plane, rho.shifted(-threshold, True, 1)))
     return events
 
 
@@ -153,7 +163,8 @@ def _latch_values(y, params, plane):
     return max(rate, MIN_IMPACT_RATE), direction
 
 
-def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval, max_step):
+def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval, max_step,
+                      max_nfev=None):
     """Integrate one smooth segment; returns a solve_ivp-style solution.
 
     This is the one seam between the driver and an integrator.  The solution must
@@ -162,19 +173,62 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
     like solve_ivp events, with ``terminal`` and ``direction``).  ``method`` "radau5"
     runs ballc's compiled Radau IIA on the system's C right-hand side and Jacobian;
     any other is handed to scipy's solve_ivp (with the analytic Jacobian when implicit).
+    ``max_nfev``: give up (status -1, keeping what was computed) after that many
+    right-hand-side calls.
     """
     if method == "radau5":
         return _radau5.solve_system(system.params, system.latch, system.flags, (t0, t1), y0,
                                     rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
-                                    events=events)
+                                    events=events, max_nfev=max_nfev)
     options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
-    return solve_ivp(system, (t0, t1), y0, method=method, rtol=rtol, atol=atol,
-                     t_eval=t_eval, events=events, max_step=max_step, **options)
+    budget = [_call_budget(system, max_nfev)] if max_nfev is not None else []
+    sol = solve_ivp(system, (t0, t1), y0, method=method, rtol=rtol, atol=atol,
+                    t_eval=t_eval, events=list(events) + budget, max_step=max_step, **options)
+    if budget:
+        if len(sol.t_events[-1]):
+            sol.status = -1
+            sol.message = (f"gave up at t = {sol.t[-1]:.9g} after {sol.nfev} right-hand-side "
+                           "evaluations (max_nfev)")
+        sol.t_events, sol.y_events = sol.t_events[:-1], sol.y_events[:-1]
+    return sol
+
+
+def _call_budget(system, max_nfev):
+    """A terminal solve_ivp event that stops the integration gracefully at the end of
+    the first step after which ``system`` has been called ``max_nfev`` more times
+    (solve_ivp has no call budget of its own).  It is +1 before that step's end time
+    and -1 from it on, so the event search puts the root at that step's end."""
+    start, stop = system.nfev, []
+
+    def g(t, y):
+        if not stop and system.nfev - start >= max_nfev:
+            stop.append(t)
+        return -1.0 if stop and t >= stop[0] else 1.0
+    return _event(g, True, -1)
+
+
+def _event(function, terminal, direction):
+    function.terminal = terminal
+    function.direction = direction
+    return function
 
 
 #: scipy raises any rtol below 100 machine epsilons to that value (with a warning);
 #: ballc rejects such an rtol instead of silently integrating with another one.
 MIN_RTOL = 100 * np.finfo(float).eps
+
+
+def _failure_hint(scene, in_contact):
+    """Why a contact segment may defeat the integrator, when the cause is the usual one."""
+    if not any(in_contact.values()) or scene.tangential_model not in ("friction", "mixture"):
+        return ""
+    if scene.friction_coefficient == 0 or scene.effective_mixture == 1:
+        return ""
+    return (f" (in contact with Coulomb friction: below the regularisation speed "
+            f"{scene.friction_regularization_speed:g} m/s friction is a viscous law of "
+            "coefficient mu F_n / v_s, too stiff to resolve for hard materials or loose "
+            "tolerances; try friction_regularization='smooth' with "
+            "friction_regularization_speed >= 1e-6 m/s, or tighter rtol)")
 
 
 def _check_options(scene, t_end, method, rtol, atol, max_step=np.inf):
@@ -218,7 +272,7 @@ def _check_options(scene, t_end, method, rtol, atol, max_step=np.inf):
 
 def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float = 1e-10,
              atol: float = 1e-10, t_eval=None, max_step: float = np.inf,
-             progress: bool | None = None) -> Result:
+             progress: bool | None = None, max_nfev: int | None = DEFAULT_MAX_NFEV) -> Result:
     """Simulate ``scene`` from t = 0 to ``t_end`` (s).
 
     Parameters
@@ -238,6 +292,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         every contact event.
     max_step : float
         Largest step (s).
+    max_nfev : int or None
+        Give up (status -1, message, results so far) after this many right-hand-side
+        evaluations in all (default 2e7, about half a minute of radau5); None: no limit.
     progress : bool, optional
         Show a tqdm progress bar in simulated time (advanced once per segment).
         None (default): only when stderr is a terminal.
@@ -250,6 +307,10 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         arrays always hold what was computed up to there.
     """
     t_end = _check_options(scene, t_end, method, rtol, atol, max_step)
+    if max_nfev is not None and (isinstance(max_nfev, bool) or not isinstance(
+            max_nfev, (int, np.integer)) or max_nfev <= 0):
+        raise SceneError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
+                         "integer > 0")
     if t_eval is not None:
         t_eval_given = t_eval
         try:
@@ -287,12 +348,14 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if bar is not None:
             bar.update(t - bar.n)
         system = _core.System(params, latch, _flags(scene, in_contact))
-        events = _segment_events(scene, in_contact)
+        events = _segment_events(scene, in_contact, y)
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > t) & (t_eval <= t_end)]
+        remaining = None if max_nfev is None else max(max_nfev - nfev, 1)
         sol = integrate_segment(system, t, t_end, y, [e[2] for e in events], method=method,
-                                rtol=rtol, atol=atol, t_eval=segment_eval, max_step=max_step)
+                                rtol=rtol, atol=atol, t_eval=segment_eval, max_step=max_step,
+                                max_nfev=remaining)
         nfev += sol.nfev
         njev += sol.njev
         nlu += sol.nlu
@@ -311,7 +374,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     _record_depth(open_contacts[plane], _penetration(plane, scene)(0, yy), yy)
 
         if sol.status == -1:
-            status, message = -1, f"integrator failed at t = {sol.t[-1]:.6g} s: {sol.message}"
+            status = -1
+            message = (f"integrator failed at t = {sol.t[-1]:.6g} s: {sol.message}"
+                       + _failure_hint(scene, in_contact))
             break
         if sol.status == 0:
             break
@@ -344,7 +409,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             lost = y[_DISSIPATED] - dissipated_at_start.pop(plane)
             contact.energy_lost_normal, contact.energy_lost_tangential = map(float, lost)
         else:  # "through"
-            open_contacts[plane].max_penetration = scene.radius
+            contact = open_contacts.pop(plane)   # ended by passing through: no t_end
+            contact.max_penetration = scene.radius
             status = 1
             message = (f"ball passed through the {plane} at t = {t:.6g} s "
                        "(penetration reached the ball's radius)")
@@ -361,7 +427,27 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     contacts=contacts, flags=np.concatenate(flag_columns),
                     latch=np.concatenate(latch_columns, axis=1))
     summarize_contact_forces(result)
+    result.message += _balance_warning(result, rtol)
     return result
+
+
+def _balance_warning(result, rtol):
+    """A warning for the message when the integrated energy balance does not close.
+
+    kinetic + potential + spring + dissipated is conserved by the equations for every
+    model (dissipation is integrated with the motion), so a drift beyond what the
+    tolerances allow is an integration artefact, not physics: say so.
+    """
+    balance = result.energy["balance"]
+    scale = max(abs(balance[0]), 1.0)
+    drift = float(np.max(np.abs(balance - balance[0])))
+    allowed = max(1e-6, 1e3 * float(np.max(rtol))) * scale
+    if not drift > allowed:
+        return ""
+    return (f" Warning: the energy balance (kinetic + potential + spring + dissipated) "
+            f"drifted by {drift:.3g} J ({drift / scale:.2g} of the initial energy): the "
+            "integration is not accurate at this tolerance, so neither is this result; "
+            "tighten rtol/atol.")
 
 
 def _record_depth(contact, depth, y):
