@@ -60,6 +60,7 @@ DOCS = Path(__file__).resolve().parent.parent / "docs"
 
 def _summary(result):
     return {"final": result.y[_IDX, -1].copy(), "status": result.status,
+            "inaccurate": "energy balance" in result.message,
             "contacts": np.array([[c.t_start, c.t_end] for c in result.contacts]),
             "nfev": result.nfev}
 
@@ -282,6 +283,8 @@ def _write_markdown(results, references, special, budget, elapsed, args, path):
                 ratio = (f"{run['cpu'] / base['cpu']:.2g}x" if base is not None
                          and "error" not in base else "")
                 note = "" if run["status"] == 0 else f" (status {run['status']})"
+                if run.get("inaccurate"):
+                    note += " (energy balance off: flagged not accurate)"
                 lines.append(f"| {method} | {tol:.0e} | {run['cpu']:.3g}{note} | "
                              f"{run['nfev']} | {final:.1e} | {_fmt(contact, 1)} | {ratio} |")
         lines.append("")
