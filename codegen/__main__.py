@@ -11,11 +11,10 @@ import time
 from pathlib import Path
 
 from .emit import GENERATOR_VERSION, SIGNATURE, BallcPrinter, c_string_array, header_comment, kernel_c
+from .contact import TANGENTIAL_LAWS
 from .kernels import CONTACT_LAW_LAYOUT, MASS_LAYOUT, build_kernels
 from .model import (LATCH_FIELDS, LATCH_NAMES, MECHANICAL_STATE_NAMES, PARAMETER_NAMES,
                     PARAMETERS, PLANES, STATE_NAMES)
-
-CONTACT_LAW_NOUT = 13
 
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
@@ -39,6 +38,8 @@ def render(verbose=False) -> dict[str, str]:
             print(f"  {kernel.name:28s} {len(kernel.outputs):4d} outputs {ops:6d} ops",
                   file=sys.stderr)
 
+    law_names = {f"{plane}_{law}" for plane in PLANES for law in TANGENTIAL_LAWS}
+    (contact_law_nout,) = {len(k.outputs) for k in kernels if k.name in law_names}
     units = [p[2] for p in PARAMETERS]
     h = [header, "#ifndef BALLC_KERNELS_H", "#define BALLC_KERNELS_H", "",
          "/* Argument layout: the one source of truth for state and parameter order. */",
@@ -51,7 +52,7 @@ def render(verbose=False) -> dict[str, str]:
          f"#define BALLC_MASS_SIZE {len(MASS_LAYOUT)}",
          *[f"#define BALLC_STATE_{name.upper()} {i}" for i, name in enumerate(STATE_NAMES)],
          f"#define BALLC_N_MECHANICAL_STATES {len(MECHANICAL_STATE_NAMES)}",
-         f"#define BALLC_CONTACT_LAW_NOUT {CONTACT_LAW_NOUT}",
+         f"#define BALLC_CONTACT_LAW_NOUT {contact_law_nout}",
          "/* contact-law kernel outputs: " + "; ".join(CONTACT_LAW_LAYOUT) + " */",
          "#define BALLC_LAW_FORCE 6",
          "#define BALLC_LAW_DISSIPATION 9",

@@ -93,6 +93,11 @@ class BallcPrinter(C99CodePrinter):
         return super()._print_Pow(expr)
 
 
+def plain_symbols(states):
+    """Plain symbols named like the state dynamicsymbols (qw(t) -> qw)."""
+    return [sm.Symbol(s.func.__name__) for s in states]
+
+
 def _plain(expr, replacements):
     """Replace dynamicsymbols by plain symbols and reject anything left over."""
     return sm.sympify(expr).xreplace(replacements)
@@ -101,7 +106,7 @@ def _plain(expr, replacements):
 def kernel_c(kernel: Kernel, state_syms, param_syms, printer=None) -> tuple[str, int]:
     """C source of one kernel and its operation count after CSE."""
     printer = printer or BallcPrinter()
-    plain_states = [sm.Symbol(s.func.__name__) for s in state_syms]
+    plain_states = plain_symbols(state_syms)
     replacements = dict(zip(state_syms, plain_states))
     outputs = [_plain(e, replacements) for e in kernel.outputs]
     definitions = [(s, _plain(e, replacements)) for s, e in kernel.definitions]

@@ -19,7 +19,7 @@ import sympy as sm
 import sympy.physics.mechanics as me
 
 from . import contact
-from .emit import Kernel, forward_jacobian
+from .emit import Kernel, forward_jacobian, plain_symbols
 from .model import PLANES, STATE_NAMES, Model, bodies, build_model, gravity_loads, kanes_equations
 
 MASS_LAYOUT = ("J00", "J01", "J02", "J11", "J12", "J22",
@@ -44,10 +44,6 @@ def pack_mass(M: sm.Matrix) -> list:
     J = [M[i, j] for i, j in J_INDEX]
     B = [M[i, 3 + j] for i in range(3) for j in range(3)]
     return J + B + [D]
-
-
-def _zero_when(expr, symbol):
-    return expr.subs(symbol, 0)
 
 
 def derive(model: Model | None = None):
@@ -84,18 +80,12 @@ def derive(model: Model | None = None):
     return model, pieces
 
 
-def plain(model, exprs):
-    """Expressions with the state dynamicsymbols replaced by plain symbols."""
-    return [sm.sympify(e).xreplace(dict(zip(model.states, plain_states(model)))) for e in exprs]
-
-
-def plain_states(model):
-    return [sm.Symbol(s.func.__name__) for s in model.states]
-
-
 def jacobian_kernel(model, name, doc, outputs, extra=(), extra_doc="", prefix="j"):
     """Kernel of d(outputs)/d(state), row-major, by forward_jacobian."""
-    definitions, jac = forward_jacobian(plain(model, outputs), plain_states(model), prefix)
+    states = plain_symbols(model.states)
+    replacements = dict(zip(model.states, states))
+    outputs = [sm.sympify(e).xreplace(replacements) for e in outputs]
+    definitions, jac = forward_jacobian(outputs, states, prefix)
     return Kernel(name, doc, jac, list(extra), extra_doc, definitions)
 
 

@@ -32,6 +32,8 @@ N_PARAMETERS = BALLC_N_PARAMETERS
 N_LATCH = BALLC_N_LATCH
 N_LATCH_PER_PLANE = BALLC_N_LATCH_PER_PLANE
 STATE_NAMES = tuple(BALLC_STATE_NAMES[i].decode() for i in range(BALLC_N_STATES))
+#: state name -> index in the state vector (from the generated layout)
+STATE_INDEX = {name: i for i, name in enumerate(STATE_NAMES)}
 PARAMETER_NAMES = tuple(BALLC_PARAMETER_NAMES[i].decode() for i in range(BALLC_N_PARAMETERS))
 PARAMETER_UNITS = tuple(BALLC_PARAMETER_UNITS[i].decode() for i in range(BALLC_N_PARAMETERS))
 LATCH_NAMES = tuple(BALLC_LATCH_NAMES[i].decode() for i in range(BALLC_N_LATCH))

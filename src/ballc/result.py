@@ -8,7 +8,7 @@ import numpy as np
 from . import _core
 from .orientation import angles_123_from_quaternion
 
-_STATE = {name: i for i, name in enumerate(_core.STATE_NAMES)}
+_STATE = _core.STATE_INDEX
 
 
 @dataclass
@@ -95,7 +95,7 @@ class Result:
     @property
     def quaternion(self) -> np.ndarray:
         """(4, n) unit quaternion (qw, qx, qy, qz), ball frame -> inertial."""
-        q = self._rows(0, 4)
+        q = self._rows(_STATE["qw"], 4)
         return q / np.linalg.norm(q, axis=0)
 
     @property
@@ -106,17 +106,17 @@ class Result:
     @property
     def position(self) -> np.ndarray:
         """(3, n) centre position (m)."""
-        return self._rows(4)
+        return self._rows(_STATE["x"])
 
     @property
     def angular_velocity(self) -> np.ndarray:
         """(3, n) angular velocity, inertial components (rad/s)."""
-        return self._rows(7)
+        return self._rows(_STATE["omega_x"])
 
     @property
     def velocity(self) -> np.ndarray:
         """(3, n) centre velocity (m/s)."""
-        return self._rows(10)
+        return self._rows(_STATE["vx"])
 
     @property
     def observer_position(self) -> np.ndarray:

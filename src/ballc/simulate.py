@@ -32,8 +32,8 @@ DEFAULT_MAX_NFEV = 20_000_000
 #: Hunt-Crossley's damping chi = 3/2 (1 - c_tau) k0 / |rhodot^-| stays finite.
 MIN_IMPACT_RATE = 1e-9
 
-_STATE = {name: i for i, name in enumerate(_core.STATE_NAMES)}
-_Z, _VZ = _STATE["z"], _STATE["vz"]
+_STATE = _core.STATE_INDEX
+_QUATERNION = slice(_STATE["qw"], _STATE["qw"] + 4)
 _OMEGA, _V = _STATE["omega_x"], _STATE["vx"]
 _KIN_PER_PLANE = _core.CONTACT_KINEMATICS_NOUT // len(PLANES)
 _DISSIPATED = [_STATE["dissipated_normal"], _STATE["dissipated_tangential"]]
@@ -385,7 +385,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         kind, plane, index = fired[0]
         t = float(sol.t_events[index][-1])
         y = np.array(sol.y_events[index][-1])
-        y[:4] /= np.linalg.norm(y[:4])
+        y[_QUATERNION] /= np.linalg.norm(y[_QUATERNION])
         if kind == "enter":
             rate, direction = _latch_values(y, params, plane)
             k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE
