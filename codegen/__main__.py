@@ -12,7 +12,7 @@ from pathlib import Path
 
 from .emit import GENERATOR_VERSION, SIGNATURE, BallcPrinter, c_string_array, header_comment, kernel_c
 from .contact import TANGENTIAL_LAWS
-from .kernels import CONTACT_LAW_LAYOUT, MASS_LAYOUT, build_kernels
+from .kernels import MASS_LAYOUT, build_kernels, contact_law_offsets, describe_contact_law_layout
 from .model import (LATCH_FIELDS, LATCH_NAMES, MECHANICAL_STATE_NAMES, PARAMETER_NAMES,
                     PARAMETERS, PLANES, STATE_NAMES)
 
@@ -51,12 +51,13 @@ def render(verbose=False) -> dict[str, str]:
          f"#define BALLC_N_PLANES {len(PLANES)}",
          f"#define BALLC_MASS_SIZE {len(MASS_LAYOUT)}",
          *[f"#define BALLC_STATE_{name.upper()} {i}" for i, name in enumerate(STATE_NAMES)],
+         *[f"#define BALLC_PARAMETER_{name.upper()} {i}"
+           for i, name in enumerate(PARAMETER_NAMES)],
+         *[f"#define BALLC_LATCH_{field[0].upper()} {i}" for i, field in enumerate(LATCH_FIELDS)],
          f"#define BALLC_N_MECHANICAL_STATES {len(MECHANICAL_STATE_NAMES)}",
          f"#define BALLC_CONTACT_LAW_NOUT {contact_law_nout}",
-         "/* contact-law kernel outputs: " + "; ".join(CONTACT_LAW_LAYOUT) + " */",
-         "#define BALLC_LAW_FORCE 6",
-         "#define BALLC_LAW_DISSIPATION 9",
-         "#define BALLC_LAW_DEFLECTION_RATE 11",
+         "/* contact-law kernel outputs: " + describe_contact_law_layout() + " */",
+         *[f"#define BALLC_LAW_{suffix} {offset}" for suffix, offset in contact_law_offsets()],
          *sizes, "",
          c_string_array("BALLC_STATE_NAMES", STATE_NAMES).rstrip(),
          c_string_array("BALLC_PARAMETER_NAMES", PARAMETER_NAMES).rstrip(),

@@ -80,7 +80,7 @@ def normal_force(model: Model, plane: str):
     return _hunt_crossley(model, rho, rhodot, rate_at_impact)
 
 
-def _slip(model: Model, plane: str):
+def slip_kinematics(model: Model, plane: str):
     """(point, contact-point velocity, normal, in-plane slip components (sx, sy))."""
     N = model.frame
     point, velocity, _, _ = contact_kinematics(model, plane)
@@ -96,7 +96,7 @@ def friction_model_force(model: Model, plane: str):
     = 0) or ``-v_t / sqrt(|v_t|^2 + v_s^2)`` (``smooth_friction`` = 1).
     """
     N = model.frame
-    point, _, normal, (sx, sy) = _slip(model, plane)
+    point, _, normal, (sx, sy) = slip_kinematics(model, plane)
     f_n = normal_force(model, plane)
     eps = model.p["friction_regularization_speed"]
     smooth = model.p["smooth_friction"]
@@ -114,7 +114,7 @@ def digin_model_force(model: Model, plane: str):
     """Seed's dig-in model: HC force along the latched direction, weight mixture."""
     N = model.frame
     point, velocity, rho, _ = contact_kinematics(model, plane)
-    rate_at_impact, dx, dy, dz = latch_symbols(model, plane)
+    rate_at_impact, dx, dy, dz = latch_symbols(model, plane)[:4]
     direction = dx*N.x + dy*N.y + dz*N.z
     f_d = _hunt_crossley(model, rho, me.dot(velocity, direction), rate_at_impact)
     weight = model.p["mixture"]
@@ -144,7 +144,7 @@ def compliant_model_force(model: Model, plane: str):
     """
     N = model.frame
     p = model.p
-    point, _, normal, (vx, vy) = _slip(model, plane)
+    point, _, normal, (vx, vy) = slip_kinematics(model, plane)
     _, _, rho, _ = contact_kinematics(model, plane)
     f_n = normal_force(model, plane)
     kappa = p["tangential_stiffness_ratio"]

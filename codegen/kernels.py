@@ -26,9 +26,24 @@ MASS_LAYOUT = ("J00", "J01", "J02", "J11", "J12", "J22",
                "B00", "B01", "B02", "B10", "B11", "B12", "B20", "B21", "B22", "D")
 J_INDEX = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 #: Outputs of every contact-law kernel, in order.
-CONTACT_LAW_LAYOUT = ("generalized force (6)", "force on the ball at the contact point (3)",
-                      "dissipation rate normal (1)", "dissipation rate tangential (1)",
-                      "deflection rate x, y (2)")
+#: (C macro suffix, description, count): BALLC_LAW_<suffix> is the offset of each block.
+CONTACT_LAW_LAYOUT = (("GENERALIZED_FORCE", "generalized force", 6),
+                      ("FORCE", "force on the ball at the contact point", 3),
+                      ("DISSIPATION", "dissipation rate normal, tangential", 2),
+                      ("DEFLECTION_RATE", "deflection rate x, y", 2))
+
+
+def contact_law_offsets():
+    """[(macro suffix, offset)] of the blocks of CONTACT_LAW_LAYOUT."""
+    offsets, offset = [], 0
+    for suffix, _, count in CONTACT_LAW_LAYOUT:
+        offsets.append((suffix, offset))
+        offset += count
+    return offsets
+
+
+def describe_contact_law_layout():
+    return ", ".join(f"{what} ({count})" for _, what, count in CONTACT_LAW_LAYOUT)
 
 
 def pack_mass(M: sm.Matrix) -> list:
@@ -71,6 +86,7 @@ def derive(model: Model | None = None):
     }
     for plane in PLANES:
         G = F.jacobian(sm.Matrix(contact_forces[plane]))   # generalized-force map, 6x3
+        pieces[f"{plane}_force_map"] = G
         for name, function in contact.TANGENTIAL_LAWS.items():
             law = function(model, plane)
             f = sm.Matrix([me.dot(law.force, v) for v in (N.x, N.y, N.z)])
@@ -129,13 +145,37 @@ def build_kernels():
             outputs = pieces[f"{plane}_{law}"]
             doc = f"{plane} contact, {law} law (weighted):"
             extra_doc = "latched rhodot^-, d_x, d_y, d_z of this plane"
-            kernels.append(Kernel(f"{plane}_{law}", f"{doc} {', '.join(CONTACT_LAW_LAYOUT)}.",
+            kernels.append(Kernel(f"{plane}_{law}", f"{doc} {describe_contact_law_layout()}.",
                                   list(outputs), list(latch), extra_doc))
             kernels.append(jacobian_kernel(model, f"{plane}_{law}_jac", f"{doc} d(outputs)/dx "
                                            f"({len(outputs)}x{n} row-major).", list(outputs),
                                            latch, extra_doc))
+    for plane in PLANES:
+        kernels.append(slip_kernel(model, plane, pieces[f"{plane}_force_map"]))
     kernels += output_kernels(model)
     return model, kernels
+
+
+def slip_kernel(model: Model, plane: str, force_map: sm.Matrix):
+    """What exact (event-driven) Coulomb friction needs on ``plane``.
+
+    Outputs: the slip velocity u (2: x, y components of the contact-point velocity in
+    the plane), its derivative du/dx (2 x N_STATES row-major: u is linear in the
+    state), and the generalized-force map of a tangential force at the contact point
+    (6 x 2 row-major: columns for a unit force along N.x and N.y).  The driver's
+    stick constraint force and the sliding Coulomb force are applied through this
+    map, so the mechanics of where a contact force acts stay derived here.
+    """
+    _, _, _, slip = contact.slip_kinematics(model, plane)
+    states = plain_symbols(model.states)
+    replacements = dict(zip(model.states, states))
+    slip = [sm.sympify(u).xreplace(replacements) for u in slip]
+    derivative = [u.diff(x) for u in slip for x in states]
+    tangential_map = [force_map[i, k].xreplace(replacements) for i in range(6) for k in range(2)]
+    return Kernel(f"{plane}_slip", f"{plane} contact: slip velocity u (2), du/dx "
+                  f"(2x{len(states)} row-major), generalized-force map of a tangential "
+                  "force at the contact point (6x2 row-major).",
+                  slip + derivative + tangential_map, [])
 
 
 def output_kernels(model: Model):
@@ -166,4 +206,4 @@ def output_kernels(model: Model):
     ]
 
 
-__all__ = ["CONTACT_LAW_LAYOUT", "MASS_LAYOUT", "STATE_NAMES", "build_kernels", "derive"]
+__all__ = ["CONTACT_LAW_LAYOUT", "contact_law_offsets", "MASS_LAYOUT", "STATE_NAMES", "build_kernels", "derive"]

@@ -82,6 +82,10 @@ LATCH_FIELDS = (
     ("digin_direction_x", "ru1 / ro1", "1", "unit contact-point velocity at impact, x"),
     ("digin_direction_y", "ru2 / ro2", "1", "unit contact-point velocity at impact, y"),
     ("digin_direction_z", "ru3 / ro3", "1", "unit contact-point velocity at impact, z"),
+    ("slip_direction_x", "-", "1",
+     "exact Coulomb friction: unit slip direction latched at the segment start, x"),
+    ("slip_direction_y", "-", "1",
+     "exact Coulomb friction: unit slip direction latched at the segment start, y"),
 )
 PLANES = ("floor", "ceiling")
 LATCH_NAMES = tuple(f"{plane}_{f[0]}" for plane in PLANES for f in LATCH_FIELDS)

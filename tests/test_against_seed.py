@@ -19,6 +19,7 @@ MODELS = ("friction", "dig-in", "mixture")
 def seed_parameters(scene, latch):
     """The seed's 26 parameters for a ballc scene and latched values."""
     values = dict(zip(_core.PARAMETER_NAMES, scene.parameter_vector()))
+    c = _core.N_LATCH_PER_PLANE   # the ceiling's latched values start here
     seed = {
         "m": scene.mass, "mo": scene.observer_mass, "g": scene.gravity, "r": scene.radius,
         "alpha": scene.observer_position[0], "beta": scene.observer_position[1],
@@ -29,7 +30,7 @@ def seed_parameters(scene, latch):
         "Ep": scene.plane_youngs_modulus, "ctau": scene.c_tau,
         "mu": scene.friction_coefficient,
         "rhodtu": latch[0], "ru1": latch[1], "ru2": latch[2], "ru3": latch[3],
-        "rhodto": latch[4], "ro1": latch[5], "ro2": latch[6], "ro3": latch[7],
+        "rhodto": latch[c], "ro1": latch[c + 1], "ro2": latch[c + 2], "ro3": latch[c + 3],
     }
     return [seed[name] for name in SEED_PARAMETER_NAMES]
 
@@ -62,11 +63,11 @@ def random_state(rng, scene, where):
     deflections = rng.uniform(-1e-3, 1e-3, 4) * r     # compliant model's tangential springs
     auxiliary = np.concatenate([rng.uniform(-10, 10, 2), deflections])   # dissipated, deflections
     y = np.concatenate([quaternion_from_angles_123(angles), position, omega, velocity, auxiliary])
-    latch = np.empty(8)
-    for k in range(2):
+    latch = np.zeros(_core.N_LATCH)
+    for k in range(0, _core.N_LATCH, _core.N_LATCH_PER_PLANE):
         direction = rng.normal(size=3)
-        latch[4 * k] = rng.uniform(1, 30)
-        latch[4 * k + 1:4 * k + 4] = direction / np.linalg.norm(direction)
+        latch[k] = rng.uniform(1, 30)
+        latch[k + 1:k + 4] = direction / np.linalg.norm(direction)
     flags = _core.FLAGS["observer"] if scene.observer_mass else 0
     mixture = scene.effective_mixture
     if where != "free" and scene.tangential_model == "compliant":
@@ -89,7 +90,7 @@ def brackets_positive(scene, y, latch, where):
     arm = np.array([0, 0, -r if where == "floor" else r])
     vcp = velocity + np.cross(omega, arm)
     n = np.array([0, 0, 1.0 if where == "floor" else -1.0])
-    k = 0 if where == "floor" else 4
+    k = 0 if where == "floor" else _core.N_LATCH_PER_PLANE
     a = 1.5 * (1 - scene.c_tau) / latch[k]
     return 1 + a * (-vcp @ n) > 0.05 and 1 + a * (vcp @ latch[k + 1:k + 4]) > 0.05
 

@@ -101,9 +101,12 @@ def test_trajectory_matches_seed_pipeline():
 
 @pytest.mark.parametrize("method", ["radau5", "Radau"])
 def test_call_budget_stops_honestly_with_the_results_so_far(method):
-    """A friction contact at a loose tolerance crawls (the seed's 1e-10 m/s Coulomb
-    regularisation); the budget stops it with status -1, the cause and the data."""
-    result = ballc.simulate(ballc.Scene(tangential_model="friction"), 1.0, rtol=1e-6,
+    """A friction contact at a loose tolerance crawls with the seed's literal law (the
+    1e-10 m/s Coulomb regularisation, "max"): tens of thousands of calls go into the
+    first contact whatever the rounding, so a 50,000-call budget stops it there, with
+    status -1, the cause and the data."""
+    scene = ballc.Scene(tangential_model="friction", friction_regularization="max")
+    result = ballc.simulate(scene, 1.0, rtol=1e-6,
                             atol=1e-6, method=method, max_nfev=50_000)
     assert result.status == -1 and not result.success
     assert "max_nfev" in result.message and "regularisation" in result.message

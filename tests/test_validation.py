@@ -82,9 +82,9 @@ SCENE_CASES = {
     "velocity string": (dict(velocity="123"), "velocity", "'123'"),
     "velocity scalar": (dict(velocity=5.0), "velocity", "5.0"),
     # initial position not overlapping a plane
-    "overlaps floor": (dict(position=(0.0, 0.0, 0.5)), "position", "(0.0, 0.0, 0.5)"),
+    "below the floor": (dict(position=(0.0, 0.0, -0.5)), "position", "(0.0, 0.0, -0.5)"),
     "below floor": (dict(position=(0.0, 0.0, -3.0)), "position", "(0.0, 0.0, -3.0)"),
-    "overlaps ceiling": (dict(position=(0.0, 0.0, 9.5)), "position", "(0.0, 0.0, 9.5)"),
+    "above the ceiling": (dict(position=(0.0, 0.0, 10.0)), "position", "(0.0, 0.0, 10.0)"),
     # unknown tangential model, with a suggestion
     "tangential model typo": (dict(tangential_model="frictoin"), "tangential_model",
                               "'frictoin'"),

@@ -17,6 +17,9 @@ cdef extern from "ballc_kernels.h":
     void ballc_energy(const double *, const double *, const double *, double *) nogil
     void ballc_contact_kinematics(const double *, const double *, const double *, double *) nogil
     void ballc_observer_position(const double *, const double *, const double *, double *) nogil
+    int BALLC_FLOOR_SLIP_NOUT
+    void ballc_floor_slip(const double *, const double *, const double *, double *) nogil
+    void ballc_ceiling_slip(const double *, const double *, const double *, double *) nogil
 
 cdef extern from "_system.h":
     int BALLC_WITH_OBSERVER, BALLC_FLOOR_FRICTION, BALLC_FLOOR_DIGIN
@@ -26,6 +29,10 @@ cdef extern from "_system.h":
     int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
     int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
     int ballc_contact_forces(const double *, const double *, const double *, int, double *) nogil
+    int ballc_stick_state(const double *, const double *, const double *, int, int,
+                          double *) nogil
+    int ballc_remove_slip(const double *, const double *, int, int, double *) nogil
+    int BALLC_FLOOR_SLIP, BALLC_CEILING_SLIP, BALLC_FLOOR_STICK, BALLC_CEILING_STICK
 
 N_STATES = BALLC_N_STATES
 N_PARAMETERS = BALLC_N_PARAMETERS
@@ -46,6 +53,10 @@ FLAGS = {
     "ceiling_digin": BALLC_CEILING_DIGIN,
     "floor_compliant": BALLC_FLOOR_COMPLIANT,
     "ceiling_compliant": BALLC_CEILING_COMPLIANT,
+    "floor_slip": BALLC_FLOOR_SLIP,
+    "ceiling_slip": BALLC_CEILING_SLIP,
+    "floor_stick": BALLC_FLOOR_STICK,
+    "ceiling_stick": BALLC_CEILING_STICK,
 }
 ENERGY_NOUT = BALLC_ENERGY_NOUT
 CONTACT_KINEMATICS_NOUT = BALLC_CONTACT_KINEMATICS_NOUT
@@ -194,4 +205,60 @@ def contact_forces(const double[:, ::1] states, const double[::1] params,
     for i in range(states.shape[0]):
         if ballc_contact_forces(&states[i, 0], &params[0], &latch[0], flags, &o[i, 0]) != BALLC_OK:
             o[i, :] = np.nan
+    return out
+
+
+def _plane_index(int plane):
+    if plane not in (0, 1):
+        raise ValueError(f"plane must be 0 (floor) or 1 (ceiling), got {plane}")
+    return plane
+
+
+def slip_map(const double[::1] params, int plane):
+    """(2, N_STATES): du/dx of the slip velocity u (x, y) of ``plane``'s contact point;
+    u is linear in the state, u = slip_map . y."""
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _plane_index(plane)
+    cdef double ys[BALLC_MAX_STATES]
+    out = np.empty(BALLC_FLOOR_SLIP_NOUT)
+    cdef double[::1] o = out
+    cdef Py_ssize_t i
+    for i in range(BALLC_N_STATES):
+        ys[i] = 0.0
+    if plane == 0:
+        ballc_floor_slip(ys, &params[0], NULL, &o[0])
+    else:
+        ballc_ceiling_slip(ys, &params[0], NULL, &o[0])
+    return out[2:2 + 2 * BALLC_N_STATES].reshape(2, BALLC_N_STATES)
+
+
+def stick_state(const double[::1] y, const double[::1] params, const double[::1] latch,
+                int flags, int plane):
+    """(lambda_x, lambda_y, N, margin) of a sticking ``plane``: the constraint force (N)
+    that holds the slip velocity, the friction share's normal force (N) and
+    mu N - |lambda| (N); raises if it cannot be evaluated (flags must hold the plane's
+    friction and stick flags)."""
+    _check("y", y.shape[0], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check("latch", latch.shape[0], BALLC_N_LATCH)
+    _plane_index(plane)
+    out = np.empty(4)
+    cdef double[::1] o = out
+    cdef int status = ballc_stick_state(&y[0], &params[0], &latch[0], flags, plane, &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"stick state failed with C status {status}")
+    return out
+
+
+def remove_slip(const double[::1] y, const double[::1] params, int flags, int plane):
+    """The state with ``plane``'s slip velocity set to zero by a tangential impulse at
+    the contact point (for slip-to-stick transitions, where it is at rounding level)."""
+    _check("y", y.shape[0], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _plane_index(plane)
+    out = np.empty(BALLC_N_STATES)
+    cdef double[::1] o = out
+    cdef int status = ballc_remove_slip(&y[0], &params[0], flags, plane, &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"remove_slip failed with C status {status}")
     return out

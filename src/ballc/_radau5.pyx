@@ -25,10 +25,13 @@ cdef extern from "ballc_kernels.h":
 cdef extern from "_system.h":
     int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
     int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
+    int ballc_stick_state(const double *, const double *, const double *, int, int,
+                          double *) nogil
 
 cdef extern from "_radau5_solver.h":
     ctypedef int (*radau5_fun)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_jac)(void *, double, const double *, double *) noexcept nogil
+    ctypedef int (*radau5_event_fun)(void *, int, double, const double *, double *) noexcept nogil
     ctypedef struct radau5_lapack:
         pass
     ctypedef struct radau5_problem:
@@ -47,6 +50,8 @@ cdef extern from "_radau5_solver.h":
         int n_events
         const double *ev_coef
         const double *ev_offset
+        const int *ev_nonlinear
+        radau5_event_fun ev_fun
         const int *ev_terminal
         const int *ev_direction
         radau5_lapack lapack
@@ -74,6 +79,7 @@ ctypedef struct ball_ctx:
     const double *params
     const double *latch
     int flags
+    const int *event_plane   # per event: the plane of a stick-margin event (or -1)
 
 cdef int _ball_fun(void *ctx, double t, const double *y, double *f) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
@@ -82,6 +88,14 @@ cdef int _ball_fun(void *ctx, double t, const double *y, double *f) noexcept nog
 cdef int _ball_jac(void *ctx, double t, const double *y, double *jac) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
     return ballc_jacobian(y, c.params, c.latch, c.flags, jac)
+
+cdef int _ball_event(void *ctx, int e, double t, const double *y, double *g) noexcept nogil:
+    """The stick-to-slip margin mu N - |lambda| of the event's plane."""
+    cdef ball_ctx *c = <ball_ctx *>ctx
+    cdef double out[4]
+    cdef int status = ballc_stick_state(y, c.params, c.latch, c.flags, c.event_plane[e], out)
+    g[0] = out[3]
+    return status
 
 ctypedef struct linear_ctx:
     int n
@@ -148,22 +162,29 @@ def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
 
 
 def _event_arrays(events, n):
+    """Linear events (``coefficients``, ``offset``) and stick-margin events
+    (``stick_plane``, ``offset``: g = mu N - |lambda| + offset, evaluated in C)."""
     m = len(events)
     coef = np.zeros((max(m, 1), n))
     offset = np.zeros(max(m, 1))
     terminal = np.zeros(max(m, 1), dtype=np.intc)
     direction = np.zeros(max(m, 1), dtype=np.intc)
+    plane = np.full(max(m, 1), -1, dtype=np.intc)
     for k, e in enumerate(events):
-        for attr in ("coefficients", "offset"):
-            if not hasattr(e, attr):
-                raise TypeError(f"events[{k}] = {e!r} is not a linear event: radau5 needs "
-                                "`coefficients` and `offset` (g(y) = coefficients . y + offset)")
-        coef[k] = _vector(f"events[{k}].coefficients", e.coefficients, n)
-        offset[k] = float(e.offset)
+        if hasattr(e, "stick_plane"):
+            plane[k] = int(e.stick_plane)
+        else:
+            for attr in ("coefficients", "offset"):
+                if not hasattr(e, attr):
+                    raise TypeError(f"events[{k}] = {e!r} is neither a linear event "
+                                    "(`coefficients` and `offset`: g(y) = coefficients . y "
+                                    "+ offset) nor a stick-release event (`stick_plane`)")
+            coef[k] = _vector(f"events[{k}].coefficients", e.coefficients, n)
+        offset[k] = float(getattr(e, "offset", 0.0))
         terminal[k] = bool(getattr(e, "terminal", False))
         dirn = float(getattr(e, "direction", 0))
         direction[k] = (dirn > 0) - (dirn < 0)
-    return m, coef, offset, terminal, direction
+    return m, coef, offset, terminal, direction, plane
 
 
 cdef object _run(radau5_problem *p, int n, int m):
@@ -208,7 +229,8 @@ cdef object _run(radau5_problem *p, int n, int m):
 
 
 cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
-                   rtol, atol, max_step, t_eval, events, first_step, max_nfev):
+                   rtol, atol, max_step, t_eval, events, first_step, max_nfev,
+                   radau5_event_fun event_fun=NULL, int[::1] event_plane=None):
     cdef radau5_problem p
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
         raise ValueError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
@@ -217,10 +239,15 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     t0, t1, rtol, atol_v, max_step, t_eval, first = _options(
         n, t0, t1, rtol, atol, max_step, t_eval, first_step)
     y0 = _vector("y0", y0, n)
-    m, coef, offset, terminal, direction = _event_arrays(list(events or ()), n)
+    m, coef, offset, terminal, direction, plane = _event_arrays(list(events or ()), n)
+    if event_plane is not None:   # the system evaluates its own events: it reads the planes
+        np.asarray(event_plane)[:plane.size] = plane
+    elif np.any(plane[:m] >= 0):
+        raise TypeError("stick-margin events need ballc's system (solve_system)")
+    nonlinear = np.ascontiguousarray(plane >= 0, dtype=np.intc)
     cdef double[::1] y0v = y0, atolv = atol_v, offv = offset
     cdef double[:, ::1] coefv = coef
-    cdef int[::1] termv = terminal, dirv = direction
+    cdef int[::1] termv = terminal, dirv = direction, nlv = nonlinear
     cdef double[::1] tev
     p.n = n
     p.fun = fun
@@ -248,6 +275,8 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.ev_offset = &offv[0]
     p.ev_terminal = &termv[0]
     p.ev_direction = &dirv[0]
+    p.ev_nonlinear = &nlv[0]
+    p.ev_fun = event_fun
     return _run(&p, n, m)
 
 
@@ -257,7 +286,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
 
     ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
     ``_core.System``.  ``events``: objects with ``coefficients`` (N_STATES),
-    ``offset``, ``terminal`` and ``direction`` -- g(y) = coefficients . y + offset.
+    ``offset``, ``terminal`` and ``direction`` -- g(y) = coefficients . y + offset --
+    or with ``stick_plane`` (0 floor, 1 ceiling) instead of ``coefficients``: the
+    stick-to-slip margin mu N - |lambda| + offset of that plane, evaluated in C.
     Returns a solve_ivp-shaped OptimizeResult (t, y, t_events, y_events, status,
     message, success, nfev, njev, nlu) plus nstep and nreject.  ``max_nfev``: give
     up (status -1, with what was computed) after that many right-hand-side calls.
@@ -266,11 +297,13 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     params = _vector("params", params, BALLC_N_PARAMETERS)
     latch = _vector("latch", latch, BALLC_N_LATCH)
     cdef double[::1] pv = params, lv = latch
+    cdef int[::1] planes = np.full(max(len(events or ()), 1), -1, dtype=np.intc)
     ctx.params = &pv[0]
     ctx.latch = &lv[0]
     ctx.flags = flags
+    ctx.event_plane = &planes[0]
     return _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
-                  max_step, t_eval, events, first_step, max_nfev)
+                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes)
 
 
 def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),

@@ -67,7 +67,7 @@ typedef struct {
     double *y_new, *f_new, *scale, *Z0, *Znew, *W, *F, *dW, *tmp, *err, *ZE;
     cplx *ctmp;
     /* events */
-    double *g, *g_new, *roots;
+    double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */
     int *active, *count;
     size_t cap_out, cap_hits;
 } solver_t;
@@ -449,33 +449,59 @@ static int store_hit(solver_t *s, int event, double t, const double *y)
 
 /* ---- events ---- */
 
-/* g_e(y) = c . y + offset, as solve_ivp evaluates an event (no gating: the driver
- * keeps segments from starting on an event's zero; see simulate.contact_hysteresis). */
-static double event_value(const solver_t *s, int e, const double *y, const double *f)
+/* g_e(t, y): c . y + offset, or the system's event function + offset, as solve_ivp
+ * evaluates an event (no gating: the driver keeps segments from starting on an event's
+ * zero; see simulate.py).  NaN when the system cannot evaluate it. */
+static int is_nonlinear(const solver_t *s, int e)
 {
-    (void)f;
-    const double *c = s->p->ev_coef + (size_t)e * s->n;
+    return s->p->ev_nonlinear != NULL && s->p->ev_nonlinear[e];
+}
+
+static double event_value(const solver_t *s, int e, double t, const double *y)
+{
     double g = s->p->ev_offset[e];
+    if (is_nonlinear(s, e)) {
+        double v;
+        if (s->p->ev_fun == NULL || s->p->ev_fun(s->p->ctx, e, t, y, &v) != 0) return NAN;
+        return g + v;
+    }
+    const double *c = s->p->ev_coef + (size_t)e * s->n;
     for (int i = 0; i < s->n; i++) g += c[i] * y[i];
     return g;
 }
 
-/* g_e on the last step's dense output: a cubic in x = (t - t_old) / h. */
-typedef struct { double a[4], t_old, h; int direction; } cubic_t;
+/* A function of t whose root brentq finds. */
+typedef double (*scalar_fn)(void *ctx, double t);
 
-static double cubic_at(const cubic_t *q, double tt)
+/* A linear event on the last step's dense output: a cubic in x = (t - t_old) / h. */
+typedef struct { double a[4], t_old, h; } cubic_t;
+
+static double cubic_at(void *ctx, double tt)
 {
+    const cubic_t *q = ctx;
     double x = (tt - q->t_old) / q->h;
     return q->a[0] + x * (q->a[1] + x * (q->a[2] + x * q->a[3]));
 }
 
+/* A system event on the last step's dense output. */
+typedef struct { solver_t *s; int e; } dense_event_t;
+
+static void dense(const solver_t *s, double tt, double *out);
+
+static double dense_event_at(void *ctx, double tt)
+{
+    const dense_event_t *q = ctx;
+    dense(q->s, tt, q->s->ev_y);
+    return event_value(q->s, q->e, tt, q->s->ev_y);
+}
+
 /* scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c), xtol = rtol = 4 eps as in
  * solve_ivp's solve_event_equation. */
-static double brentq(const cubic_t *q, double xa, double xb)
+static double brentq(scalar_fn f, void *q, double xa, double xb)
 {
     const double xtol = 4 * EPS, rtol = 4 * EPS;
     double xpre = xa, xcur = xb, xblk = 0, fblk = 0, spre = 0, scur = 0;
-    double fpre = cubic_at(q, xpre), fcur = cubic_at(q, xcur);
+    double fpre = f(q, xpre), fcur = f(q, xcur);
     if (fpre == 0) return xpre;
     if (fcur == 0) return xcur;
     if (signbit(fpre) == signbit(fcur))   /* rounding at a bracket end: take the nearer */
@@ -516,20 +542,23 @@ static double brentq(const cubic_t *q, double xa, double xb)
         xpre = xcur;
         fpre = fcur;
         xcur += fabs(scur) > delta ? scur : (sbis > 0 ? delta : -delta);
-        fcur = cubic_at(q, xcur);
+        fcur = f(q, xcur);
     }
     return xcur;
 }
 
-static double event_root(const solver_t *s, int e)
+static double event_root(solver_t *s, int e)
 {
+    if (is_nonlinear(s, e)) {
+        dense_event_t q = {s, e};
+        return brentq(dense_event_at, &q, s->t_old, s->t);
+    }
     const double *c = s->p->ev_coef + (size_t)e * s->n;
-    cubic_t q = {{s->p->ev_offset[e], 0, 0, 0}, s->t_old, s->t - s->t_old,
-                 s->p->ev_direction[e]};
+    cubic_t q = {{s->p->ev_offset[e], 0, 0, 0}, s->t_old, s->t - s->t_old};
     for (int i = 0; i < s->n; i++) q.a[0] += c[i] * s->y_old[i];
     for (int i = 0; i < s->n; i++)
         for (int j = 0; j < 3; j++) q.a[j + 1] += c[i] * s->Q[3 * i + j];
-    return brentq(&q, s->t_old, s->t);
+    return brentq(cubic_at, &q, s->t_old, s->t);
 }
 
 /* ivp.find_active_events + handle_events after a step.  Returns 1 when a terminal
@@ -623,7 +652,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     size_t nd = (size_t)n * (1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1) /* y f y_old y_new f_new scale tmp err ZE */
          + (size_t)n * n * 2                                /* J, LU_real */
          + (size_t)n * 3 * 7                                /* Z Q Z0 Znew W F dW */
-         + (size_t)m * 3;                                   /* g g_new roots */
+         + (size_t)m * 3 + (size_t)n;                       /* g g_new roots, ev_y */
     double *dblock = calloc(nd, sizeof(double));
     cplx *cblock = calloc((size_t)n * n + n, sizeof(cplx));
     int *iblock = calloc(2 * (size_t)n + 2 * (size_t)m + 2, sizeof(int));
@@ -636,7 +665,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.J = d; d += n * n; s.LU_real = d; d += n * n;
     s.Z = d; d += 3 * n; s.Q = d; d += 3 * n; s.Z0 = d; d += 3 * n; s.Znew = d; d += 3 * n;
     s.W = d; d += 3 * n; s.F = d; d += 3 * n; s.dW = d; d += 3 * n;
-    s.g = d; d += m; s.g_new = d; d += m; s.roots = d; d += m;
+    s.g = d; d += m; s.g_new = d; d += m; s.roots = d; d += m; s.ev_y = d; d += n;
     s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n;
     s.piv_real = iblock; s.piv_complex = iblock + n;
     s.active = iblock + 2 * n; s.count = iblock + 2 * n + m;
@@ -653,7 +682,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         r->status = RADAU5_FAILED;
         goto done;
     }
-    for (int e = 0; e < m; e++) s.g[e] = event_value(&s, e, s.y, s.f);
+    for (int e = 0; e < m; e++) s.g[e] = event_value(&s, e, s.t, s.y);
     s.h_abs = p->first_step > 0 ? p->first_step : initial_step(&s);
     if (call_jac(&s, s.t, s.y) != 0) {
         snprintf(r->message, sizeof r->message,
@@ -686,7 +715,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         const double *y_out = s.y;
         int terminate = 0;
         if (m > 0) {
-            for (int e = 0; e < m; e++) s.g_new[e] = event_value(&s, e, s.y, s.f);
+            for (int e = 0; e < m; e++) s.g_new[e] = event_value(&s, e, s.t, s.y);
             terminate = handle_events(&s, &t_out);
             if (terminate < 0) goto oom;
             if (terminate) {

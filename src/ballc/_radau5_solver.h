@@ -8,7 +8,8 @@
  * Jacobian / LU reuse strategy and collocation-polynomial dense output.  The
  * event logic is solve_ivp's (find_active_events, handle_events, brentq with
  * xtol = rtol = 4 eps), for events that are linear functionals of the state,
- * g(y) = c . y + d: on one step g(t) is then a cubic in t.  Events are evaluated
+ * g(y) = c . y + d (on one step g(t) is then a cubic in t), and for events the
+ * system evaluates itself (a callback, evaluated on the dense output).  Events are evaluated
  * exactly as solve_ivp evaluates them (the driver keeps segments from starting on
  * an event's zero; see simulate.py).
  *
@@ -26,6 +27,9 @@
  * anything else when the function cannot be evaluated at (t, y). */
 typedef int (*radau5_fun)(void *ctx, double t, const double *y, double *f);
 typedef int (*radau5_jac)(void *ctx, double t, const double *y, double *jac);
+/* *g = value of the system-defined (non-linear) event ``e`` at (t, y), before its offset.
+ * Return 0 on success. */
+typedef int (*radau5_event_fun)(void *ctx, int e, double t, const double *y, double *g);
 
 typedef void (*radau5_dgetrf)(int *m, int *n, double *a, int *lda, int *ipiv, int *info);
 typedef void (*radau5_dgetrs)(char *trans, int *n, int *nrhs, double *a, int *lda,
@@ -56,9 +60,11 @@ typedef struct {
     long max_nfev;            /* > 0: give up (status RADAU5_FAILED) once nfev reaches it */
     const double *t_eval;     /* NULL: store every step; else n_eval times, sorted in */
     long n_eval;              /*   the direction of integration, within the interval */
-    int n_events;             /* events g_k(y) = coef[k*n:(k+1)*n] . y + offset[k] */
-    const double *ev_coef;
-    const double *ev_offset;
+    int n_events;             /* events g_k(y) = coef[k*n:(k+1)*n] . y + offset[k], or, */
+    const double *ev_coef;    /*   where ev_nonlinear[k] is nonzero, */
+    const double *ev_offset;  /*   g_k(t, y) = ev_fun(ctx, k, t, y) + offset[k] */
+    const int *ev_nonlinear;  /* may be NULL: all linear */
+    radau5_event_fun ev_fun;  /* may be NULL when no event is non-linear */
     const int *ev_terminal;   /* nonzero: stop at the first occurrence */
     const int *ev_direction;  /* +1 rising only, -1 falling only, 0 both */
     radau5_lapack lapack;

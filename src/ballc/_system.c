@@ -59,47 +59,102 @@ static int inputs_finite(const double *state, const double *params, const double
         && all_finite(latch, BALLC_N_LATCH);
 }
 
-/* Mass blocks (16) and forcing (6) of everything that acts under ``flags``; the rates
- * of the auxiliary states go to ``auxiliary`` (indexed by state, may be NULL). */
+/* Exact Coulomb mode of ``plane`` under ``flags``: 0 none, SLIP or STICK. */
+enum { MODE_NONE = 0, MODE_SLIP = 1, MODE_STICK = 2 };
+static int exact_mode(int flags, int plane)
+{
+    int friction = plane == 0 ? BALLC_FLOOR_FRICTION : BALLC_CEILING_FRICTION;
+    int slip = plane == 0 ? BALLC_FLOOR_SLIP : BALLC_CEILING_SLIP;
+    int stick = plane == 0 ? BALLC_FLOOR_STICK : BALLC_CEILING_STICK;
+    if (!(flags & friction)) return MODE_NONE;
+    if (flags & stick) return MODE_STICK;
+    if (flags & slip) return MODE_SLIP;
+    return MODE_NONE;
+}
+
+/* The slip kernel's outputs: u (2), du/dx (2 x NS), tangential force map G_t (6 x 2). */
+#define SLIP_U 0
+#define SLIP_DU 2
+#define SLIP_G (2 + 2 * NS)
+static const kernel_fn SLIP_KERNELS[BALLC_N_PLANES] = {ballc_floor_slip, ballc_ceiling_slip};
+
+/* What one evaluation of the equations yields besides the state derivative. */
+typedef struct {
+    double mass[BALLC_MASS_SIZE];
+    double contact_force[3 * BALLC_N_PLANES];   /* on the ball, per plane */
+    int mode[BALLC_N_PLANES];                   /* exact Coulomb mode per plane */
+    double load[BALLC_N_PLANES];                /* N: the friction share's normal force */
+    double slip[BALLC_N_PLANES][BALLC_FLOOR_SLIP_NOUT];
+    double e[BALLC_N_PLANES][2];                /* sliding: the force direction is -e */
+    double lambda[BALLC_N_PLANES][2];           /* sticking: the constraint force */
+} evaluation_t;
+
+/* Mass blocks and forcing of everything that acts under ``flags``; the rates of the
+ * auxiliary states go to ``xdot`` (indexed by state, may be NULL).  A plane in exact
+ * Coulomb mode gets its friction kernel's normal share (mu = 0) and, when sliding,
+ * the Coulomb force -mu N e; a sticking plane's constraint force is added later
+ * (it needs M). */
 static void assemble(const double *state, const double *params, const double *latch,
-                     int flags, double *mass, double *force, double *xdot)
+                     int flags, evaluation_t *ev, double *force, double *xdot)
 {
     double buf[BALLC_BALL_NOUT];
     double out[LAW_NOUT];
+    double normal_params[BALLC_N_PARAMETERS];
+    memcpy(normal_params, params, sizeof normal_params);
+    normal_params[BALLC_PARAMETER_FRICTION_COEFFICIENT] = 0.0;
     ballc_ball(state, params, NULL, buf);
-    memcpy(mass, buf, BALLC_MASS_SIZE * sizeof(double));
+    memcpy(ev->mass, buf, BALLC_MASS_SIZE * sizeof(double));
     memcpy(force, buf + BALLC_MASS_SIZE, NU * sizeof(double));
     if (flags & BALLC_WITH_OBSERVER) {
         ballc_observer(state, params, NULL, buf);
-        for (int i = 0; i < BALLC_MASS_SIZE; i++) mass[i] += buf[i];
+        for (int i = 0; i < BALLC_MASS_SIZE; i++) ev->mass[i] += buf[i];
         for (int i = 0; i < NU; i++) force[i] += buf[BALLC_MASS_SIZE + i];
     }
     if (xdot)
         for (int i = BALLC_N_MECHANICAL_STATES; i < NS; i++) xdot[i] = 0.0;
+    for (int i = 0; i < 3 * BALLC_N_PLANES; i++) ev->contact_force[i] = 0.0;
+    for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+        ev->mode[plane] = exact_mode(flags, plane);
+        ev->load[plane] = 0.0;
+    }
     for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
         if (!(flags & CONTACT_LAWS[k].flag)) continue;
         int plane = CONTACT_LAWS[k].plane, target[4];
-        CONTACT_LAWS[k].value(state, params, law_latch(latch, plane), out);
-        for (int i = 0; i < NU; i++) force[i] += out[i];
+        int exact = ev->mode[plane] != MODE_NONE && (CONTACT_LAWS[k].flag &
+                    (BALLC_FLOOR_FRICTION | BALLC_CEILING_FRICTION));
+        CONTACT_LAWS[k].value(state, exact ? normal_params : params,
+                              law_latch(latch, plane), out);
+        for (int i = 0; i < NU; i++) force[i] += out[BALLC_LAW_GENERALIZED_FORCE + i];
+        for (int i = 0; i < 3; i++) ev->contact_force[3 * plane + i] += out[BALLC_LAW_FORCE + i];
+        if (exact) ev->load[plane] = (plane == 0 ? 1.0 : -1.0) * out[BALLC_LAW_FORCE + 2];
         if (!xdot) continue;
         auxiliary_targets(plane, target);
         for (int i = 0; i < 4; i++) xdot[target[i]] += out[BALLC_LAW_DISSIPATION + i];
     }
-}
-
-int ballc_contact_forces(const double *state, const double *params, const double *latch,
-                         int flags, double *forces)
-{
-    double out[LAW_NOUT];
-    for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
-    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
-    for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
-        if (!(flags & CONTACT_LAWS[k].flag)) continue;
-        int plane = CONTACT_LAWS[k].plane;
-        CONTACT_LAWS[k].value(state, params, law_latch(latch, plane), out);
-        for (int i = 0; i < 3; i++) forces[3 * plane + i] += out[BALLC_LAW_FORCE + i];
+    const double mu = params[BALLC_PARAMETER_FRICTION_COEFFICIENT];
+    for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+        if (ev->mode[plane] == MODE_NONE) continue;
+        double *slip = ev->slip[plane];
+        SLIP_KERNELS[plane](state, params, NULL, slip);
+        if (ev->mode[plane] != MODE_SLIP) continue;
+        const double *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
+        double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = hypot(ux, uy);
+        double *e = ev->e[plane];
+        if (speed > 0) {
+            double sign = ux * d[0] + uy * d[1] < 0 ? -1.0 : 1.0;
+            e[0] = sign * ux / speed;
+            e[1] = sign * uy / speed;
+        } else {
+            e[0] = d[0];
+            e[1] = d[1];
+        }
+        double f[2] = {-mu * ev->load[plane] * e[0], -mu * ev->load[plane] * e[1]};
+        const double *G = slip + SLIP_G;
+        for (int i = 0; i < NU; i++) force[i] += G[2 * i] * f[0] + G[2 * i + 1] * f[1];
+        ev->contact_force[3 * plane] += f[0];
+        ev->contact_force[3 * plane + 1] += f[1];
+        if (xdot) xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -= f[0] * ux + f[1] * uy;
     }
-    return all_finite(forces, 3 * BALLC_N_PLANES) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 /* Factor S = J - B B^T / D. */
@@ -153,29 +208,146 @@ static void schur_solve(const schur_t *f, double *b)
         bv[j] = (bv[j] - (B[j]*w0 + B[3+j]*w1 + B[6+j]*w2)) / f->D;
 }
 
-static int accelerations(const double *state, const double *params, const double *latch,
-                         int flags, schur_t *factor, double *udot, double *xdot)
+/* Responses of a sticking plane: z_k = M^-1 G_t e_k (6 x 2, column k at z[k]) and the
+ * Delassus matrix W = (du/d speeds) z (2 x 2), inverted into Winv.  Returns
+ * BALLC_SINGULAR when W is not invertible. */
+static int stick_response(const schur_t *factor, const double *slip, double z[2][NU],
+                          double Winv[2][2])
 {
-    double mass[BALLC_MASS_SIZE];
-    assemble(state, params, latch, flags, mass, udot, xdot);
-    int status = schur_factor(mass, factor);
+    const double *G = slip + SLIP_G, *du = slip + SLIP_DU;
+    double W[2][2];
+    for (int k = 0; k < 2; k++) {
+        for (int i = 0; i < NU; i++) z[k][i] = G[2 * i + k];
+        schur_solve(factor, z[k]);
+        for (int r = 0; r < 2; r++) {
+            double s = 0;
+            for (int i = 0; i < NU; i++) s += du[r * NS + NQ + i] * z[k][i];
+            W[r][k] = s;
+        }
+    }
+    double det = W[0][0] * W[1][1] - W[0][1] * W[1][0];
+    if (!(fabs(det) > 0) || !isfinite(det)) return BALLC_SINGULAR;
+    Winv[0][0] = W[1][1] / det; Winv[0][1] = -W[0][1] / det;
+    Winv[1][0] = -W[1][0] / det; Winv[1][1] = W[0][0] / det;
+    return BALLC_OK;
+}
+
+/* udot (6) and the auxiliary rates.  A sticking plane's constraint force lambda makes
+ * du/dt = 0: lambda = -W^-1 (du/d speeds) udot_0, udot = udot_0 + z lambda.  (The
+ * planes are handled one after the other: both can only touch the ball at once when
+ * H < 2 r, which Scene rejects.) */
+static int accelerations(const double *state, const double *params, const double *latch,
+                         int flags, schur_t *factor, evaluation_t *ev, double *udot,
+                         double *xdot)
+{
+    assemble(state, params, latch, flags, ev, udot, xdot);
+    int status = schur_factor(ev->mass, factor);
     if (status != BALLC_OK) return status;
     schur_solve(factor, udot);
+    for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+        if (ev->mode[plane] != MODE_STICK) continue;
+        const double *slip = ev->slip[plane], *du = slip + SLIP_DU;
+        double z[2][NU], Winv[2][2], a0[2];
+        status = stick_response(factor, slip, z, Winv);
+        if (status != BALLC_OK) return status;
+        for (int r = 0; r < 2; r++) {
+            a0[r] = 0;
+            for (int i = 0; i < NU; i++) a0[r] += du[r * NS + NQ + i] * udot[i];
+        }
+        double *lambda = ev->lambda[plane];
+        lambda[0] = -(Winv[0][0] * a0[0] + Winv[0][1] * a0[1]);
+        lambda[1] = -(Winv[1][0] * a0[0] + Winv[1][1] * a0[1]);
+        for (int i = 0; i < NU; i++) udot[i] += z[0][i] * lambda[0] + z[1][i] * lambda[1];
+        ev->contact_force[3 * plane] += lambda[0];
+        ev->contact_force[3 * plane + 1] += lambda[1];
+        if (xdot)
+            xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -=
+                lambda[0] * slip[SLIP_U] + lambda[1] * slip[SLIP_U + 1];
+    }
     return all_finite(udot, NU) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+static int any_stick(int flags)
+{
+    return exact_mode(flags, 0) == MODE_STICK || exact_mode(flags, 1) == MODE_STICK;
 }
 
 int ballc_rhs(const double *state, const double *params, const double *latch,
               int flags, double *xdot)
 {
     schur_t factor;
+    evaluation_t ev;
     if (!inputs_finite(state, params, latch)) {
         for (int i = 0; i < NS; i++) xdot[i] = NAN;
         return BALLC_NOT_FINITE;
     }
     ballc_kinematics(state, params, NULL, xdot);
-    int status = accelerations(state, params, latch, flags, &factor, xdot + NQ, xdot);
+    int status = accelerations(state, params, latch, flags, &factor, &ev, xdot + NQ, xdot);
     if (status == BALLC_OK && !all_finite(xdot, NS)) status = BALLC_NOT_FINITE;
     return status;
+}
+
+int ballc_contact_forces(const double *state, const double *params, const double *latch,
+                         int flags, double *forces)
+{
+    schur_t factor;
+    evaluation_t ev;
+    double udot[NU];
+    for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
+    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+    if (status != BALLC_OK) return status;
+    memcpy(forces, ev.contact_force, sizeof ev.contact_force);
+    return all_finite(forces, 3 * BALLC_N_PLANES) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+int ballc_stick_state(const double *state, const double *params, const double *latch,
+                      int flags, int plane, double *out)
+{
+    schur_t factor;
+    evaluation_t ev;
+    double udot[NU];
+    for (int i = 0; i < 4; i++) out[i] = NAN;
+    if (plane < 0 || plane >= BALLC_N_PLANES || exact_mode(flags, plane) != MODE_STICK)
+        return BALLC_SINGULAR;
+    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+    if (status != BALLC_OK) return status;
+    out[0] = ev.lambda[plane][0];
+    out[1] = ev.lambda[plane][1];
+    out[2] = ev.load[plane];
+    out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]
+             - hypot(out[0], out[1]);
+    return all_finite(out, 4) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+int ballc_remove_slip(const double *state, const double *params, int flags, int plane,
+                      double *state_out)
+{
+    schur_t factor;
+    double mass[BALLC_MASS_SIZE], buf[BALLC_BALL_NOUT];
+    double slip[BALLC_FLOOR_SLIP_NOUT], z[2][NU], Winv[2][2];
+    memcpy(state_out, state, NS * sizeof(double));
+    if (plane < 0 || plane >= BALLC_N_PLANES) return BALLC_SINGULAR;
+    if (!all_finite(state, NS) || !all_finite(params, BALLC_N_PARAMETERS))
+        return BALLC_NOT_FINITE;
+    ballc_ball(state, params, NULL, buf);
+    memcpy(mass, buf, sizeof mass);
+    if (flags & BALLC_WITH_OBSERVER) {
+        ballc_observer(state, params, NULL, buf);
+        for (int i = 0; i < BALLC_MASS_SIZE; i++) mass[i] += buf[i];
+    }
+    int status = schur_factor(mass, &factor);
+    if (status != BALLC_OK) return status;
+    SLIP_KERNELS[plane](state, params, NULL, slip);
+    status = stick_response(&factor, slip, z, Winv);
+    if (status != BALLC_OK) return status;
+    const double *u = slip + SLIP_U;
+    double impulse[2] = {-(Winv[0][0] * u[0] + Winv[0][1] * u[1]),
+                         -(Winv[1][0] * u[0] + Winv[1][1] * u[1])};
+    for (int i = 0; i < NU; i++)
+        state_out[NQ + i] += z[0][i] * impulse[0] + z[1][i] * impulse[1];
+    return all_finite(state_out, NS) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 /* Add dF/dx (6 x 13) and d(M a)/dq (6 x 4) of one dynamics kernel family. */
@@ -188,18 +360,75 @@ static void add_dynamics_jac(kernel_fn kernel, const double *state, const double
     for (int i = 0; i < NU * 4; i++) dMa[i] += buf[NU * NS + i];
 }
 
+/* Forward-difference Jacobian of the whole right-hand side, for sticking planes
+ * (lambda depends on the state through M, the forcing and the Delassus matrix).
+ * Jacobians are rare (the integrator reuses them), so this costs little. */
+static int difference_jacobian(const double *state, const double *params, const double *latch,
+                               int flags, double *jac)
+{
+    double f0[NS], f1[NS], y[NS];
+    int status = ballc_rhs(state, params, latch, flags, f0);
+    if (status != BALLC_OK) return status;
+    memcpy(y, state, sizeof y);
+    for (int j = 0; j < NS; j++) {
+        y[j] = state[j] + 1.4901161193847656e-08 * fmax(1.0, fabs(state[j]));
+        double h = y[j] - state[j];
+        status = ballc_rhs(y, params, latch, flags, f1);
+        y[j] = state[j];
+        if (status != BALLC_OK) return status;
+        for (int i = 0; i < NS; i++) jac[i * NS + j] = (f1[i] - f0[i]) / h;
+    }
+    return all_finite(jac, NS * NS) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+/* Add the sliding Coulomb force's derivatives: F_t = -mu N e(u), with
+ * de/du = sign (I - e e^T) / |u| (sign: e's orientation along the latched direction),
+ * and those of the tangential dissipation rate mu N (e . u). */
+static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const double *latch,
+                         const double *law_jac, double *dF, double *jac)
+{
+    const double *slip = ev->slip[plane], *du = slip + SLIP_DU, *G = slip + SLIP_G;
+    const double *e = ev->e[plane], *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
+    double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = hypot(ux, uy);
+    double N = ev->load[plane], normal = plane == 0 ? 1.0 : -1.0;
+    double de[2][2] = {{0, 0}, {0, 0}};
+    if (speed > 0) {
+        double sign = ux * d[0] + uy * d[1] < 0 ? -1.0 : 1.0;
+        for (int a = 0; a < 2; a++)
+            for (int b = 0; b < 2; b++)
+                de[a][b] = sign * ((a == b) - e[a] * e[b]) / speed;
+    }
+    double eu = e[0] * ux + e[1] * uy;
+    for (int j = 0; j < NS; j++) {
+        double dN = normal * law_jac[(BALLC_LAW_FORCE + 2) * NS + j];
+        double du0 = du[j], du1 = du[NS + j];
+        double df[2];
+        for (int a = 0; a < 2; a++)
+            df[a] = -mu * (e[a] * dN + N * (de[a][0] * du0 + de[a][1] * du1));
+        for (int i = 0; i < NU; i++) dF[i * NS + j] += G[2 * i] * df[0] + G[2 * i + 1] * df[1];
+        jac[BALLC_STATE_DISSIPATED_TANGENTIAL * NS + j] +=
+            mu * (eu * dN + N * (e[0] * du0 + e[1] * du1));
+    }
+}
+
 int ballc_jacobian(const double *state, const double *params, const double *latch,
                    int flags, double *jac)
 {
     schur_t factor;
+    evaluation_t ev;
     double udot[NU];
     if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
-    int status = accelerations(state, params, latch, flags, &factor, udot, NULL);
+    if (any_stick(flags)) return difference_jacobian(state, params, latch, flags, jac);
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
 
     for (int i = 0; i < NS * NS; i++) jac[i] = 0.0;
     ballc_kinematics_jac(state, params, NULL, jac);   /* rows 0..6 */
 
+    double normal_params[BALLC_N_PARAMETERS];
+    memcpy(normal_params, params, sizeof normal_params);
+    normal_params[BALLC_PARAMETER_FRICTION_COEFFICIENT] = 0.0;
+    const double mu = params[BALLC_PARAMETER_FRICTION_COEFFICIENT];
     double dF[NU * NS] = {0}, dMa[NU * 4] = {0}, buf[LAW_NOUT * NS];
     add_dynamics_jac(ballc_ball_jac, state, params, udot, dF, dMa);
     if (flags & BALLC_WITH_OBSERVER)
@@ -207,12 +436,15 @@ int ballc_jacobian(const double *state, const double *params, const double *latc
     for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
         if (!(flags & CONTACT_LAWS[k].flag)) continue;
         int plane = CONTACT_LAWS[k].plane, target[4];
-        CONTACT_LAWS[k].jac(state, params, law_latch(latch, plane), buf);
-        for (int i = 0; i < NU * NS; i++) dF[i] += buf[i];
+        int exact = ev.mode[plane] == MODE_SLIP && (CONTACT_LAWS[k].flag &
+                    (BALLC_FLOOR_FRICTION | BALLC_CEILING_FRICTION));
+        CONTACT_LAWS[k].jac(state, exact ? normal_params : params, law_latch(latch, plane), buf);
+        for (int i = 0; i < NU * NS; i++) dF[i] += buf[BALLC_LAW_GENERALIZED_FORCE * NS + i];
         auxiliary_targets(plane, target);
         for (int i = 0; i < 4; i++)
             for (int j = 0; j < NS; j++)
                 jac[target[i] * NS + j] += buf[(BALLC_LAW_DISSIPATION + i) * NS + j];
+        if (exact) add_slip_jac(&ev, plane, mu, latch, buf, dF, jac);
     }
     /* d udot / dx_j = M^-1 (dF/dx_j - d(M udot)/dx_j); M depends on q only. */
     for (int j = 0; j < NS; j++) {

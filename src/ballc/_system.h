@@ -18,7 +18,19 @@ enum {
     BALLC_CEILING_FRICTION = 8,
     BALLC_CEILING_DIGIN = 16,
     BALLC_FLOOR_COMPLIANT = 32,
-    BALLC_CEILING_COMPLIANT = 64
+    BALLC_CEILING_COMPLIANT = 64,
+    /* Exact (event-driven) Coulomb friction, with the plane's FRICTION flag: the friction
+     * kernel then contributes its normal share only, and the tangential force is
+     * SLIP: -mu N e, e the unit slip velocity (oriented along the latched slip direction
+     *       d, so that it continues smoothly through u . d = 0, where the driver's
+     *       slip-to-stick event sits; e = d at zero slip), N the friction share's
+     *       normal force;
+     * STICK: the constraint force lambda that holds the slip velocity u constant
+     *       (du/dt = 0), from the equations of motion. */
+    BALLC_FLOOR_SLIP = 128,
+    BALLC_CEILING_SLIP = 256,
+    BALLC_FLOOR_STICK = 512,
+    BALLC_CEILING_STICK = 1024
 };
 
 /* Sum of the contact forces on the ball, per plane (floor x y z, ceiling x y z). */
@@ -26,7 +38,7 @@ int ballc_contact_forces(const double *state, const double *params, const double
                          int flags, double *forces);
 
 /* Return codes. */
-enum { BALLC_OK = 0, BALLC_NOT_POSITIVE_DEFINITE = 1, BALLC_NOT_FINITE = 2 };
+enum { BALLC_OK = 0, BALLC_NOT_POSITIVE_DEFINITE = 1, BALLC_NOT_FINITE = 2, BALLC_SINGULAR = 3 };
 
 /* xdot (BALLC_N_STATES) = f(state); latch holds BALLC_N_LATCH values (floor, ceiling).
  * The auxiliary states (dissipated work, tangential deflections) get the rates of the
@@ -37,5 +49,18 @@ int ballc_rhs(const double *state, const double *params, const double *latch,
 /* jac (BALLC_N_STATES^2, row-major) = d f / d state. */
 int ballc_jacobian(const double *state, const double *params, const double *latch,
                    int flags, double *jac);
+
+/* Stick state of ``plane`` (0 floor, 1 ceiling) under ``flags`` (which must hold that
+ * plane's FRICTION and STICK flags): out = [lambda_x, lambda_y, N, mu N - |lambda|],
+ * the constraint force that keeps the slip velocity constant, the friction share's
+ * normal force and the margin to the Coulomb cone (the stick-to-slip event). */
+int ballc_stick_state(const double *state, const double *params, const double *latch,
+                      int flags, int plane, double *out);
+
+/* state_out = state with the slip velocity of ``plane`` set to zero by a tangential
+ * impulse at the contact point (the impulse P = -W^-1 u, W the 2x2 Delassus matrix);
+ * used at slip-to-stick transitions, where |u| is at rounding level. */
+int ballc_remove_slip(const double *state, const double *params, int flags, int plane,
+                      double *state_out);
 
 #endif

@@ -42,6 +42,8 @@ def _contact_arrays(contacts) -> dict:
         values = [getattr(c, name) for c in contacts]
         if name == "plane":
             arrays[name] = np.array(values, dtype=str)
+        elif name == "transitions":   # variable length: one JSON text per contact
+            arrays[name] = np.array([json.dumps(v) for v in values], dtype=str)
         elif values and np.ndim(values[0]) == 1:
             arrays[name] = np.array(values, dtype=float).reshape(len(values), -1)
         else:
@@ -58,6 +60,8 @@ def _contacts_from(arrays: dict) -> list:
             value = arrays[name][i]
             if name == "plane":
                 values[name] = str(value)
+            elif name == "transitions":
+                values[name] = [(float(t), str(mode)) for t, mode in json.loads(str(value))]
             elif np.ndim(value) == 1:
                 values[name] = np.array(value, dtype=float)
             else:

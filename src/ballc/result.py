@@ -37,6 +37,8 @@ class Contact:
     energy_lost_tangential: float = np.nan  # J, dissipated by the tangential force
     time_sticking: float = np.nan          # s, |F_t| below the Coulomb cap mu F_n
     time_slipping: float = np.nan          # s, |F_t| at the cap
+    #: exact Coulomb friction: [(t, "slip" or "stick")], the start of each phase (s)
+    transitions: list = field(default_factory=list)
 
     @property
     def duration(self) -> float:

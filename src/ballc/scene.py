@@ -23,7 +23,7 @@ mixture                            mixtur          1            0.375
 tangential_model                   -               -            "mixture"
 friction_regularization_speed      (1e-10 in the   m/s          1e-10
                                    seed's code)
-friction_regularization            -               -            "max" (or "smooth")
+friction_regularization            -               -            "exact" (or "max", "smooth")
 tangential_stiffness_ratio         -               1            Mindlin (compliant)
 position (centre)                  m1, m2, m3      m            (0, 0, 5)
 velocity (centre)                  um1, um2, um3   m/s          (-5, 5, -25)
@@ -36,9 +36,13 @@ angular_velocity (inertial comps)  u1, u2, u3      rad/s        (0, 0, 0)
 (ballc's tangential-compliance model: an elastic tangential spring of stiffness
 ``tangential_stiffness_ratio`` times the normal contact stiffness, damped like the
 normal force, capped at mu F_n; default ratio: Mindlin's, from the Poisson ratios
-and moduli).  ``friction_regularization`` is "max" (the seed's
+and moduli).  ``friction_regularization`` is "exact" (Coulomb's law itself, the
+limit v_s -> 0 of the seed's: stick and slip are separate modes, their transitions
+integrator events; see ballc.stickslip), "max" (the seed's literal
 v_t / max(|v_t|, v_s)) or "smooth" (v_t / sqrt(|v_t|^2 + v_s^2)), v_s being
-``friction_regularization_speed``.
+``friction_regularization_speed`` (used by "max" and "smooth" only).
+A scene may start in contact with a plane (0 < z < H): see simulate's notes on what
+such a start latches.
 The seed's latched values rhodtu, rhodto, ru1..3, ro1..3 are not parameters: ballc
 latches them itself at each contact start.
 """
@@ -55,7 +59,7 @@ from . import _core
 from .orientation import quaternion_from_angles_123
 
 TANGENTIAL_MODELS = ("mixture", "friction", "dig-in", "compliant")
-FRICTION_REGULARIZATIONS = ("max", "smooth")
+FRICTION_REGULARIZATIONS = ("exact", "max", "smooth")
 
 #: Scene field -> seed symbol(s).
 SEED_SYMBOLS = {
@@ -99,7 +103,7 @@ class Scene:
     mixture: float = 0.375
     tangential_model: str = "mixture"
     friction_regularization_speed: float = 1e-10
-    friction_regularization: str = "max"
+    friction_regularization: str = "exact"
     tangential_stiffness_ratio: float | None = None
     position: tuple = (0.0, 0.0, 5.0)
     velocity: tuple = (-5.0, 5.0, -25.0)
@@ -330,7 +334,7 @@ def _validate(s: Scene) -> None:
         fail("observer_position", s.observer_position,
              "the observer must lie strictly inside the ball (alpha^2 + beta^2 + gamma^2 < 1)")
     z = s.position[2]
-    if not s.radius <= z <= s.ceiling_height - s.radius:
-        fail("position", s.position, f"the ball must start clear of both planes: "
-             f"{s.radius} <= z <= {s.ceiling_height - s.radius}")
+    if not 0 < z < s.ceiling_height:
+        fail("position", s.position, f"the centre must start between the planes, less than "
+             f"one radius deep in either: 0 < z < {s.ceiling_height}")
 

@@ -14,7 +14,7 @@ import sys
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import _core, _radau5
+from . import _core, _radau5, stickslip
 from .result import Contact, Result
 from .scene import Scene, SceneError
 
@@ -115,8 +115,15 @@ def contact_threshold(scene, plane, rho0, entering):
     return max(base, far_side + base)
 
 
-def _segment_events(scene, in_contact, y0):
-    """Events of one segment starting at state y0: [(kind, plane, LinearEvent)]."""
+def _segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0):
+    """Events of one segment starting at state y0: [(kind, plane, event)].
+
+    ``coulomb``: each plane's exact-Coulomb mode ("slip", "stick" or None).  A sliding
+    plane stops when u . d (d its latched slip direction) falls through zero; a
+    sticking plane releases when |lambda| reaches mu N.  Both sit a rounding-level
+    margin past their zero, so that a segment starting on it (slip from rest, a stick
+    that starts at the cone) does not fire at once.
+    """
     events = []
     for plane in PLANES:
         rho = _penetration(plane, scene)
@@ -131,10 +138,22 @@ def _segment_events(scene, in_contact, y0):
         else:
             threshold = contact_threshold(scene, plane, rho0, entering=True)
             events.append(("enter", plane, rho.shifted(-threshold, True, 1)))
+        mode = coulomb[plane] if coulomb else None
+        if mode == "slip":
+            k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE
+            direction = latch[k + stickslip._SLIP_DIRECTION:k + stickslip._SLIP_DIRECTION + 2]
+            margin = 4 * np.spacing(stickslip.speed_scale(scene, y0))
+            events.append(("stop", plane, LinearEvent(
+                stickslip.slip_stop_coefficients(params, plane, direction), margin,
+                True, -1)))
+        elif mode == "stick":
+            load = _core.stick_state(y0, params, latch, flags, PLANES.index(plane))[2]
+            events.append(("release", plane, stickslip.StickRelease(
+                plane, params, latch, flags, stickslip.force_scale(scene, load))))
     return events
 
 
-def _flags(scene, in_contact):
+def _flags(scene, in_contact, coulomb=None):
     flags = _core.FLAGS["observer"] if scene.observer_mass != 0 else 0
     mixture = scene.effective_mixture
     for plane in PLANES:
@@ -147,14 +166,28 @@ def _flags(scene, in_contact):
             flags |= _core.FLAGS[f"{plane}_friction"]
         if mixture > 0:
             flags |= _core.FLAGS[f"{plane}_digin"]
+        if coulomb:
+            flags |= stickslip.mode_flags(plane, coulomb[plane])
     return flags
 
 
-def _latch_values(y, params, plane):
-    """(rhodot^-, unit dig-in direction) of ``plane`` at state y."""
+def _latch_values(y, params, plane, scene=None):
+    """(rhodot^-, unit dig-in direction) of ``plane`` at state y.
+
+    At a contact start rho = 0 and rhodot^- is the penetration rate.  A scene that
+    starts in contact (rho > 0) latches the rate at which an elastic (Hertz) approach
+    would have arrived at its present penetration and rate:
+    rhodot^- = sqrt(rhodot^2 + 4/5 k0 rho^(5/2) / m_total), from the energy balance
+    1/2 m rhodot^-^2 = 1/2 m rhodot^2 + 2/5 k0 rho^(5/2).  (A ball resting at its
+    static penetration thus has the damping it would have after a gentle landing,
+    not the infinite damping of rhodot^- = 0.)
+    """
     kin = _core.contact_kinematics(np.ascontiguousarray(y[None, :]), params)[0]
     k = PLANES.index(plane) * _KIN_PER_PLANE
-    rate, velocity = kin[k + 1], kin[k + 2:k + 5]
+    rho, rate, velocity = kin[k], kin[k + 1], kin[k + 2:k + 5]
+    if scene is not None and rho > 0:
+        stored = 0.8 * scene.hertz_stiffness * rho ** 2.5 / (scene.mass + scene.observer_mass)
+        rate = math.sqrt(rate * rate + stored)
     speed = np.linalg.norm(velocity)
     if speed > 0:
         direction = velocity / speed
@@ -184,6 +217,9 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
     budget = [_call_budget(system, max_nfev)] if max_nfev is not None else []
     sol = solve_ivp(system, (t0, t1), y0, method=method, rtol=rtol, atol=atol,
                     t_eval=t_eval, events=list(events) + budget, max_step=max_step, **options)
+    # solve_ivp leaves t and y as empty lists when no t_eval point fell in the segment
+    sol.t = np.asarray(sol.t, dtype=float)
+    sol.y = np.asarray(sol.y, dtype=float).reshape(len(y0), sol.t.size)
     if budget:
         if len(sol.t_events[-1]):
             sol.status = -1
@@ -327,10 +363,57 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     latch = np.zeros(_core.N_LATCH)
     y = scene.initial_state()
     t = 0.0
+    exact = stickslip.uses_exact_coulomb(scene)
     in_contact = {plane: False for plane in PLANES}
+    coulomb: dict[str, str | None] = {plane: None for plane in PLANES}
+    relatches = {plane: 0 for plane in PLANES}
     open_contacts: dict[str, Contact] = {}
     dissipated_at_start: dict[str, np.ndarray] = {}
     contacts: list[Contact] = []
+
+    def begin_contact(plane, y):
+        """Latch the contact's values at state y; returns the (possibly projected) state."""
+        rate, direction = _latch_values(y, params, plane, scene)
+        k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE
+        latch[k] = rate
+        latch[k + 1:k + 4] = direction
+        y[_DEFLECTION[plane]] = 0.0      # the tangential spring starts relaxed
+        in_contact[plane] = True
+        contact = Contact(plane=plane, t_start=t, velocity_before=y[_V:_V + 3].copy(),
+                          angular_velocity_before=y[_OMEGA:_OMEGA + 3].copy(),
+                          penetration_rate_at_impact=rate, digin_direction=direction)
+        _record_depth(contact, _penetration(plane, scene)(0, y), y)
+        open_contacts[plane] = contact
+        contacts.append(contact)
+        dissipated_at_start[plane] = y[_DISSIPATED].copy()
+        relatches[plane] = 0
+        if exact:
+            y = start_slip_or_settle(plane, y)
+        return y
+
+    def start_slip_or_settle(plane, y):
+        """At a contact start or a stop event: slip on along u when |u| is not at rest,
+        else settle (stick, or slip from rest along -lambda)."""
+        u = stickslip.slip_velocity(params, plane, y)
+        speed = float(np.hypot(*u))
+        at_rest = speed <= stickslip.SLIP_AT_REST * stickslip.speed_scale(scene, y)
+        if not at_rest and relatches[plane] < stickslip.MAX_RELATCH:
+            mode, direction = "slip", u / speed
+        else:
+            base = _flags(scene, in_contact)
+            mode, direction, y = stickslip.settle(scene, params, latch, base, plane, y)
+        set_mode(plane, mode, direction)
+        return y
+
+    def set_mode(plane, mode, direction=None):
+        coulomb[plane] = mode
+        if direction is not None:
+            stickslip.set_slip_direction(latch, plane, direction)
+        open_contacts[plane].transitions.append((t, mode))
+
+    for plane in PLANES:   # a scene may start in contact (issue 9): latch as documented
+        if _penetration(plane, scene)(0.0, y) > 0:
+            y = begin_contact(plane, y)
     ts, ys = [np.array([t])], [y[:, None]]
     if t_eval is not None:
         keep = t_eval == 0.0
@@ -338,8 +421,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     # Per stored sample: the flags and latched values of the segment that computed it,
     # so outputs that need the right-hand side (the observer's acceleration) can
     # re-evaluate it exactly as integrated.  Same shapes as ts/ys (one column per sample).
-    flag_columns = [np.full(ts[0].size, _flags(scene, in_contact), dtype=np.int32)]
-    latch_columns = [np.zeros((_core.N_LATCH, ts[0].size))]
+    flag_columns = [np.full(ts[0].size, _flags(scene, in_contact, coulomb), dtype=np.int32)]
+    latch_columns = [np.repeat(latch[:, None], ts[0].size, axis=1)]
     bar = _progress_bar(progress, t_end)
     nfev = njev = nlu = 0
     status, message = 0, "The solver successfully reached the end of the integration interval."
@@ -347,8 +430,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     while t < t_end:
         if bar is not None:
             bar.update(t - bar.n)
-        system = _core.System(params, latch, _flags(scene, in_contact))
-        events = _segment_events(scene, in_contact, y)
+        flags = _flags(scene, in_contact, coulomb)
+        system = _core.System(params, latch, flags)
+        events = _segment_events(scene, in_contact, y, coulomb, params, latch, flags)
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > t) & (t_eval <= t_end)]
@@ -387,21 +471,20 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         y = np.array(sol.y_events[index][-1])
         y[_QUATERNION] /= np.linalg.norm(y[_QUATERNION])
         if kind == "enter":
-            rate, direction = _latch_values(y, params, plane)
-            k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE
-            latch[k] = rate
-            latch[k + 1:k + 4] = direction
-            y[_DEFLECTION[plane]] = 0.0      # the tangential spring starts relaxed
-            in_contact[plane] = True
-            contact = Contact(plane=plane, t_start=t, velocity_before=y[_V:_V + 3].copy(),
-                              angular_velocity_before=y[_OMEGA:_OMEGA + 3].copy(),
-                              penetration_rate_at_impact=rate, digin_direction=direction)
-            _record_depth(contact, 0.0, y)
-            open_contacts[plane] = contact
-            contacts.append(contact)
-            dissipated_at_start[plane] = y[_DISSIPATED].copy()
+            y = begin_contact(plane, y)
+        elif kind == "stop":
+            relatches[plane] += 1
+            y = start_slip_or_settle(plane, y)
+        elif kind == "release":
+            stick_flags = _flags(scene, in_contact, coulomb)
+            lam = _core.stick_state(y, params, latch, stick_flags, PLANES.index(plane))[:2]
+            size = float(np.hypot(*lam))
+            direction = -lam / size if size > 0 else latch_slip_direction(latch, plane)
+            y = _core.remove_slip(y, params, _flags(scene, in_contact), PLANES.index(plane))
+            set_mode(plane, "slip", direction)
         elif kind == "leave":
             in_contact[plane] = False
+            coulomb[plane] = None
             contact = open_contacts.pop(plane)
             contact.t_end = t
             contact.velocity_after = y[_V:_V + 3].copy()
@@ -448,6 +531,11 @@ def _balance_warning(result, rtol):
             f"drifted by {drift:.3g} J ({drift / scale:.2g} of the initial energy): the "
             "integration is not accurate at this tolerance, so neither is this result; "
             "tighten rtol/atol.")
+
+
+def latch_slip_direction(latch, plane):
+    k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE + stickslip._SLIP_DIRECTION
+    return np.array(latch[k:k + 2])
 
 
 def _record_depth(contact, depth, y):

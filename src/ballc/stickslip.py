@@ -1,0 +1,124 @@
+"""Exact Coulomb friction as events: the slip and stick modes of a contact.
+
+With ``friction_regularization="exact"`` (the default), a contact with a Coulomb part
+(the friction model, and the friction share 1 - mixture of the mixture) alternates two
+kinds of smooth segment instead of integrating the seed's regularised law
+``mu F_n u / max(|u|, v_s)``, whose viscous core (time constant ~ m v_s / (mu F_n),
+about 1e-12 s) makes loose tolerances crawl and chatter:
+
+* **slip**: F_t = -mu N u/|u| (N the friction share's normal force).  The direction
+  is oriented along the slip direction ``d`` latched at the segment start, so the law
+  continues smoothly through u . d = 0, where the *stop* event sits (u . d is linear
+  in the state; when u turns by 90 degrees without stopping, ``d`` is re-latched).
+* **stick**: u held constant (at zero) by a tangential constraint force lambda
+  computed in C from the equations of motion (a 2x2 Delassus solve).  Its *release*
+  event is mu N - |lambda| = 0 (evaluated in C by radau5 and through ``_core`` by
+  scipy's methods); the slip that follows starts along -lambda, so the friction force
+  is continuous.
+
+The seed's law is the limit v_s -> 0 of this one.  Contact start and end close either
+mode.  This module holds the decisions at the mode boundaries; the driver
+(simulate.py) holds the segment loop.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+
+PLANES = ("floor", "ceiling")
+_STATE = _core.STATE_INDEX
+_OMEGA, _V = _STATE["omega_x"], _STATE["vx"]
+_LATCH = {name: i for i, name in enumerate(_core.LATCH_NAMES[:_core.N_LATCH_PER_PLANE])}
+_SLIP_DIRECTION = _LATCH["floor_slip_direction_x"]
+
+#: A slip speed below SLIP_AT_REST * (|v| + r |omega|) at a stop event counts as zero:
+#: the state is then projected onto u = 0 (an impulse of that size) and the contact
+#: sticks or restarts slipping.  Above it the slip direction has only turned: re-latch.
+SLIP_AT_REST = 1e-11
+
+#: At most this many re-latches of the slip direction per contact before a stop is
+#: treated as at rest (a slip direction spiralling into zero would otherwise need ever
+#: shorter segments).
+MAX_RELATCH = 50
+
+
+def uses_exact_coulomb(scene) -> bool:
+    """Whether ``scene``'s contacts have a Coulomb part integrated as stick/slip events."""
+    return (scene.friction_regularization == "exact"
+            and scene.tangential_model in ("friction", "mixture")
+            and scene.effective_mixture < 1 and scene.friction_coefficient > 0)
+
+
+def mode_flags(plane: str, mode: str | None) -> int:
+    """The C flags of a plane's Coulomb mode ("slip", "stick" or None)."""
+    return _core.FLAGS[f"{plane}_{mode}"] if mode else 0
+
+
+def set_slip_direction(latch: np.ndarray, plane: str, direction) -> None:
+    k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE + _SLIP_DIRECTION
+    latch[k:k + 2] = direction
+
+
+def speed_scale(scene, y) -> float:
+    """|v| + r |omega| (m/s): the scale slip speeds are compared with."""
+    return float(np.linalg.norm(y[_V:_V + 3]) + scene.radius * np.linalg.norm(
+        y[_OMEGA:_OMEGA + 3])) + 1e-300
+
+
+def force_scale(scene, load) -> float:
+    """A force (N) at rounding level of the stick force: 64 eps of weight + load."""
+    weight = (scene.mass + scene.observer_mass) * abs(scene.gravity)
+    return 64 * np.finfo(float).eps * (weight + abs(load))
+
+
+class StickRelease:
+    """The stick-to-slip event of ``plane``: g = mu N - |lambda| + offset (N).
+
+    Callable like a solve_ivp event (evaluated through ``_core``); radau5 reads
+    ``stick_plane`` and ``offset`` and evaluates it in C.
+    """
+
+    __slots__ = ("stick_plane", "offset", "terminal", "direction", "_params", "_latch",
+                 "_flags")
+
+    def __init__(self, plane: str, params, latch, flags: int, offset: float):
+        self.stick_plane = PLANES.index(plane)
+        self.offset = float(offset)
+        self.terminal = True
+        self.direction = -1
+        self._params = np.ascontiguousarray(params, dtype=float)
+        self._latch = np.array(latch, dtype=float)
+        self._flags = int(flags)
+
+    def __call__(self, t, y):
+        y = np.ascontiguousarray(y, dtype=float)
+        return float(_core.stick_state(y, self._params, self._latch, self._flags,
+                                       self.stick_plane)[3]) + self.offset
+
+    def __repr__(self):
+        return (f"StickRelease({PLANES[self.stick_plane]}: mu N - |lambda| + "
+                f"{self.offset:g})")
+
+
+def slip_stop_coefficients(params, plane: str, direction) -> np.ndarray:
+    """Coefficients c of the stop event u . d = c . y (u is linear in the state)."""
+    return np.asarray(direction, dtype=float) @ _core.slip_map(params, PLANES.index(plane))
+
+
+def slip_velocity(params, plane: str, y) -> np.ndarray:
+    return _core.slip_map(params, PLANES.index(plane)) @ y
+
+
+def settle(scene, params, latch, base_flags: int, plane: str, y):
+    """The mode a contact takes on at zero slip: ("stick", None, y0) when the constraint
+    force that holds it lies in the friction cone, else ("slip", direction, y0) along
+    -lambda.  y0 is y with the slip velocity projected to exactly zero."""
+    index = PLANES.index(plane)
+    y0 = _core.remove_slip(np.ascontiguousarray(y, dtype=float), params, base_flags, index)
+    stick_flags = base_flags | mode_flags(plane, "stick")
+    lam_x, lam_y, load, margin = _core.stick_state(y0, params, latch, stick_flags, index)
+    size = float(np.hypot(lam_x, lam_y))
+    if margin >= -force_scale(scene, load) or size == 0:
+        return "stick", None, y0
+    return "slip", -np.array([lam_x, lam_y]) / size, y0
