@@ -10,11 +10,11 @@ core = Extension(
 )
 
 # The compiled Radau IIA integrator; it calls ballc_rhs / ballc_jacobian directly, so it
-# links its own copy of the system and kernels.  LAPACK comes from scipy at run time.
+# links its own copy of the system and kernels.  Its linear algebra is _lu.c (no LAPACK).
 radau5 = Extension(
     "ballc._radau5",
-    sources=["src/ballc/_radau5.pyx", "src/ballc/_radau5_solver.c", "src/ballc/_system.c",
-             "generated/ballc_kernels.c"],
+    sources=["src/ballc/_radau5.pyx", "src/ballc/_radau5_solver.c", "src/ballc/_lu.c",
+             "src/ballc/_system.c", "generated/ballc_kernels.c"],
     include_dirs=["generated", "src/ballc"],
     extra_compile_args=["-O2", "-std=c99"],
 )

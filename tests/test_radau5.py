@@ -1,8 +1,8 @@
 """radau5 (ballc's compiled Radau IIA) against scipy's Radau, and against exact solutions.
 
 radau5 is a port of scipy's Radau: same method, same error control, same event
-logic.  The two differ only by floating-point rounding (summation order, LAPACK
-called directly instead of through lu_solve), so at rtol = atol = 1e-12 they
+logic.  The two differ only by floating-point rounding (summation order, ballc's
+own LU (_lu.c) instead of LAPACK's through lu_solve), so at rtol = atol = 1e-12 they
 take (nearly) the same steps.  What the tolerances below allow:
 
 * Smooth segments: both solutions are within a few local tolerances of the true

@@ -2,13 +2,13 @@
 """Bridge to the compiled Radau IIA (order 5) integrator in ``_radau5_solver.c``.
 
 Private: use ``ballc.simulate(..., method="radau5")``.  This module checks and
-converts arguments, hands LAPACK's addresses (from ``scipy.linalg.cython_lapack``)
-and a C right-hand side to ``radau5_solve`` and turns its buffers into arrays.
-The whole integration runs in C without the GIL: no Python per step.
+converts arguments, hands a C right-hand side to ``radau5_solve`` and turns its
+buffers into arrays.  The whole integration runs in C without the GIL: no Python
+per step; the Newton systems are solved by ballc's own LU (``_lu.c``), no LAPACK.
 
 ``solve_system`` integrates ballc's equations (``ballc_rhs`` / ``ballc_jacobian``);
 ``solve_linear`` integrates y' = A y (a generic entry point, used to test the
-integrator against the matrix exponential).
+integrator against the matrix exponential); ``_lu_solve`` exposes the LU for tests.
 """
 import warnings
 
@@ -16,7 +16,6 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from libc.string cimport memcpy
-from scipy.linalg.cython_lapack cimport dgetrf, dgetrs, zgetrf, zgetrs
 
 
 cdef extern from "ballc_kernels.h":
@@ -28,12 +27,18 @@ cdef extern from "_system.h":
     int ballc_stick_state(const double *, const double *, const double *, int, int,
                           double *) nogil
 
+cdef extern from "_lu.h":
+    int BALLC_LU_OK
+    int ballc_lu_factor(int, double *, int *) nogil
+    int ballc_lu_factor_complex(int, double complex *, int *) nogil
+    void ballc_lu_solve(int, const double *, const int *, double *) nogil
+    void ballc_lu_solve_complex(int, const double complex *, const int *,
+                                double complex *) nogil
+
 cdef extern from "_radau5_solver.h":
     ctypedef int (*radau5_fun)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_jac)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_event_fun)(void *, int, double, const double *, double *) noexcept nogil
-    ctypedef struct radau5_lapack:
-        pass
     ctypedef struct radau5_problem:
         int n
         radau5_fun fun
@@ -54,7 +59,6 @@ cdef extern from "_radau5_solver.h":
         radau5_event_fun ev_fun
         const int *ev_terminal
         const int *ev_direction
-        radau5_lapack lapack
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -66,7 +70,6 @@ cdef extern from "_radau5_solver.h":
         int *hit_event
         double *hit_t
         double *hit_y
-    void radau5_set_lapack(radau5_lapack *, void *, void *, void *, void *) nogil
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
     void radau5_free(radau5_result *) nogil
 
@@ -193,8 +196,6 @@ cdef object _run(radau5_problem *p, int n, int m):
     cdef double[::1] tv, htv
     cdef double[:, ::1] yv, hyv
     cdef int[::1] hev
-    radau5_set_lapack(&p.lapack, <void *>dgetrf, <void *>dgetrs, <void *>zgetrf,
-                      <void *>zgetrs)
     with nogil:
         rc = radau5_solve(p, &r)
     try:
@@ -320,3 +321,41 @@ def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, eve
     ctx.A = &av[0, 0]
     return _solve(_linear_fun, _linear_jac, &ctx, ctx.n, t_span, y0, rtol, atol,
                   max_step, t_eval, events, first_step, max_nfev)
+
+
+def _lu_solve(A, b):
+    """Solve A x = b with ballc's LU (``_lu.c``), for tests: real when A and b are
+    real, complex otherwise.  Raises numpy.linalg.LinAlgError on an exactly zero pivot."""
+    cdef int n, info
+    cdef double[:, ::1] ar
+    cdef double[::1] br
+    cdef double complex[:, ::1] ac
+    cdef double complex[::1] bc
+    cdef int[::1] pv
+    is_complex = np.iscomplexobj(A) or np.iscomplexobj(b)
+    dtype = complex if is_complex else float
+    A = np.array(A, dtype=dtype, order="C")   # copies: factored in place
+    x = np.array(b, dtype=dtype)
+    if A.ndim != 2 or A.shape[0] != A.shape[1] or A.shape[0] == 0 or x.shape != (A.shape[0],):
+        raise ValueError(f"need A (n x n, n > 0) and b (n), got {A.shape} and {x.shape}")
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(x))):
+        raise ValueError("A and b must be finite")
+    n = A.shape[0]
+    piv = np.empty(n, dtype=np.intc)
+    pv = piv
+    if is_complex:
+        ac = A
+        bc = x
+        info = ballc_lu_factor_complex(n, &ac[0, 0], &pv[0])
+        if info == BALLC_LU_OK:
+            ballc_lu_solve_complex(n, &ac[0, 0], &pv[0], &bc[0])
+    else:
+        ar = A
+        br = x
+        info = ballc_lu_factor(n, &ar[0, 0], &pv[0])
+        if info == BALLC_LU_OK:
+            ballc_lu_solve(n, &ar[0, 0], &pv[0], &br[0])
+    if info != BALLC_LU_OK:
+        raise np.linalg.LinAlgError(f"singular matrix: the pivot of column {info - 1} is "
+                                    "exactly zero")
+    return x

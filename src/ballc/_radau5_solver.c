@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "_lu.h"
 #include "_radau5_solver.h"
 
 #define NEWTON_MAXITER 6   /* Maximum number of Newton iterations. */
@@ -98,37 +99,33 @@ static int call_jac(solver_t *s, double t, const double *y)
     return 0;
 }
 
-/* LU of MU_REAL / h I - J and MU_COMPLEX / h I - J (column-major for LAPACK). */
+/* LU of MU_REAL / h I - J and MU_COMPLEX / h I - J (row-major, as J; see _lu.h). */
 static int factor(solver_t *s, double h)
 {
-    int n = s->n, info_r = 0, info_c = 0;
+    int n = s->n;
     double mr = s->k.mu_real / h;
     cplx mc = s->k.mu_complex / h;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++) {
             double a = -s->J[i * n + j];
-            s->LU_real[i + j * n] = a + (i == j ? mr : 0.0);
-            s->LU_complex[i + j * n] = a + (i == j ? mc : 0.0);
+            s->LU_real[i * n + j] = a + (i == j ? mr : 0.0);
+            s->LU_complex[i * n + j] = a + (i == j ? mc : 0.0);
         }
-    s->p->lapack.dgetrf(&n, &n, s->LU_real, &n, s->piv_real, &info_r);
-    s->p->lapack.zgetrf(&n, &n, s->LU_complex, &n, s->piv_complex, &info_c);
+    int info_r = ballc_lu_factor(n, s->LU_real, s->piv_real);
+    int info_c = ballc_lu_factor_complex(n, s->LU_complex, s->piv_complex);
     s->r->nlu += 2;
     s->lu_valid = 1;
-    return (info_r == 0 && info_c == 0) ? 0 : -1;
+    return (info_r == BALLC_LU_OK && info_c == BALLC_LU_OK) ? 0 : -1;
 }
 
 static void solve_real(solver_t *s, double *b)
 {
-    int n = s->n, one = 1, info = 0;
-    char trans = 'N';
-    s->p->lapack.dgetrs(&trans, &n, &one, s->LU_real, &n, s->piv_real, b, &n, &info);
+    ballc_lu_solve(s->n, s->LU_real, s->piv_real, b);
 }
 
 static void solve_complex(solver_t *s, cplx *b)
 {
-    int n = s->n, one = 1, info = 0;
-    char trans = 'N';
-    s->p->lapack.zgetrs(&trans, &n, &one, s->LU_complex, &n, s->piv_complex, b, &n, &info);
+    ballc_lu_solve_complex(s->n, s->LU_complex, s->piv_complex, b);
 }
 
 /* radau.solve_collocation_system: Z (3 x n) starts as Z0 and ends as the solution. */
@@ -610,15 +607,6 @@ static int handle_events(solver_t *s, double *t_stop)
 }
 
 /* ---- driver (solve_ivp's loop) ---- */
-
-void radau5_set_lapack(radau5_lapack *lapack, void *dgetrf, void *dgetrs, void *zgetrf,
-                       void *zgetrs)
-{
-    lapack->dgetrf = (radau5_dgetrf)dgetrf;
-    lapack->dgetrs = (radau5_dgetrs)dgetrs;
-    lapack->zgetrf = (radau5_zgetrf)zgetrf;
-    lapack->zgetrs = (radau5_zgetrs)zgetrs;
-}
 
 void radau5_free(radau5_result *r)
 {

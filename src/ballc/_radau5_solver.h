@@ -14,9 +14,9 @@
  * an event's zero; see simulate.py).
  *
  * Generic in the system: the right-hand side and Jacobian are C callbacks, the
- * dimension is a run-time value.  Linear algebra is LAPACK's dgetrf/dgetrs and
- * zgetrf/zgetrs, whose addresses the caller supplies (ballc takes them from
- * scipy.linalg.cython_lapack, so no LAPACK is linked at build time).
+ * dimension is a run-time value.  The Newton systems are solved by ballc's own
+ * small LU with partial pivoting (_lu.h: fixed loop order, no BLAS, no threads),
+ * so results do not depend on the machine's LAPACK or its threading.
  */
 #ifndef BALLC_RADAU5_H
 #define BALLC_RADAU5_H
@@ -30,21 +30,6 @@ typedef int (*radau5_jac)(void *ctx, double t, const double *y, double *jac);
 /* *g = value of the system-defined (non-linear) event ``e`` at (t, y), before its offset.
  * Return 0 on success. */
 typedef int (*radau5_event_fun)(void *ctx, int e, double t, const double *y, double *g);
-
-typedef void (*radau5_dgetrf)(int *m, int *n, double *a, int *lda, int *ipiv, int *info);
-typedef void (*radau5_dgetrs)(char *trans, int *n, int *nrhs, double *a, int *lda,
-                              int *ipiv, double *b, int *ldb, int *info);
-typedef void (*radau5_zgetrf)(int *m, int *n, double _Complex *a, int *lda, int *ipiv,
-                              int *info);
-typedef void (*radau5_zgetrs)(char *trans, int *n, int *nrhs, double _Complex *a, int *lda,
-                              int *ipiv, double _Complex *b, int *ldb, int *info);
-
-typedef struct {
-    radau5_dgetrf dgetrf;
-    radau5_dgetrs dgetrs;
-    radau5_zgetrf zgetrf;
-    radau5_zgetrs zgetrs;
-} radau5_lapack;
 
 typedef struct {
     int n;                    /* number of states */
@@ -67,7 +52,6 @@ typedef struct {
     radau5_event_fun ev_fun;  /* may be NULL when no event is non-linear */
     const int *ev_terminal;   /* nonzero: stop at the first occurrence */
     const int *ev_direction;  /* +1 rising only, -1 falling only, 0 both */
-    radau5_lapack lapack;
 } radau5_problem;
 
 enum { RADAU5_REACHED = 0, RADAU5_EVENT = 1, RADAU5_FAILED = -1 };
@@ -84,10 +68,6 @@ typedef struct {
     double *hit_t;
     double *hit_y;            /* n_hits x n */
 } radau5_result;
-
-/* Fill ``lapack`` from untyped addresses (as Cython hands them over). */
-void radau5_set_lapack(radau5_lapack *lapack, void *dgetrf, void *dgetrs, void *zgetrf,
-                       void *zgetrs);
 
 /* Integrate; returns 0, or -1 when memory ran out (result->message says so).
  * The result always holds what was computed; release it with radau5_free. */
