@@ -33,6 +33,7 @@ cdef extern from "_system.h":
                           double *) nogil
     int ballc_remove_slip(const double *, const double *, int, int, double *) nogil
     int BALLC_FLOOR_SLIP, BALLC_CEILING_SLIP, BALLC_FLOOR_STICK, BALLC_CEILING_STICK
+    int BALLC_FLOOR_SLIP_FIXED, BALLC_CEILING_SLIP_FIXED
 
 N_STATES = BALLC_N_STATES
 N_PARAMETERS = BALLC_N_PARAMETERS
@@ -57,6 +58,8 @@ FLAGS = {
     "ceiling_slip": BALLC_CEILING_SLIP,
     "floor_stick": BALLC_FLOOR_STICK,
     "ceiling_stick": BALLC_CEILING_STICK,
+    "floor_slip_fixed": BALLC_FLOOR_SLIP_FIXED,
+    "ceiling_slip_fixed": BALLC_CEILING_SLIP_FIXED,
 }
 ENERGY_NOUT = BALLC_ENERGY_NOUT
 CONTACT_KINEMATICS_NOUT = BALLC_CONTACT_KINEMATICS_NOUT

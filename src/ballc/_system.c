@@ -59,17 +59,24 @@ static int inputs_finite(const double *state, const double *params, const double
         && all_finite(latch, BALLC_N_LATCH);
 }
 
-/* Exact Coulomb mode of ``plane`` under ``flags``: 0 none, SLIP or STICK. */
-enum { MODE_NONE = 0, MODE_SLIP = 1, MODE_STICK = 2 };
+/* Exact Coulomb mode of ``plane`` under ``flags``. */
+enum { MODE_NONE = 0, MODE_SLIP = 1, MODE_SLIP_FIXED = 2, MODE_STICK = 3 };
 static int exact_mode(int flags, int plane)
 {
     int friction = plane == 0 ? BALLC_FLOOR_FRICTION : BALLC_CEILING_FRICTION;
     int slip = plane == 0 ? BALLC_FLOOR_SLIP : BALLC_CEILING_SLIP;
+    int fixed = plane == 0 ? BALLC_FLOOR_SLIP_FIXED : BALLC_CEILING_SLIP_FIXED;
     int stick = plane == 0 ? BALLC_FLOOR_STICK : BALLC_CEILING_STICK;
     if (!(flags & friction)) return MODE_NONE;
     if (flags & stick) return MODE_STICK;
+    if (flags & fixed) return MODE_SLIP_FIXED;
     if (flags & slip) return MODE_SLIP;
     return MODE_NONE;
+}
+
+static int is_sliding(int mode)
+{
+    return mode == MODE_SLIP || mode == MODE_SLIP_FIXED;
 }
 
 /* The slip kernel's outputs: u (2), du/dx (2 x NS), tangential force map G_t (6 x 2). */
@@ -136,11 +143,11 @@ static void assemble(const double *state, const double *params, const double *la
         if (ev->mode[plane] == MODE_NONE) continue;
         double *slip = ev->slip[plane];
         SLIP_KERNELS[plane](state, params, NULL, slip);
-        if (ev->mode[plane] != MODE_SLIP) continue;
+        if (!is_sliding(ev->mode[plane])) continue;
         const double *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
         double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = hypot(ux, uy);
         double *e = ev->e[plane];
-        if (speed > 0) {
+        if (speed > 0 && ev->mode[plane] == MODE_SLIP) {
             double sign = ux * d[0] + uy * d[1] < 0 ? -1.0 : 1.0;
             e[0] = sign * ux / speed;
             e[1] = sign * uy / speed;
@@ -382,8 +389,8 @@ static int difference_jacobian(const double *state, const double *params, const 
 }
 
 /* Add the sliding Coulomb force's derivatives: F_t = -mu N e(u), with
- * de/du = sign (I - e e^T) / |u| (sign: e's orientation along the latched direction),
- * and those of the tangential dissipation rate mu N (e . u). */
+ * de/du = sign (I - e e^T) / |u| (sign: e's orientation along the latched direction;
+ * 0 with a fixed direction), and those of the tangential dissipation rate mu N (e . u). */
 static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const double *latch,
                          const double *law_jac, double *dF, double *jac)
 {
@@ -392,7 +399,7 @@ static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const dou
     double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = hypot(ux, uy);
     double N = ev->load[plane], normal = plane == 0 ? 1.0 : -1.0;
     double de[2][2] = {{0, 0}, {0, 0}};
-    if (speed > 0) {
+    if (speed > 0 && ev->mode[plane] == MODE_SLIP) {
         double sign = ux * d[0] + uy * d[1] < 0 ? -1.0 : 1.0;
         for (int a = 0; a < 2; a++)
             for (int b = 0; b < 2; b++)
@@ -436,7 +443,7 @@ int ballc_jacobian(const double *state, const double *params, const double *latc
     for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
         if (!(flags & CONTACT_LAWS[k].flag)) continue;
         int plane = CONTACT_LAWS[k].plane, target[4];
-        int exact = ev.mode[plane] == MODE_SLIP && (CONTACT_LAWS[k].flag &
+        int exact = is_sliding(ev.mode[plane]) && (CONTACT_LAWS[k].flag &
                     (BALLC_FLOOR_FRICTION | BALLC_CEILING_FRICTION));
         CONTACT_LAWS[k].jac(state, exact ? normal_params : params, law_latch(latch, plane), buf);
         for (int i = 0; i < NU * NS; i++) dF[i] += buf[BALLC_LAW_GENERALIZED_FORCE * NS + i];

@@ -30,7 +30,12 @@ enum {
     BALLC_FLOOR_SLIP = 128,
     BALLC_CEILING_SLIP = 256,
     BALLC_FLOOR_STICK = 512,
-    BALLC_CEILING_STICK = 1024
+    BALLC_CEILING_STICK = 1024,
+    /* SLIP_FIXED: sliding with the force direction held at the latched d (e = d): the
+     * last approach to zero slip and the first departure from it, where u/|u| is
+     * singular (the driver switches to SLIP once |u| is clear of zero). */
+    BALLC_FLOOR_SLIP_FIXED = 2048,
+    BALLC_CEILING_SLIP_FIXED = 4096
 };
 
 /* Sum of the contact forces on the ball, per plane (floor x y z, ceiling x y z). */

@@ -115,14 +115,15 @@ def contact_threshold(scene, plane, rho0, entering):
     return max(base, far_side + base)
 
 
-def _segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0):
+def _segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
+                    clear=0.0):
     """Events of one segment starting at state y0: [(kind, plane, event)].
 
-    ``coulomb``: each plane's exact-Coulomb mode ("slip", "stick" or None).  A sliding
-    plane stops when u . d (d its latched slip direction) falls through zero; a
-    sticking plane releases when |lambda| reaches mu N.  Both sit a rounding-level
-    margin past their zero, so that a segment starting on it (slip from rest, a stick
-    that starts at the cone) does not fire at once.
+    ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
+    see ballc.stickslip), ``clear`` the slip speed (m/s) below which the slip
+    direction is held fixed.  The stop and release events sit a rounding-level margin
+    past their zero, so that a segment starting on it (slip from rest, a stick that
+    starts at the cone) does not fire at once.
     """
     events = []
     for plane in PLANES:
@@ -139,13 +140,15 @@ def _segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None
             threshold = contact_threshold(scene, plane, rho0, entering=True)
             events.append(("enter", plane, rho.shifted(-threshold, True, 1)))
         mode = coulomb[plane] if coulomb else None
-        if mode == "slip":
-            k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE
-            direction = latch[k + stickslip._SLIP_DIRECTION:k + stickslip._SLIP_DIRECTION + 2]
-            margin = 4 * np.spacing(stickslip.speed_scale(scene, y0))
-            events.append(("stop", plane, LinearEvent(
-                stickslip.slip_stop_coefficients(params, plane, direction), margin,
-                True, -1)))
+        if mode in ("slip", "slip_fixed"):
+            k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE + stickslip._SLIP_DIRECTION
+            along = stickslip.slip_stop_coefficients(params, plane, latch[k:k + 2])
+            if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
+                events.append(("approach", plane, LinearEvent(along, -clear, True, -1)))
+            else:                # fixed direction: stop at u . d = 0, or go free at 2 clear
+                margin = 4 * np.spacing(stickslip.speed_scale(scene, y0))
+                events.append(("stop", plane, LinearEvent(along, margin, True, -1)))
+                events.append(("clear", plane, LinearEvent(along, -2 * clear, True, 1)))
         elif mode == "stick":
             load = _core.stick_state(y0, params, latch, flags, PLANES.index(plane))[2]
             events.append(("release", plane, stickslip.StickRelease(
@@ -367,6 +370,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     in_contact = {plane: False for plane in PLANES}
     coulomb: dict[str, str | None] = {plane: None for plane in PLANES}
     relatches = {plane: 0 for plane in PLANES}
+    transitions = {plane: 0 for plane in PLANES}
     open_contacts: dict[str, Contact] = {}
     dissipated_at_start: dict[str, np.ndarray] = {}
     contacts: list[Contact] = []
@@ -386,30 +390,68 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         open_contacts[plane] = contact
         contacts.append(contact)
         dissipated_at_start[plane] = y[_DISSIPATED].copy()
-        relatches[plane] = 0
+        relatches[plane] = transitions[plane] = 0
         if exact:
             y = start_slip_or_settle(plane, y)
         return y
 
     def start_slip_or_settle(plane, y):
-        """At a contact start or a stop event: slip on along u when |u| is not at rest,
-        else settle (stick, or slip from rest along -lambda)."""
+        """At a contact start: slip freely when |u| is clear of zero, with a fixed
+        direction below that, settle (stick, or slip from rest) at u = 0."""
         u = stickslip.slip_velocity(params, plane, y)
         speed = float(np.hypot(*u))
-        at_rest = speed <= stickslip.SLIP_AT_REST * stickslip.speed_scale(scene, y)
-        if not at_rest and relatches[plane] < stickslip.MAX_RELATCH:
-            mode, direction = "slip", u / speed
+        if speed > 2 * stickslip.clear_speed(scene, y, rtol, atol):
+            set_mode(plane, "slip", u / speed)
+        elif speed > 0:
+            set_mode(plane, "slip_fixed", u / speed)
         else:
-            base = _flags(scene, in_contact)
-            mode, direction, y = stickslip.settle(scene, params, latch, base, plane, y)
+            y = settle(plane, y)
+        return y
+
+    def settle(plane, y):
+        mode, direction, y = stickslip.settle(scene, params, latch, _flags(scene, in_contact),
+                                              plane, y)
         set_mode(plane, mode, direction)
         return y
 
     def set_mode(plane, mode, direction=None):
+        """Enter ``mode`` on ``plane`` at the current t; the contact records when each
+        phase of slip or stick begins."""
+        phase = "stick" if mode == "stick" else "slip"
         coulomb[plane] = mode
+        transitions[plane] += 1
         if direction is not None:
             stickslip.set_slip_direction(latch, plane, direction)
-        open_contacts[plane].transitions.append((t, mode))
+        record = open_contacts[plane].transitions
+        if not record or record[-1][1] != phase:
+            record.append((t, phase))
+
+    def coulomb_transition(kind, plane, y):
+        """The next exact-Coulomb mode after event ``kind`` on ``plane`` (see stickslip)."""
+        u = stickslip.slip_velocity(params, plane, y)
+        speed = float(np.hypot(*u))
+        clear = stickslip.clear_speed(scene, y, rtol, atol)
+        if kind == "approach":   # u . d fell to `clear`: near zero, or only turned away
+            relatches[plane] += 1
+            if speed <= 2 * clear or relatches[plane] > stickslip.MAX_RELATCH:
+                set_mode(plane, "slip_fixed", u / speed)
+            else:
+                set_mode(plane, "slip", u / speed)
+        elif kind == "stop":     # u . d = 0 with the direction held: what is left is error
+            if speed <= clear:
+                y = settle(plane, y)
+            else:
+                set_mode(plane, "slip", u / speed)
+        elif kind == "clear":    # clear of zero again: the direction goes free
+            set_mode(plane, "slip", u / speed)
+        else:                    # "release": |lambda| reached mu N; slip from rest along -lambda
+            stick_flags = _flags(scene, in_contact, coulomb)
+            lam = _core.stick_state(y, params, latch, stick_flags, PLANES.index(plane))[:2]
+            size = float(np.hypot(*lam))
+            direction = -lam / size if size > 0 else latch_slip_direction(latch, plane)
+            y = _core.remove_slip(y, params, _flags(scene, in_contact), PLANES.index(plane))
+            set_mode(plane, "slip_fixed", direction)
+        return y
 
     for plane in PLANES:   # a scene may start in contact (issue 9): latch as documented
         if _penetration(plane, scene)(0.0, y) > 0:
@@ -432,7 +474,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             bar.update(t - bar.n)
         flags = _flags(scene, in_contact, coulomb)
         system = _core.System(params, latch, flags)
-        events = _segment_events(scene, in_contact, y, coulomb, params, latch, flags)
+        clear = stickslip.clear_speed(scene, y, rtol, atol)
+        events = _segment_events(scene, in_contact, y, coulomb, params, latch, flags, clear)
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > t) & (t_eval <= t_end)]
@@ -472,16 +515,13 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         y[_QUATERNION] /= np.linalg.norm(y[_QUATERNION])
         if kind == "enter":
             y = begin_contact(plane, y)
-        elif kind == "stop":
-            relatches[plane] += 1
-            y = start_slip_or_settle(plane, y)
-        elif kind == "release":
-            stick_flags = _flags(scene, in_contact, coulomb)
-            lam = _core.stick_state(y, params, latch, stick_flags, PLANES.index(plane))[:2]
-            size = float(np.hypot(*lam))
-            direction = -lam / size if size > 0 else latch_slip_direction(latch, plane)
-            y = _core.remove_slip(y, params, _flags(scene, in_contact), PLANES.index(plane))
-            set_mode(plane, "slip", direction)
+        elif kind in ("approach", "stop", "clear", "release"):
+            if transitions[plane] >= stickslip.MAX_TRANSITIONS:
+                status = -1
+                message = (f"stick-slip transitions on the {plane} did not settle: "
+                           f"{transitions[plane]} mode changes in one contact by t = {t:.9g} s")
+                break
+            y = coulomb_transition(kind, plane, y)
         elif kind == "leave":
             in_contact[plane] = False
             coulomb[plane] = None
@@ -551,7 +591,9 @@ STICK_SLIP_THRESHOLD = 0.999
 
 def summarize_contact_forces(result):
     """Peak normal force and sticking / slipping time of every contact, from the
-    stored samples (solver steps, or t_eval: the resolution is that of the samples)."""
+    stored samples (solver steps, or t_eval: the resolution is that of the samples);
+    with exact Coulomb friction the sticking and slipping times come from the
+    transition events instead."""
     scene = result.scene
     params = scene.parameter_vector()
     mu = scene.friction_coefficient
@@ -572,12 +614,23 @@ def summarize_contact_forces(result):
         f_n = forces[:, 2] * normal
         f_t = np.hypot(forces[:, 0], forces[:, 1])
         contact.peak_normal_force = float(f_n.max())
+        if contact.transitions:   # exact Coulomb friction: the phases are events
+            contact.time_sticking, contact.time_slipping = _phase_times(contact, end)
+            continue
         slipping = (f_t >= STICK_SLIP_THRESHOLD * mu * f_n) & (f_n > 0)
         t = result.t[inside]
         dt = np.diff(t)
         slip_fraction = 0.5 * (slipping[1:].astype(float) + slipping[:-1])
         contact.time_slipping = float(np.sum(dt * slip_fraction))
         contact.time_sticking = float(np.sum(dt) - contact.time_slipping)
+
+
+def _phase_times(contact, end):
+    """(time sticking, time slipping) from a contact's transition events (s)."""
+    starts = [t for t, _ in contact.transitions] + [end]
+    durations = np.diff(starts)
+    sticking = sum(d for d, (_, phase) in zip(durations, contact.transitions) if phase == "stick")
+    return float(sticking), float(end - contact.t_start - sticking)
 
 
 def _progress_bar(progress, t_end):

@@ -1,24 +1,33 @@
 """Exact Coulomb friction as events: the slip and stick modes of a contact.
 
 With ``friction_regularization="exact"`` (the default), a contact with a Coulomb part
-(the friction model, and the friction share 1 - mixture of the mixture) alternates two
-kinds of smooth segment instead of integrating the seed's regularised law
+(the friction model, and the friction share 1 - mixture of the mixture) alternates
+smooth segments of three kinds instead of integrating the seed's regularised law
 ``mu F_n u / max(|u|, v_s)``, whose viscous core (time constant ~ m v_s / (mu F_n),
 about 1e-12 s) makes loose tolerances crawl and chatter:
 
-* **slip**: F_t = -mu N u/|u| (N the friction share's normal force).  The direction
-  is oriented along the slip direction ``d`` latched at the segment start, so the law
-  continues smoothly through u . d = 0, where the *stop* event sits (u . d is linear
-  in the state; when u turns by 90 degrees without stopping, ``d`` is re-latched).
+* **slip**: F_t = -mu N u/|u| (N the friction share's normal force), u the slip
+  velocity.  Its *approach* event fires when u . d (d latched at the segment start)
+  falls to a small speed ``clear`` (see :func:`clear_speed`); there the direction is
+  frozen (or re-latched, if u has only turned away from d).
+* **slip with a fixed direction**: F_t = -mu N d.  Near zero slip u/|u| is singular
+  (its Jacobian grows like 1/|u|, and an implicit step across u = 0 cannot converge
+  when u misses zero by the integration error), so the last approach to zero and the
+  first departure from it keep the direction they had: its *stop* event is u . d = 0,
+  its *clear* event u . d = 2 clear (then free slip resumes).  Over the few
+  microseconds this lasts the true direction turns by no more than the integration
+  error of u.
 * **stick**: u held constant (at zero) by a tangential constraint force lambda
   computed in C from the equations of motion (a 2x2 Delassus solve).  Its *release*
   event is mu N - |lambda| = 0 (evaluated in C by radau5 and through ``_core`` by
   scipy's methods); the slip that follows starts along -lambda, so the friction force
   is continuous.
 
-The seed's law is the limit v_s -> 0 of this one.  Contact start and end close either
-mode.  This module holds the decisions at the mode boundaries; the driver
-(simulate.py) holds the segment loop.
+At a stop, the slip left over (the integration error of u, at most ``clear``) is
+removed by a tangential impulse, and the contact sticks if lambda lies in the cone
+|lambda| <= mu N, else slips on from rest along -lambda.  The seed's law is the limit
+v_s -> 0 of this one.  Contact start and end close any mode.  This module holds the
+decisions at the mode boundaries; the driver (simulate.py) holds the segment loop.
 """
 from __future__ import annotations
 
@@ -32,15 +41,17 @@ _OMEGA, _V = _STATE["omega_x"], _STATE["vx"]
 _LATCH = {name: i for i, name in enumerate(_core.LATCH_NAMES[:_core.N_LATCH_PER_PLANE])}
 _SLIP_DIRECTION = _LATCH["floor_slip_direction_x"]
 
-#: A slip speed below SLIP_AT_REST * (|v| + r |omega|) at a stop event counts as zero:
-#: the state is then projected onto u = 0 (an impulse of that size) and the contact
-#: sticks or restarts slipping.  Above it the slip direction has only turned: re-latch.
-SLIP_AT_REST = 1e-11
+#: The slip speed below which the direction is held fixed: CLEAR_FACTOR times the
+#: integration error scale rtol (|v| + r |omega|) + atol (see clear_speed).
+CLEAR_FACTOR = 100.0
 
-#: At most this many re-latches of the slip direction per contact before a stop is
-#: treated as at rest (a slip direction spiralling into zero would otherwise need ever
-#: shorter segments).
-MAX_RELATCH = 50
+#: At most this many re-latches of the slip direction per contact (a direction that
+#: keeps turning away from its latched value) before a stop is forced.
+MAX_RELATCH = 1000
+
+#: At most this many mode changes in one contact: more means the transitions do not
+#: settle (a Zeno-like sequence), and the run stops honestly.
+MAX_TRANSITIONS = 100_000
 
 
 def uses_exact_coulomb(scene) -> bool:
@@ -51,7 +62,7 @@ def uses_exact_coulomb(scene) -> bool:
 
 
 def mode_flags(plane: str, mode: str | None) -> int:
-    """The C flags of a plane's Coulomb mode ("slip", "stick" or None)."""
+    """The C flags of a plane's Coulomb mode ("slip", "slip_fixed", "stick" or None)."""
     return _core.FLAGS[f"{plane}_{mode}"] if mode else 0
 
 
@@ -64,6 +75,13 @@ def speed_scale(scene, y) -> float:
     """|v| + r |omega| (m/s): the scale slip speeds are compared with."""
     return float(np.linalg.norm(y[_V:_V + 3]) + scene.radius * np.linalg.norm(
         y[_OMEGA:_OMEGA + 3])) + 1e-300
+
+
+def clear_speed(scene, y, rtol, atol) -> float:
+    """The slip speed (m/s) below which the slip direction is held fixed: well above
+    the integration error of u, rtol (|v| + r |omega|) + atol, so that a free-direction
+    step never has to cross the singular u = 0."""
+    return CLEAR_FACTOR * (float(rtol) * speed_scale(scene, y) + float(np.max(atol)))
 
 
 def force_scale(scene, load) -> float:
@@ -112,8 +130,9 @@ def slip_velocity(params, plane: str, y) -> np.ndarray:
 
 def settle(scene, params, latch, base_flags: int, plane: str, y):
     """The mode a contact takes on at zero slip: ("stick", None, y0) when the constraint
-    force that holds it lies in the friction cone, else ("slip", direction, y0) along
-    -lambda.  y0 is y with the slip velocity projected to exactly zero."""
+    force that holds it lies in the friction cone, else ("slip_fixed", direction, y0):
+    slip from rest along -lambda.  y0 is y with the slip velocity projected to exactly
+    zero."""
     index = PLANES.index(plane)
     y0 = _core.remove_slip(np.ascontiguousarray(y, dtype=float), params, base_flags, index)
     stick_flags = base_flags | mode_flags(plane, "stick")
@@ -121,4 +140,4 @@ def settle(scene, params, latch, base_flags: int, plane: str, y):
     size = float(np.hypot(lam_x, lam_y))
     if margin >= -force_scale(scene, load) or size == 0:
         return "stick", None, y0
-    return "slip", -np.array([lam_x, lam_y]) / size, y0
+    return "slip_fixed", -np.array([lam_x, lam_y]) / size, y0

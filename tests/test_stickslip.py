@@ -1,0 +1,278 @@
+"""Exact Coulomb friction (stick and slip as events) against independent oracles.
+
+The oracles: Coulomb's skid-to-roll solution of a sphere on a plane, the rigid
+Coulomb impact map's rolling boundary (a closed form), the seed's own regularised law
+at a tight tolerance (its v_s -> 0 limit is this model), and the equations of motion
+themselves (the stick force keeps the slip velocity exactly constant).
+"""
+import math
+
+import numpy as np
+import pytest
+
+import ballc
+from ballc import _core, stickslip
+from ballc.simulate import _latch_values
+
+G = 9.81
+
+
+def skid_scene(mu, v0, spin=0.0):
+    """A solid sphere (no observer, c_tau = 1) launched along the floor at v0 without
+    spin, resting at its static penetration (m g / k0)^(2/3) with no vertical speed,
+    so that F_n = m g throughout (the friction acts at (0, 0, -r): no vertical force)."""
+    base = ballc.Scene(observer_mass=0.0, c_tau=1.0, tangential_model="friction",
+                       friction_coefficient=mu, gravity=G, velocity=(v0, 0.0, 0.0),
+                       angular_velocity=(0.0, spin, 0.0))
+    rho = (base.mass * G / base.hertz_stiffness) ** (2 / 3)
+    return base.replace(position=(0.0, 0.0, base.radius - rho))
+
+
+@pytest.mark.parametrize("tol", [1e-3, 1e-6, 1e-10])
+@pytest.mark.parametrize("mu, v0", [(0.3, 2.0), (0.1, 5.0), (0.8, 0.5)])
+def test_skid_to_roll_matches_coulomb_theory(mu, v0, tol):
+    """Coulomb: the contact point slides for t* = 2 v0 / (7 mu g), then the sphere rolls
+    at 5 v0 / 7 and the contact point stays at rest (no force acts along the floor).
+    The slip phase is linear in t, so every tolerance must find t* to ~1e-13."""
+    scene = skid_scene(mu, v0)
+    result = ballc.simulate(scene, 2.5 * 2 * v0 / (7 * mu * G), rtol=tol, atol=tol)
+    assert result.status == 0, result.message
+    (contact,) = result.contacts
+    t_star = 2 * v0 / (7 * mu * G)
+    assert [phase for _, phase in contact.transitions] == ["slip", "stick"]
+    assert contact.transitions[1][0] == pytest.approx(t_star, rel=1e-6)
+    assert result.velocity[0, -1] == pytest.approx(5 * v0 / 7, rel=1e-6)
+    sticking = result.t >= contact.transitions[1][0]
+    slip = result.velocity[0] - scene.radius * result.angular_velocity[1]
+    assert np.max(np.abs(slip[sticking])) <= 1e-12
+    # the normal force is m g throughout: the ball stays at its static penetration
+    np.testing.assert_allclose(result.position[2], scene.position[2], rtol=0, atol=1e-12)
+    # the contact table's phase times come from the events
+    assert contact.time_slipping == pytest.approx(t_star, rel=1e-6)
+    assert contact.time_sticking == pytest.approx(result.t[-1] - t_star, rel=1e-6)
+
+
+def test_backspin_reverses_then_rolls():
+    """With backspin omega0 (about +y, for motion along +x the rolling spin is v/r
+    about +y: backspin is negative) the slip is v0 - r omega0 > 0 and Coulomb gives
+    rolling at (5 v0 + 2 r omega0) / 7, here negative: the ball comes back."""
+    mu, v0, omega0 = 0.4, 1.0, -6.0
+    scene = skid_scene(mu, v0, spin=omega0)
+    u0 = v0 - scene.radius * omega0
+    t_star = 2 * u0 / (7 * mu * G)
+    result = ballc.simulate(scene, 2 * t_star, rtol=1e-8, atol=1e-8)
+    (contact,) = result.contacts
+    assert contact.transitions[1] == (pytest.approx(t_star, rel=1e-6), "stick")
+    expected = (5 * v0 + 2 * scene.radius * omega0) / 7
+    assert expected < 0
+    assert result.velocity[0, -1] == pytest.approx(expected, rel=1e-6)
+
+
+def steel_oblique(u, mu=0.2, c_tau=0.9, tol=1e-10):
+    """A steel ball hits the floor at normal speed 1 m/s, tangential speed u, no spin,
+    gravity off, exact Coulomb friction."""
+    from test_physics import STEEL
+    scene = ballc.Scene(**{**STEEL, "gravity": 0.0, "observer_mass": 0.0, "c_tau": c_tau,
+                           "friction_coefficient": mu, "tangential_model": "friction",
+                           "position": (0.0, 0.0, STEEL["radius"] + 1e-4),
+                           "velocity": (0.6 * u, 0.8 * u, -1.0)})
+    result = ballc.simulate(scene, 4e-4, rtol=tol, atol=tol)
+    assert result.status == 0, result.message
+    (contact,) = result.contacts
+    return scene, contact
+
+
+@pytest.mark.parametrize("side, rolls", [(0.999, True), (1.001, False)])
+def test_rolling_boundary_of_the_rigid_coulomb_map(side, rolls):
+    """Without tangential compliance the slip only loses speed in proportion to the
+    normal impulse, so a compliant impact ends rolling exactly when the rigid map's
+    |u| <= 3.5 mu (1 + e) |v_n| (solid sphere), e the Hunt-Crossley restitution.
+    0.1 % either side of that boundary decides the outcome."""
+    mu, c_tau = 0.2, 0.9
+    e = ballc.hunt_crossley_restitution(c_tau)
+    u = side * 3.5 * mu * (1 + e) * 1.0
+    scene, contact = steel_oblique(u, mu, c_tau)
+    w, v = contact.angular_velocity_after, contact.velocity_after
+    slip = np.hypot(*(v[:2] + np.cross(w, [0, 0, -scene.radius])[:2]))
+    assert (contact.transitions[-1][1] == "stick") == rolls
+    if rolls:
+        assert slip <= 1e-12
+    else:
+        assert slip > 1e-4 * u
+    rigid = ballc.rigid_impact(contact.velocity_before, contact.angular_velocity_before,
+                               mass=scene.mass, radius=scene.radius, restitution=e,
+                               friction_coefficient=mu)
+    np.testing.assert_allclose(contact.velocity_after, rigid.velocity, atol=1e-3 * u)
+
+
+@pytest.fixture(scope="module")
+def seed_pair():
+    """The seed scene at rtol = atol = 1e-12 with the seed's literal law (v_s = 1e-10)
+    and with exact Coulomb friction."""
+    kw = dict(rtol=1e-12, atol=1e-12)
+    literal = ballc.simulate(ballc.Scene(friction_regularization="max"), 5.0, **kw)
+    exact = ballc.simulate(ballc.Scene(), 5.0, **kw)
+    return literal, exact
+
+
+def test_seed_scene_agrees_with_the_seeds_law(seed_pair):
+    """v_s = 1e-10 m/s is the seed's regularisation: its effect on positions and
+    velocities is far below 1e-6, so the two models agree there at every contact end
+    and at t = 5 s; and both show the seed's 9 alternating contacts."""
+    literal, exact = seed_pair
+    assert literal.status == exact.status == 0
+    assert [c.plane for c in exact.contacts] == [c.plane for c in literal.contacts] \
+        == ["floor", "ceiling"] * 4 + ["floor"]
+    for a, b in zip(literal.contacts, exact.contacts):
+        assert b.t_end == pytest.approx(a.t_end, abs=1e-6)
+        np.testing.assert_allclose(b.velocity_after, a.velocity_after, atol=1e-6)
+        np.testing.assert_allclose(b.angular_velocity_after, a.angular_velocity_after, atol=1e-6)
+    np.testing.assert_allclose(exact.position[:, -1], literal.position[:, -1], atol=1e-6)
+    np.testing.assert_allclose(exact.velocity[:, -1], literal.velocity[:, -1], atol=1e-6)
+
+
+def test_seed_scene_comes_back_at_the_first_ceiling_contact(seed_pair):
+    """The seed's published run: x-velocity -2.63 -> +2.20 m/s at the first ceiling
+    contact (shared NOTES, measured on the seed's own code)."""
+    _, exact = seed_pair
+    ceiling = exact.contacts[1]
+    assert ceiling.velocity_before[0] == pytest.approx(-2.63, abs=0.01)
+    assert ceiling.velocity_after[0] == pytest.approx(2.20, abs=0.01)
+
+
+def test_phase_times_add_up_to_the_contact(seed_pair):
+    """The stick and slip times come from the transition events and fill the contact."""
+    _, exact = seed_pair
+    for contact in exact.contacts:
+        times = [t for t, _ in contact.transitions] + [contact.t_end]
+        assert times[0] == contact.t_start and np.all(np.diff(times) >= 0)
+        assert contact.time_sticking + contact.time_slipping == pytest.approx(
+            contact.duration, rel=1e-12)
+
+
+def test_stick_force_holds_the_slip_velocity(rng):
+    """In stick mode the constraint force makes du/dt = 0 exactly (the equations of
+    motion, evaluated independently by the right-hand side), and sits in or out of the
+    cone as the margin says."""
+    scene = ballc.Scene(mixture=0.375)
+    params = scene.parameter_vector()
+    for plane, index in (("floor", 0), ("ceiling", 1)):
+        flags = (_core.FLAGS["observer"] | _core.FLAGS[f"{plane}_friction"]
+                 | _core.FLAGS[f"{plane}_digin"] | _core.FLAGS[f"{plane}_stick"])
+        du_dx = _core.slip_map(params, index)
+        for _ in range(30):
+            y = scene.initial_state()
+            y[4:7] = [0, 0, rng.uniform(0.6, 0.95) if plane == "floor" else 9.3]
+            y[7:13] = rng.uniform(-5, 5, 6)
+            y[:4] = rng.normal(size=4)
+            y[:4] /= np.linalg.norm(y[:4])
+            latch = np.zeros(_core.N_LATCH)
+            k = index * _core.N_LATCH_PER_PLANE
+            latch[k] = rng.uniform(1, 20)
+            d = rng.normal(size=3)
+            latch[k + 1:k + 4] = d / np.linalg.norm(d)
+            ydot = _core.rhs(y, params, latch, flags)
+            assert np.max(np.abs(du_dx @ ydot)) <= 1e-12 * np.max(np.abs(ydot))
+            lam_x, lam_y, load, margin = _core.stick_state(y, params, latch, flags, index)
+            assert margin == pytest.approx(scene.friction_coefficient * load
+                                           - math.hypot(lam_x, lam_y), abs=1e-12 * load)
+
+
+def test_remove_slip_is_an_impulse_at_the_contact_point(rng):
+    """The projection at a stop is a tangential impulse at the contact point: it zeroes
+    u, leaves vz and omega_z unchanged, and conserves the angular momentum about the
+    contact point, m (r e_z) x v + I omega (no observer: a plain sphere)."""
+    scene = ballc.Scene(observer_mass=0.0)
+    params = scene.parameter_vector()
+    inertia = scene.inertia[0]
+    for _ in range(20):
+        y = scene.initial_state()
+        y[7:13] = rng.uniform(-5, 5, 6)
+        out = _core.remove_slip(y, params, 0, 0)
+        assert np.max(np.abs(_core.slip_map(params, 0) @ out)) <= 1e-14
+        assert out[12] == pytest.approx(y[12], abs=1e-14)
+        assert out[9] == pytest.approx(y[9], abs=1e-14)
+        arm = [0.0, 0.0, scene.radius]
+
+        def momentum(x):
+            return scene.mass * np.cross(arm, x[10:13]) + inertia * x[7:10]
+        np.testing.assert_allclose(momentum(out), momentum(y), atol=1e-13)
+        assert np.array_equal(out[:7], y[:7]) and np.array_equal(out[13:], y[13:])
+
+
+def test_loose_tolerances_finish_quickly_on_the_seed_scene():
+    """No cliff: every tolerance from 1e-3 to 1e-8 finishes the 5-s seed throw with
+    status 0 and fewer right-hand-side calls than the next tighter tolerance (the
+    seed's own law needed millions of calls, or failed, between 1e-4 and 1e-7)."""
+    calls = []
+    for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
+        result = ballc.simulate(ballc.Scene(), 5.0, rtol=tol, atol=tol, max_nfev=200_000)
+        assert result.status == 0, (tol, result.message)
+        assert len(result.contacts) == 9
+        calls.append(result.nfev)
+    assert calls == sorted(calls)
+    assert calls[-1] < 60_000
+
+
+@pytest.mark.parametrize("method", ["Radau", "BDF"])
+def test_scipy_methods_use_the_same_events(method):
+    """scipy's implicit methods run the same stick/slip modes (the release event is a
+    Python callable through _core): same phases and outcome as radau5."""
+    scene = skid_scene(0.3, 2.0)
+    t_star = 2 * 2.0 / (7 * 0.3 * G)
+    result = ballc.simulate(scene, 2 * t_star, method=method, rtol=1e-9, atol=1e-9)
+    (contact,) = result.contacts
+    assert [phase for _, phase in contact.transitions] == ["slip", "stick"]
+    assert contact.transitions[1][0] == pytest.approx(t_star, rel=1e-6)
+    assert result.velocity[0, -1] == pytest.approx(5 * 2.0 / 7, rel=1e-6)
+
+
+def test_start_in_contact_latches_the_elastic_approach_rate():
+    """A scene that starts with penetration rho and rate rhodot latches the rate an
+    elastic approach would have had there: 1/2 m r'^2 = 1/2 m rhodot^2 + 2/5 k0 rho^5/2."""
+    scene = ballc.Scene(observer_mass=0.0, position=(0, 0, 0.9), velocity=(0, 0, -0.3))
+    rho, rate = 0.1, 0.3
+    expected = math.sqrt(rate ** 2 + 0.8 * scene.hertz_stiffness * rho ** 2.5 / scene.mass)
+    latched, _ = _latch_values(scene.initial_state(), scene.parameter_vector(), "floor", scene)
+    assert latched == pytest.approx(expected, rel=1e-12)
+    result = ballc.simulate(scene, 0.5)
+    assert result.contacts[0].t_start == 0.0
+    assert result.contacts[0].penetration_rate_at_impact == pytest.approx(expected, rel=1e-12)
+
+
+def test_uses_exact_coulomb_only_where_there_is_coulomb_friction():
+    assert stickslip.uses_exact_coulomb(ballc.Scene())
+    assert stickslip.uses_exact_coulomb(ballc.Scene(tangential_model="friction"))
+    assert not stickslip.uses_exact_coulomb(ballc.Scene(friction_regularization="max"))
+    assert not stickslip.uses_exact_coulomb(ballc.Scene(tangential_model="dig-in"))
+    assert not stickslip.uses_exact_coulomb(ballc.Scene(tangential_model="compliant"))
+    assert not stickslip.uses_exact_coulomb(ballc.Scene(friction_coefficient=0.0))
+
+
+WORK_PRECISION_SCENES = {
+    "seed": (ballc.Scene(), 5.0),
+    "friction": (ballc.Scene(tangential_model="friction"), 5.0),
+    "mu 0.1 mixture 0": (ballc.Scene(friction_coefficient=0.1, mixture=0.0), 1.2),
+    "mu 0.4 mixture 0.375": (ballc.Scene(friction_coefficient=0.4, mixture=0.375), 1.2),
+    "mu 0.8 mixture 0.7": (ballc.Scene(friction_coefficient=0.8, mixture=0.7), 1.2),
+}
+
+
+@pytest.mark.parametrize("name", list(WORK_PRECISION_SCENES))
+def test_work_precision_has_no_cliff(name):
+    """rtol = atol from 1e-3 to 1e-12: every run finishes (status 0), a looser
+    tolerance never costs more calls than the next tighter one, and the final error
+    (against 1e-13) falls by orders of magnitude every three decades of tolerance."""
+    scene, t_end = WORK_PRECISION_SCENES[name]
+    reference = ballc.simulate(scene, t_end, rtol=1e-13, atol=1e-13)
+    assert reference.status == 0
+    calls, errors = [], {}
+    for exponent in range(3, 13):
+        tol = 10.0 ** -exponent
+        result = ballc.simulate(scene, t_end, rtol=tol, atol=tol, max_nfev=500_000)
+        assert result.status == 0, (tol, result.message)
+        calls.append(result.nfev)
+        errors[exponent] = np.max(np.abs(result.y[4:13, -1] - reference.y[4:13, -1]))
+    assert calls == sorted(calls), calls
+    assert errors[3] > errors[6] > errors[9] > errors[12], errors
+    assert errors[3] < 0.2 and errors[9] < 1e-6
