@@ -1,6 +1,9 @@
 """The seed's throw under the four tangential models: does the ball come back?
 
-    python examples/compare_tangential_models.py [--out docs/tangential_models.png]
+    python examples/compare_tangential_models.py [--out DIR] [--t-end 5]
+
+writes DIR/tangential_models.png (default DIR: ballc-output/compare_tangential_models/;
+``--out docs`` regenerates the figure of docs/tangential_models.md).
 
 Left: the x-coordinate of the centre against time (the throw starts towards -x;
 "coming back" means x turns around after floor -> ceiling -> floor).  Right: the
@@ -8,6 +11,7 @@ energy (kinetic + potential + spring) against time: dig-in alone gains energy un
 the ball passes through the floor.
 """
 import argparse
+from pathlib import Path
 
 import matplotlib
 
@@ -27,10 +31,14 @@ MODELS = {
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--out", default="docs/tangential_models.png")
-    parser.add_argument("--t-end", type=float, default=5.0)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--out", type=Path, default=Path("ballc-output/compare_tangential_models"),
+                        help="output folder (default: %(default)s)")
+    parser.add_argument("--t-end", type=float, default=5.0, help="simulated time (s)")
     args = parser.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    figure = args.out / "tangential_models.png"
 
     fig, (ax_x, ax_e) = plt.subplots(1, 2, figsize=(13, 4.8))
     for label, changes in MODELS.items():
@@ -55,8 +63,8 @@ def main(argv=None):
     ax_e.set_title("Energy: dig-in alone injects energy")
     ax_e.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
-    print(f"wrote {args.out}")
+    fig.savefig(figure, dpi=110)
+    print(f"wrote {figure}")
 
 
 if __name__ == "__main__":

@@ -74,3 +74,18 @@ def test_invalid_toml_names_the_file(tmp_path):
     (tmp_path / "x.toml").write_text("mixture = [\n")
     with pytest.raises(ballc.SceneError, match="x.toml: not valid TOML"):
         ballc.Scene.from_toml(tmp_path / "x.toml")
+
+
+@pytest.mark.parametrize("name", ["x.h5", "x", "x.npz.bak", "x.NPZ"])
+def test_save_refuses_other_suffixes(result, tmp_path, name):
+    with pytest.raises(ValueError, match=r"must end in \.npz .*or \.nc") as caught:
+        result.save(tmp_path / name)
+    assert name in str(caught.value)
+    assert list(tmp_path.iterdir()) == []          # not x.h5.npz, nothing at all
+
+
+def test_load_refuses_other_suffixes(result, tmp_path):
+    result.save(tmp_path / "r.npz")
+    (tmp_path / "r.npz").rename(tmp_path / "r.h5")    # even an npz under another name
+    with pytest.raises(ValueError, match=r"r\.h5.*must end in \.npz .*or \.nc"):
+        ballc.load(tmp_path / "r.h5")

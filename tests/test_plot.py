@@ -64,3 +64,74 @@ def test_animation_is_a_gif_with_the_requested_frames(result, tmp_path):
 def test_animation_rejects_unknown_formats(result, tmp_path):
     with pytest.raises(ValueError, match="gif or .mp4"):
         result.animate(tmp_path / "a.avi", frames=2)
+
+
+def test_coordinate_components_have_distinct_line_styles(result):
+    """The seed throw's omega_x and omega_y are equal: one of them must not hide the other."""
+    import matplotlib.pyplot as plt
+    fig, axes = result.plot()
+    try:
+        for ax in axes:
+            styles = [line.get_linestyle() for line in ax.get_lines()[:3]]
+            assert len(set(styles)) == 3, styles
+            legend = ax.get_legend()
+            assert [h.get_linestyle() for h in legend.legend_handles] == styles
+    finally:
+        plt.close(fig)
+
+
+def test_top_view_legend_explains_the_arrows(result):
+    import matplotlib.pyplot as plt
+    fig, ax = result.plot_contacts()
+    try:
+        labels = [text.get_text() for text in ax.get_legend().get_texts()]
+        assert any("next contact" in label for label in labels), labels
+    finally:
+        plt.close(fig)
+
+
+def test_animation_legend_explains_arrows_and_dashed_lines(result, tmp_path):
+    import matplotlib.pyplot as plt
+    animation = result.animate(tmp_path / "a.gif", frames=2)
+    try:
+        (legend,) = animation._fig.legends
+        handles = {text.get_text(): handle for text, handle in
+                   zip(legend.get_texts(), legend.legend_handles)}
+        arrow = [h for label, h in handles.items() if "next contact" in label]
+        dashed = [h for label, h in handles.items() if "in order" in label]
+        assert len(arrow) == 1 and matplotlib.colors.same_color(arrow[0].get_color(), "red")
+        assert len(dashed) == 1 and dashed[0].get_linestyle() == "--"
+        assert matplotlib.colors.same_color(dashed[0].get_color(), "green")
+        assert any("observer" in label for label in handles)
+    finally:
+        plt.close(animation._fig)
+
+
+def test_animation_rejects_no_frames(result):
+    for frames in (0, -5, 2.5, True):
+        with pytest.raises(ValueError, match="frames = "):
+            result.animate(frames=frames)
+
+
+def test_sweep_map_of_came_back_has_a_two_colour_legend():
+    import matplotlib.pyplot as plt
+    import pandas as pd
+    from ballc.plot import CAME_BACK_COLOURS, plot_sweep_map
+    table = pd.DataFrame({"mixture": [0.0, 0.0, 0.5, 0.5], "friction_coefficient": [0.1, 0.2] * 2,
+                          "came_back": [False, False, True, False],
+                          "energy_lost_fraction": [0.4, 0.4, 0.1, 0.4], "status": [0] * 4})
+    fig, ax = plot_sweep_map(table, x="friction_coefficient", y="mixture")
+    try:
+        assert fig.axes == [ax]                                    # no colour bar
+        legend = ax.get_legend()
+        labels = [text.get_text() for text in legend.get_texts()]
+        assert labels == ["came back", "did not come back"]
+        colours = [patch.get_facecolor() for patch in legend.get_patches()]
+        assert matplotlib.colors.same_color(colours, [CAME_BACK_COLOURS["yes"],
+                                                      CAME_BACK_COLOURS["no"]])
+        image = ax.get_images()[0]
+        cells = image.to_rgba(image.get_array())
+        assert matplotlib.colors.same_color(cells[1, 0], CAME_BACK_COLOURS["yes"])
+        assert matplotlib.colors.same_color(cells[0, 0], CAME_BACK_COLOURS["no"])
+    finally:
+        plt.close(fig)

@@ -1,8 +1,9 @@
 """3D animation of a Result, like the seed's but in seconds (matplotlib).
 
 Two translucent planes (floor z = 0, ceiling z = H), the ball as a wireframe sphere
-turning with the ball, the observer as a red dot, the contact points coloured by time
-with arrows from each to the next.  Frames are taken at equal steps of simulated
+turning with the ball, the observer as a red dot, the contact points coloured by time,
+joined in order by green dashed lines with a red arrow pointing to the next; a legend
+says which is which.  Frames are taken at equal steps of simulated
 time (interpolated), so the animation runs at a constant speed; static artists are
 drawn once and only the ball, the observer and the contact markers change per frame.
 """
@@ -17,6 +18,17 @@ from .orientation import rotation_matrix
 
 #: Default number of frames: enough to follow the bounces, few enough to write in seconds.
 DEFAULT_FRAMES = 100
+
+
+def check_frames(frames) -> int:
+    """``frames`` as an int >= 1, else ValueError naming the value (the one check of the
+    frame count: ``animate`` and ``ballc --frames`` use it)."""
+    if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)) and not (
+            isinstance(frames, (float, np.floating)) and float(frames).is_integer()):
+        raise ValueError(f"frames = {frames!r} is not allowed: must be a whole number >= 1")
+    if frames < 1:
+        raise ValueError(f"frames = {frames!r} is not allowed: must be >= 1")
+    return int(frames)
 
 
 def _sphere_mesh(radius, count=13):
@@ -65,9 +77,7 @@ def animate(result, path=None, *, frames: int = DEFAULT_FRAMES, fps: int = 20, d
 
     from .plot import contact_points, scene_title
 
-    frames = int(frames)
-    if frames < 1:
-        raise ValueError(f"frames = {frames} is not allowed: must be >= 1")
+    frames = check_frames(frames)
     scene = result.scene
     times = np.linspace(result.t[0], result.t[-1], frames)
     centre, quaternion, observer = _sample(result, times)
@@ -106,8 +116,17 @@ def animate(result, path=None, *, frames: int = DEFAULT_FRAMES, fps: int = 20, d
                                 lw=1.5, arrow_length_ratio=0.6, visible=False))
     path_line, = ax.plot([], [], [], color="green", lw=0.6, ls="--")
     observer_dot, = ax.plot([], [], [], "o", color="red", ms=6)
-    ax.set_title("red dot: the observer; contact points coloured by time\n"
-                 "(plasma: dark early, light late); " + scene_title(scene), fontsize=10)
+    ax.set_title(scene_title(scene), fontsize=10)
+    # What the symbols mean (proxies: quivers and hidden markers have no legend handle).
+    from matplotlib.lines import Line2D
+    legend = [Line2D([], [], ls="", marker="o", color="red", ms=6, label="the observer"),
+              Line2D([], [], ls="", marker="o", color=cmap(0.5), ms=7,
+                     label="contact point (colour: time,\ndark early, light late)"),
+              Line2D([], [], color="green", lw=0.8, ls="--",
+                     label="contact points in order"),
+              Line2D([], [], ls="", marker=r"$\uparrow$", color="red", ms=10,
+                     label="direction to the next contact")]
+    fig.legend(handles=legend, loc="lower center", ncol=2, fontsize=8, frameon=False)
     clock = fig.text(0.02, 0.97, "", fontsize=11, va="top", family="monospace")
     state = {"ball": None}
 

@@ -4,30 +4,74 @@
 ``ballc run``    the same for a scene file (see ``Scene.from_toml``), plus the result (.npz).
 ``ballc sweep``  a parameter sweep from a TOML file (see ``ballc.sweep.load_sweep_file``):
                  a CSV table and, for two parameters, a heat map of "came back".
+
+Every option, the scene file and the output folder are checked before anything is
+simulated or written.  An expected error (invalid scene or option, unreadable file,
+output folder that cannot be made) is one line on stderr and exit code 2.
 """
 from __future__ import annotations
 
 import argparse
-import csv
+import inspect
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 from .outcome import format_summary
-from .scene import Scene, SceneError
-from .simulate import simulate
+from .scene import Scene, SceneError, read_toml, reject_unknown_keys
 
 DEMO_FRAMES = 100
+#: Simulated time (s) when neither --t-end nor the scene file's [simulate] t_end says.
+DEFAULT_T_END = 5.0
+#: Default parent of ``ballc run`` / ``ballc sweep`` outputs: <this>/<file stem>/.
+OUTPUT_ROOT = "ballc-output"
+#: Keys of a scene file's [simulate] table; all but t_end are passed to ballc.simulate.
+SIMULATE_KEYS = ("t_end", "rtol", "atol", "method")
 
 
-def write_contacts_csv(result, path) -> None:
-    """One row per contact (SI units): plane, times, velocities before/after, penetration."""
-    rows = [{"contact": i, **c.as_dict()} for i, c in enumerate(result.contacts, 1)]
-    names = list(rows[0]) if rows else ["contact", "plane", "t_start", "t_end"]
-    with open(path, "w", newline="") as stream:
-        writer = csv.DictWriter(stream, fieldnames=names)
-        writer.writeheader()
-        writer.writerows(rows)
+class CommandError(Exception):
+    """An expected failure of a command (bad path, output folder): one line, exit 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (and exit code 2, as argparse's)."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def version() -> str:
+    """The installed distribution's version, else ``ballc.__version__``."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as distribution_version
+    try:
+        return distribution_version("ballc")
+    except PackageNotFoundError:
+        from . import __version__
+        return __version__
+
+
+def _frames(text: str) -> int:
+    """argparse type of --frames: a whole number >= 1 (animate's own check)."""
+    from .animate import check_frames
+    try:
+        return check_frames(int(text))
+    except ValueError as error:
+        message = str(error) if "frames =" in str(error) else \
+            f"frames = {text!r} is not allowed: must be a whole number >= 1"
+        raise argparse.ArgumentTypeError(message) from None
+
+
+def _workers(text: str) -> int:
+    try:
+        workers = int(text)
+    except ValueError:
+        workers = 0
+    if workers < 1:
+        raise argparse.ArgumentTypeError(f"workers = {text!r} is not allowed: must be a "
+                                         "whole number >= 1")
+    return workers
 
 
 def write_outputs(result, out: Path, *, animate: bool, frames: int) -> list[Path]:
@@ -38,8 +82,11 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int) -> list[Path
     import matplotlib.pyplot as plt
 
     from .animate import animate as make_animation
-    from .animate import has_ffmpeg
+    from .animate import check_frames, has_ffmpeg
 
+    if animate:
+        frames = check_frames(frames)     # before any file is written
+    out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     written = []
     figures = (("coordinates.png", result.plot), ("energy.png", result.plot_energy),
@@ -50,7 +97,7 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int) -> list[Path
         fig.savefig(out / name, dpi=100)
         plt.close(fig)
         written.append(out / name)
-    write_contacts_csv(result, out / "contacts.csv")
+    result.contacts_csv(out / "contacts.csv")
     written.append(out / "contacts.csv")
     if animate:
         names = ["animation.gif"] + (["animation.mp4"] if has_ffmpeg() else [])
@@ -61,81 +108,176 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int) -> list[Path
     return written
 
 
-def _report(result, written, seconds) -> None:
+# --- checks made before anything is simulated or written ---
+
+def _scene_file(text: str) -> Path:
+    """The path of an existing, regular input file."""
+    path = Path(text)
+    if not path.exists():
+        raise CommandError(f"{path}: no such file")
+    if path.is_dir():
+        raise CommandError(f"{path}: is a folder, not a TOML file")
+    return path
+
+
+def _output_folder(out: Path) -> Path:
+    """Make ``out`` (and its parents) and check that a file can be written into it."""
+    if out.exists() and not out.is_dir():
+        raise CommandError(f"--out {out}: exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise CommandError(f"--out {out}: cannot create the folder "
+                           f"({error.strerror or error})") from None
+    try:
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as error:
+        raise CommandError(f"--out {out}: cannot write into the folder "
+                           f"({error.strerror or error})") from None
+    return out
+
+
+def _simulate_options(scene, t_end, options: dict):
+    """(t_end, options for ballc.simulate) checked by ballc.simulate's own validation;
+    options not given take simulate's defaults."""
+    from .simulate import _check_options, simulate
+    defaults = {name: parameter.default
+                for name, parameter in inspect.signature(simulate).parameters.items()
+                if name in ("method", "rtol", "atol")}
+    given = {name: value for name, value in options.items() if value is not None}
+    merged = {**defaults, **given}
+    t_end = _check_options(scene, t_end, method=merged["method"], rtol=merged["rtol"],
+                           atol=merged["atol"])
+    return t_end, given
+
+
+def simulate_table(path, scene=None) -> dict:
+    """A scene file's ``[simulate]`` table (t_end, rtol, atol, method), validated: unknown
+    keys fail with a "did you mean", values by ``ballc.simulate``'s own checks."""
+    data = read_toml(path)
+    settings = data.get("simulate", {})
+    if not isinstance(settings, dict):
+        raise SceneError(f"{path}: simulate = {settings!r} is not allowed: must be a "
+                         f"[simulate] table with the keys {', '.join(SIMULATE_KEYS)}")
+    try:
+        reject_unknown_keys(settings, SIMULATE_KEYS, "key",
+                            ", ".join(SIMULATE_KEYS))
+        _simulate_options(scene or Scene(), settings.get("t_end", DEFAULT_T_END),
+                          {k: v for k, v in settings.items() if k != "t_end"})
+    except SceneError as error:
+        raise SceneError(f"{path}: [simulate]: {error}") from None
+    return dict(settings)
+
+
+# --- the commands ---
+
+def _report(result, written, seconds, animate) -> None:
     print(format_summary(result))
     print()
     print(result.contact_table())
     print()
     print("wrote " + ", ".join(str(p) for p in written))
-    print(f"[{seconds['simulate']:.2f} s simulation, {seconds['outputs']:.2f} s figures "
-          f"and animation]")
+    outputs = "figures, files and animation" if animate else "figures and files"
+    print(f"[{seconds['simulate']:.2f} s simulation, {seconds['outputs']:.2f} s {outputs}]")
 
 
-def _simulate_and_write(scene, t_end, out, animate, frames, save=False):
+def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False):
+    from .simulate import simulate
     started = time.perf_counter()
-    result = simulate(scene, t_end)
+    result = simulate(scene, t_end, **options)
     simulated = time.perf_counter()
     written = write_outputs(result, out, animate=animate, frames=frames)
     if save:
         result.save(out / "result.npz")
         written.append(out / "result.npz")
     seconds = {"simulate": simulated - started, "outputs": time.perf_counter() - simulated}
-    _report(result, written, seconds)
+    _report(result, written, seconds, animate)
     return result
 
 
 def _demo(args) -> int:
     scene = Scene()
+    t_end, options = _simulate_options(scene, args.t_end, {})
+    out = _output_folder(Path(args.out))
     print(f"ballc demo: the seed scene (c_tau {scene.c_tau}, mu {scene.friction_coefficient}, "
-          f"mixture {scene.mixture}) for {args.t_end:g} s -> {args.out}/")
-    result = _simulate_and_write(scene, args.t_end, Path(args.out), not args.no_animation,
+          f"mixture {scene.mixture}) for {t_end:g} s -> {out}/")
+    result = _simulate_and_write(scene, t_end, options, out, not args.no_animation,
                                  args.frames)
     return 0 if result.success else 1
 
 
 def _run(args) -> int:
-    from .scene import read_toml
-    path = Path(args.scene)
+    path = _scene_file(args.scene)
     scene = Scene.from_toml(path)
-    settings = read_toml(path).get("simulate", {})
-    t_end = args.t_end if args.t_end is not None else settings.get("t_end", 5.0)
-    out = Path(args.out) if args.out else Path(path.stem)
-    print(f"ballc run {path} for {t_end:g} s -> {out}/")
-    result = _simulate_and_write(scene, t_end, out, args.animate, args.frames, save=True)
+    settings = simulate_table(path, scene)
+    t_end = args.t_end if args.t_end is not None else settings.get("t_end", DEFAULT_T_END)
+    overrides = {"rtol": args.rtol, "atol": args.atol, "method": args.method}
+    options = {name: settings.get(name) for name in ("rtol", "atol", "method")}
+    options.update({k: v for k, v in overrides.items() if v is not None})
+    t_end, options = _simulate_options(scene, t_end, options)
+    out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
+    described = "".join(f", {k} {v}" for k, v in options.items())
+    print(f"ballc run {path} for {t_end:g} s{described} -> {out}/")
+    result = _simulate_and_write(scene, t_end, options, out, args.animate, args.frames,
+                                 save=True)
     return 0 if result.success else 1
 
 
 def _sweep(args) -> int:
-    from .sweep import run_sweep_file
-    return run_sweep_file(args.file, out=args.out, workers=args.workers,
-                          scheduler=args.scheduler)
+    from .sweep import load_sweep_file, run_sweep_file
+    path = _scene_file(args.file)
+    load_sweep_file(path)             # its errors before the output folder is made
+    out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
+    return run_sweep_file(path, out=out, workers=args.workers, scheduler=args.scheduler)
+
+
+def _one_line(error: BaseException) -> str:
+    if isinstance(error, OSError) and error.filename and error.strerror:
+        text = f"{error.filename}: {error.strerror}"
+    else:
+        text = str(error)
+    return " ".join(text.split())
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="ballc", description="ballc: a ball between two planes")
+    parser = _Parser(prog="ballc", description="ballc: a ball between two planes")
+    parser.add_argument("--version", action="version", version=f"ballc {version()}")
     commands = parser.add_subparsers(dest="command", required=True)
 
     demo = commands.add_parser("demo", help="the seed scene: figures, animation, contact table")
-    demo.add_argument("--t-end", type=float, default=5.0, help="simulated time in s (default 5)")
+    demo.add_argument("--t-end", type=float, default=DEFAULT_T_END,
+                      help=f"simulated time in s (default {DEFAULT_T_END:g})")
     demo.add_argument("--out", default="ballc-demo", help="output folder (default ballc-demo)")
-    demo.add_argument("--frames", type=int, default=DEMO_FRAMES,
-                      help=f"animation frames (default {DEMO_FRAMES})")
+    demo.add_argument("--frames", type=_frames, default=DEMO_FRAMES,
+                      help=f"animation frames, >= 1 (default {DEMO_FRAMES})")
     demo.add_argument("--no-animation", action="store_true", help="skip the GIF/MP4")
     demo.set_defaults(run=_demo)
 
     run = commands.add_parser("run", help="simulate a scene file (TOML)")
     run.add_argument("scene", help="scene file, e.g. examples/seed.toml")
     run.add_argument("--t-end", type=float, default=None,
-                     help="simulated time in s (default: [simulate] t_end of the file, else 5)")
-    run.add_argument("--out", default=None, help="output folder (default: the file's stem)")
+                     help=f"simulated time in s (default: [simulate] t_end of the file, "
+                          f"else {DEFAULT_T_END:g})")
+    run.add_argument("--rtol", type=float, default=None,
+                     help="relative tolerance (default: [simulate] rtol, else simulate's)")
+    run.add_argument("--atol", type=float, default=None,
+                     help="absolute tolerance (default: [simulate] atol, else simulate's)")
+    run.add_argument("--method", default=None,
+                     help="integrator: radau5 or a solve_ivp method (default: [simulate] "
+                          "method, else radau5)")
+    run.add_argument("--out", default=None,
+                     help=f"output folder (default: {OUTPUT_ROOT}/<the file's stem>)")
     run.add_argument("--animate", action="store_true", help="also write the 3D animation")
-    run.add_argument("--frames", type=int, default=DEMO_FRAMES, help="animation frames")
+    run.add_argument("--frames", type=_frames, default=DEMO_FRAMES,
+                     help=f"animation frames, >= 1 (default {DEMO_FRAMES})")
     run.set_defaults(run=_run)
 
     sweep = commands.add_parser("sweep", help="a parameter sweep from a TOML file")
     sweep.add_argument("file", help="sweep file, e.g. examples/sweep.toml")
-    sweep.add_argument("--out", default=None, help="output folder (default: the file's stem)")
-    sweep.add_argument("--workers", type=int, default=None,
+    sweep.add_argument("--out", default=None,
+                       help=f"output folder (default: {OUTPUT_ROOT}/<the file's stem>)")
+    sweep.add_argument("--workers", type=_workers, default=None,
                        help="local worker processes (default: the file's, else all cores)")
     sweep.add_argument("--scheduler", default=None,
                        help="Dask scheduler address (tcp://host:8786): run on that cluster")
@@ -144,8 +286,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.run(args)
-    except (SceneError, FileNotFoundError) as error:
-        print(f"ballc {args.command}: error: {error}", file=sys.stderr)
+    except (CommandError, SceneError, OSError, ValueError) as error:
+        # expected: invalid input or an unusable path.  Anything else is a bug: traceback.
+        print(f"ballc {args.command}: error: {_one_line(error)}", file=sys.stderr)
         return 2
 
 

@@ -86,9 +86,25 @@ def _check_provenance(path, stored: dict, state_names) -> None:
                       f"this ballc has {_core.GENERATOR_VERSION!r}", stacklevel=3)
 
 
-def save(result, path) -> None:
-    """Write ``result`` to ``path``: ``.nc`` -> netCDF (needs xarray), anything else -> npz."""
+#: File name suffixes save and load understand.
+SUFFIXES = (".npz", ".nc")
+
+
+def _checked_suffix(path, action: str) -> Path:
+    """``path`` as a Path; ValueError unless it ends in .npz or .nc (numpy would quietly
+    write "x.h5" as "x.h5.npz", which load("x.h5") then cannot find)."""
     path = Path(path)
+    if path.suffix not in SUFFIXES:
+        found = f"not {path.suffix!r}" if path.suffix else "it has no suffix"
+        raise ValueError(f"cannot {action} {str(path)!r}: the file name must end in .npz "
+                         f"(numpy) or .nc (netCDF, needs xarray); {found}")
+    return path
+
+
+def save(result, path) -> None:
+    """Write ``result`` to ``path``: ``.npz`` (numpy) or ``.nc`` (netCDF, needs xarray);
+    any other suffix raises ValueError."""
+    path = _checked_suffix(path, "save a Result as")
     if path.suffix == ".nc":
         _to_dataset(result).to_netcdf(path)
         return
@@ -106,8 +122,9 @@ def _or_empty(array, dtype):
 
 
 def load(path) -> Result:
-    """Read a Result written by :func:`save` (``.npz`` or ``.nc``)."""
-    path = Path(path)
+    """Read a Result written by :func:`save` (``.npz`` or ``.nc``; any other suffix raises
+    ValueError)."""
+    path = _checked_suffix(path, "load a Result from")
     if path.suffix == ".nc":
         return _from_dataset(path)
     with np.load(path, allow_pickle=False) as data:

@@ -55,10 +55,14 @@ def summary(result) -> dict:
 def format_summary(result) -> str:
     """A few lines for the terminal."""
     s = summary(result)
+    # A model that injects energy (dig-in) ends with more than it started with: say
+    # "gained", never "lost -4013.63 J".
+    change = "lost" if s["energy_lost"] >= 0 else "gained"
     lines = [
         f"{s['contacts']} contacts in {s['t_final']:g} s; status {s['status']}: {s['message']}",
         f"energy {s['energy_initial']:.2f} J -> {s['energy_final']:.2f} J "
-        f"(lost {s['energy_lost']:.2f} J, {100 * s['energy_lost_fraction']:.1f} %)",
+        f"({change} {abs(s['energy_lost']):.2f} J, "
+        f"{100 * abs(s['energy_lost_fraction']):.1f} % of the initial energy)",
     ]
     reversal = first_reversal(result)
     if reversal is not None:

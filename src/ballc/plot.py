@@ -13,6 +13,11 @@ PLANE_MARKERS = {"floor": "o", "ceiling": "^"}
 #: Energy keys drawn first, in this order; any other key (e.g. dissipated_*) follows,
 #: and "total" comes last, thick.
 ENERGY_ORDER = ("kinetic", "potential", "spring")
+#: Line style of the x, y, z components: distinct, so that equal components (the seed
+#: throw's omega_x and omega_y) stay visible on top of each other.
+COMPONENT_STYLES = ("-", "--", ":")
+#: Sweep map colours of "came back": yes, no, and no answer (failed run, NaN).
+CAME_BACK_COLOURS = {"yes": "#1a9850", "no": "#d73027", "none": "0.85"}
 
 
 def _pyplot():
@@ -39,7 +44,8 @@ def shade_contacts(ax, result) -> None:
 def plot_coordinates(result, axes=None, figsize=(10, 8)):
     """Centre position, centre velocity and angular velocity against time.
 
-    Returns (figure, array of 3 axes).  Contacts are shaded (floor brown, ceiling cyan).
+    Returns (figure, array of 3 axes).  Contacts are shaded (floor brown, ceiling cyan);
+    the x, y, z components are solid, dashed and dotted (``COMPONENT_STYLES``).
     """
     plt = _pyplot()
     if axes is None:
@@ -51,8 +57,8 @@ def plot_coordinates(result, axes=None, figsize=(10, 8)):
               (result.angular_velocity, "angular velocity (rad/s)",
                ("$\\omega_x$", "$\\omega_y$", "$\\omega_z$")))
     for ax, (values, label, names) in zip(axes, panels):
-        for row, name in zip(values, names):
-            ax.plot(result.t, row, label=name, lw=1.2)
+        for row, name, style in zip(values, names, COMPONENT_STYLES):
+            ax.plot(result.t, row, label=name, lw=1.5 if style == ":" else 1.2, ls=style)
         shade_contacts(ax, result)
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
@@ -122,6 +128,9 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
         for (x0, y0, _), (x1, y1, _), t in zip(points[:-1], points[1:], times[1:]):
             ax.annotate("", (x1, y1), (x0, y0), arrowprops=dict(
                 arrowstyle="->", color=cmap(norm(t)), lw=1.5, shrinkA=6, shrinkB=6))
+        if len(points) > 1:     # the arrows are annotations: a legend entry by proxy
+            ax.plot([], [], color=cmap(0.5), lw=1.5, marker=">", markevery=[1],
+                    label="to the next contact\n(coloured by its time)")
         fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
                      label="contact start time (s)")
     ax.set_aspect("equal", adjustable="datalim")
@@ -176,7 +185,12 @@ def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
     for _, row in table.iterrows():
         grid[ys.index(row[y]), xs.index(row[x])] = float(row[value])
     boolean = value == "came_back"
-    cmap = plt.get_cmap("RdYlGn" if boolean else "viridis")
+    if boolean:      # two colours and a legend: yes / no is not a continuous quantity
+        from matplotlib.colors import ListedColormap
+        cmap = ListedColormap([CAME_BACK_COLOURS["no"], CAME_BACK_COLOURS["yes"]]
+                              ).with_extremes(bad=CAME_BACK_COLOURS["none"])
+    else:
+        cmap = plt.get_cmap("viridis")
     image = ax.imshow(grid, origin="lower", cmap=cmap, aspect="auto",
                       vmin=0 if boolean else None, vmax=1 if boolean else None)
     for _, row in table.iterrows():
@@ -191,9 +205,13 @@ def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
     ax.set_xlabel(x.replace("_", " "))
     ax.set_ylabel(y.replace("_", " "))
     if boolean:
-        bar = fig.colorbar(image, ax=ax, ticks=[0, 1])
-        bar.ax.set_yticklabels(["no", "yes"])
-        bar.set_label("came back (x-velocity reversed after 3 contacts)")
+        from matplotlib.patches import Patch
+        handles = [Patch(facecolor=CAME_BACK_COLOURS["yes"], label="came back"),
+                   Patch(facecolor=CAME_BACK_COLOURS["no"], label="did not come back")]
+        if np.isnan(grid).any():
+            handles.append(Patch(facecolor=CAME_BACK_COLOURS["none"], label="no answer"))
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1),
+                  title="x-velocity reversed\nafter 3 contacts?", fontsize="small")
         ax.set_title("Does the throw come back?  (cell text: energy lost; !: run failed)")
     else:
         fig.colorbar(image, ax=ax, label=value.replace("_", " "))

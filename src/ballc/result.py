@@ -61,6 +61,24 @@ class Contact:
         return row
 
 
+#: Unit of each column of :meth:`Contact.as_dict` (the contact CSV's header says them).
+CONTACT_UNITS = {
+    "plane": "", "t_start": "s", "t_end": "s", "duration": "s", "max_penetration": "m",
+    "contact_point_x": "m", "contact_point_y": "m", "peak_normal_force": "N",
+    "energy_lost_normal": "J", "energy_lost_tangential": "J", "time_sticking": "s",
+    "time_slipping": "s", "penetration_rate_at_impact": "m/s",
+    **{f"{name}_{axis}": unit for name, unit in (
+        ("velocity_before", "m/s"), ("velocity_after", "m/s"),
+        ("angular_velocity_before", "rad/s"), ("angular_velocity_after", "rad/s"))
+       for axis in "xyz"},
+}
+
+
+def _with_unit(name: str) -> str:
+    unit = CONTACT_UNITS.get(name, "")
+    return f"{name} [{unit}]" if unit else name
+
+
 @dataclass
 class Result:
     """What :func:`ballc.simulate` returns, shaped like scipy's ``OdeResult``.
@@ -151,13 +169,23 @@ class Result:
         return self._energy
 
     def contacts_dataframe(self):
-        """The contact table as a pandas DataFrame, one row per contact (SI units)."""
+        """The contact table as a pandas DataFrame, one row per contact (SI units: the
+        unit of each column is ``ballc.result.CONTACT_UNITS[column]``)."""
         import pandas as pd
         return pd.DataFrame([c.as_dict() for c in self.contacts])
 
     def contacts_csv(self, path) -> None:
-        """Write the contact table to a CSV file."""
-        self.contacts_dataframe().to_csv(path, index_label="contact")
+        """Write the contact table to a CSV file: one row per contact, numbered from 1 as
+        in :meth:`contact_table`; the header names each column's unit, e.g.
+        ``t_start [s]`` (a header only when there was no contact)."""
+        import csv
+        names = list(self.contacts[0].as_dict()) if self.contacts else list(CONTACT_UNITS)
+        with open(path, "w", newline="", encoding="utf-8") as stream:
+            writer = csv.writer(stream)
+            writer.writerow(["contact"] + [_with_unit(name) for name in names])
+            for i, contact in enumerate(self.contacts, 1):
+                row = contact.as_dict()
+                writer.writerow([i] + [row[name] for name in names])
 
     # --- the observer: what a sensor inside the ball records (see ballc.observer) ---
 
@@ -213,11 +241,14 @@ class Result:
         save(self, path)
 
     def contact_table(self) -> str:
-        """The contacts as a fixed-width text table."""
+        """The contacts as a fixed-width text table; a second header line gives the units
+        (times in s, penetration in m, centre velocities in m/s)."""
         head = (f"{'#':>2} {'plane':7} {'t_start':>8} {'t_end':>8} {'max pen.':>9} "
                 f"{'vx before':>10} {'vx after':>9} {'vy before':>10} {'vy after':>9} "
                 f"{'vz before':>10} {'vz after':>9}")
-        lines = [head, "-" * len(head)]
+        units = (f"{'':>2} {'':7} {'[s]':>8} {'[s]':>8} {'[m]':>9} " +
+                 " ".join(f"{'[m/s]':>{width}}" for width in (10, 9, 10, 9, 10, 9)))
+        lines = [head, units, "-" * len(head)]
         for i, c in enumerate(self.contacts, 1):
             vb, va = c.velocity_before, c.velocity_after
             lines.append(f"{i:2d} {c.plane:7} {c.t_start:8.4f} {c.t_end:8.4f} "

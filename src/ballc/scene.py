@@ -241,13 +241,19 @@ def mindlin_stiffness_ratio(nu_ball, nu_plane, e_ball, e_plane):
 
 
 def _reject_unknown_fields(values) -> None:
-    known = [f.name for f in fields(Scene)]
+    reject_unknown_keys(values, [f.name for f in fields(Scene)], "scene field",
+                        "the Scene fields")
+
+
+def reject_unknown_keys(values, known, what: str, allowed: str) -> None:
+    """SceneError with a "did you mean" for the first key of ``values`` not in ``known``
+    (``what``: e.g. "scene field"; ``allowed``: how to name the known keys)."""
     for key in values:
         if key not in known:
-            close = difflib.get_close_matches(str(key), known, n=1)
+            close = difflib.get_close_matches(str(key), list(known), n=1)
             hint = f"; did you mean {close[0]!r}?" if close else ""
-            raise SceneError(f"unknown scene field {key!r} is not allowed: must be one of "
-                             f"the Scene fields{hint}")
+            raise SceneError(f"unknown {what} {key!r} is not allowed: must be one of "
+                             f"{allowed}{hint}")
 
 
 def read_toml(path) -> dict:
