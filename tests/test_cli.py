@@ -173,9 +173,6 @@ def test_simulate_that_is_not_a_table_is_named(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.xfail(reason="ballc.simulate._check_options accepts rtol = '1e-5' (a string) "
-                          "and simulate then fails with a numpy TypeError: its check, in "
-                          "simulate.py, should reject strings as it does for t_end")
 def test_simulate_table_rejects_a_string_tolerance(scene_file, tmp_path):
     scene_file('[simulate]\nrtol = "1e-5"\n')
     done = run_ballc("run", "scene.toml", "--out", "out", cwd=tmp_path)

@@ -8,6 +8,7 @@ no step ever straddles a contact boundary.  At contact start the penetration rat
 """
 from __future__ import annotations
 
+import difflib
 import math
 import sys
 
@@ -282,9 +283,15 @@ def _check_options(scene, t_end, method, rtol, atol, max_step=np.inf):
     if not (math.isfinite(t_end) and t_end > 0):
         raise SceneError(f"t_end = {t_end!r} is not allowed: must be finite and > 0")
     if method not in METHODS:
-        raise SceneError(f"method = {method!r} is not allowed: must be one of {METHODS}")
+        close = difflib.get_close_matches(str(method), METHODS, n=1, cutoff=0.5) or [
+            m for m in METHODS if m.lower() == str(method).lower()]
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise SceneError(f"method = {method!r} is not allowed: must be one of {METHODS}{hint}")
     for name, value in (("rtol", rtol), ("atol", atol)):
         try:
+            if isinstance(value, (str, bytes, bool, np.bool_)) or np.asarray(value).dtype.kind \
+                    not in "iuf":
+                raise TypeError   # float("1e-5") or float(True) would pass
             array = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
             raise SceneError(f"{name} = {value!r} is not allowed: must be a number "
