@@ -68,3 +68,19 @@ def test_sweep_file_runs_from_the_command_line(tmp_path):
     assert done.returncode == 0, done.stderr
     table = pd.read_csv(tmp_path / "o" / "sweep.csv")
     assert len(table) == 4 and (tmp_path / "o" / "came_back.png").stat().st_size > 0
+
+
+def test_dask_worker_processes_give_the_same_bits():
+    """Dask workers in their own processes (their own BLAS threading settings) give the
+    same bits as this process: radau5 solves its Newton systems with ballc's own LU, so
+    no result depends on how a LAPACK build splits its work (issue 9 measured 8.4e-8 J
+    of difference in energy_final with LAPACK)."""
+    distributed = pytest.importorskip("distributed", reason="Dask is the optional 'dask' extra")
+    grid = {"mixture": [0.0, 0.375], "friction_coefficient": [0.1, 0.4]}
+    here = ballc.sweep(BASE, grid, 1.2, workers=1)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            there = ballc.sweep(BASE, grid, 1.2, client=client)
+    pd.testing.assert_frame_equal(there, here, check_exact=True)
+    assert (here["status"] == 0).all()
