@@ -24,7 +24,7 @@ from scipy.linalg import expm
 
 import ballc
 from ballc import _core, _radau5
-from ballc.simulate import LinearEvent, _segment_events
+from ballc.events import LinearEvent, segment_events as _segment_events
 
 TOL = 1e-12
 

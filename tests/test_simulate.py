@@ -120,7 +120,7 @@ def test_inaccurate_integration_says_so():
     1e-3 of the initial energy is reported as inaccurate; an exact run is not.  (The
     drift is planted in the dissipated-work state of a real run, so the check sees a
     Result exactly as simulate builds it; no chaotic trajectory is involved.)"""
-    from ballc.simulate import _balance_warning
+    from ballc.outcome import balance_warning as _balance_warning
     accurate = ballc.simulate(ballc.Scene(c_tau=1.0, mixture=0.0, friction_coefficient=0.0),
                               0.5, rtol=1e-10, atol=1e-10)
     assert "energy balance" not in accurate.message

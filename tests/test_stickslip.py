@@ -12,7 +12,7 @@ import pytest
 
 import ballc
 from ballc import _core, stickslip
-from ballc.simulate import _latch_values
+from ballc.modes import latch_values as _latch_values
 
 G = 9.81
 

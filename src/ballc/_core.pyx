@@ -5,6 +5,7 @@ Private: use the ``ballc`` package.  Every entry point checks lengths; typed
 memoryviews reject wrong dtypes and non-contiguous arrays with ValueError.
 """
 import numpy as np
+from libc.math cimport NAN
 
 cdef extern from "ballc_kernels.h":
     int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH, BALLC_N_LATCH_PER_PLANE
@@ -264,4 +265,25 @@ def remove_slip(const double[::1] y, const double[::1] params, int flags, int pl
     cdef int status = ballc_remove_slip(&y[0], &params[0], flags, plane, &o[0])
     if status != BALLC_OK:
         raise FloatingPointError(f"remove_slip failed with C status {status}")
+    return out
+
+
+def contact_forces_per_sample(const double[:, ::1] states, const double[::1] params,
+                              const double[:, ::1] latches, const int[::1] flags):
+    """(n, 6): as contact_forces, with each state row's own latched values (row of
+    ``latches``, (n, N_LATCH)) and flags -- one call for a whole run's samples."""
+    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check("latches.shape[1]", latches.shape[1], BALLC_N_LATCH)
+    _check("latches.shape[0]", latches.shape[0], states.shape[0])
+    _check("flags", flags.shape[0], states.shape[0])
+    out = np.empty((states.shape[0], 6))
+    cdef double[:, ::1] o = out
+    cdef Py_ssize_t i, j
+    with nogil:
+        for i in range(states.shape[0]):
+            if ballc_contact_forces(&states[i, 0], &params[0], &latches[i, 0], flags[i],
+                                    &o[i, 0]) != BALLC_OK:
+                for j in range(6):
+                    o[i, j] = NAN
     return out

@@ -10,12 +10,11 @@ per step; the Newton systems are solved by ballc's own LU (``_lu.c``), no LAPACK
 ``solve_linear`` integrates y' = A y (a generic entry point, used to test the
 integrator against the matrix exponential); ``_lu_solve`` exposes the LU for tests.
 """
-import warnings
-
 import numpy as np
 from scipy.optimize import OptimizeResult
 
 from libc.string cimport memcpy
+from libc.math cimport NAN
 
 
 cdef extern from "ballc_kernels.h":
@@ -59,6 +58,7 @@ cdef extern from "_radau5_solver.h":
         radau5_event_fun ev_fun
         const int *ev_terminal
         const int *ev_direction
+        int dense_output
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -70,6 +70,9 @@ cdef extern from "_radau5_solver.h":
         int *hit_event
         double *hit_t
         double *hit_y
+        long n_dense
+        double *dense_t
+        double *dense_c
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
     void radau5_free(radau5_result *) nogil
 
@@ -82,7 +85,10 @@ ctypedef struct ball_ctx:
     const double *params
     const double *latch
     int flags
-    const int *event_plane   # per event: the plane of a stick-margin event (or -1)
+    const int *event_plane   # per event: 0/1 stick release of that plane, -1 linear,
+                             # -2 - k the user's Python event k
+    void *user_events        # list of the user's event callables (borrowed)
+    void *errors             # list collecting exceptions raised by them (borrowed)
 
 cdef int _ball_fun(void *ctx, double t, const double *y, double *f) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
@@ -93,12 +99,36 @@ cdef int _ball_jac(void *ctx, double t, const double *y, double *jac) noexcept n
     return ballc_jacobian(y, c.params, c.latch, c.flags, jac)
 
 cdef int _ball_event(void *ctx, int e, double t, const double *y, double *g) noexcept nogil:
-    """The stick-to-slip margin mu N - |lambda| of the event's plane."""
+    """The stick-to-slip margin mu N - |lambda| of the event's plane, or a user event."""
     cdef ball_ctx *c = <ball_ctx *>ctx
     cdef double out[4]
-    cdef int status = ballc_stick_state(y, c.params, c.latch, c.flags, c.event_plane[e], out)
+    cdef int plane = c.event_plane[e]
+    if plane <= -2:
+        with gil:
+            return _user_event(c, -2 - plane, t, y, g)
+    cdef int status = ballc_stick_state(y, c.params, c.latch, c.flags, plane, out)
     g[0] = out[3]
     return status
+
+
+cdef int _user_event(ball_ctx *c, int k, double t, const double *y, double *g) noexcept:
+    """Call the user's event g(t, y) (Python, with the GIL); an exception is kept for
+    solve_system to raise and the event reads as NaN (no crossing) meanwhile."""
+    cdef double[::1] yv
+    errors = <list>c.errors
+    if errors:
+        g[0] = NAN
+        return -1
+    try:
+        state = np.empty(BALLC_N_STATES)
+        yv = state
+        memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+        g[0] = float((<list>c.user_events)[k](t, state))
+        return 0
+    except BaseException as error:
+        errors.append(error)
+        g[0] = NAN
+        return -1
 
 ctypedef struct linear_ctx:
     int n
@@ -139,10 +169,9 @@ def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
     rtol = float(rtol) if np.ndim(rtol) == 0 else rtol
     if not isinstance(rtol, float) or not (np.isfinite(rtol) and rtol > 0):
         raise ValueError(f"rtol = {rtol!r} is not allowed: must be one finite number > 0")
-    if rtol < 100 * EPS:   # as scipy's validate_tol
-        warnings.warn(f"At least one element of `rtol` is too small. "
-                      f"Setting `rtol = np.maximum(rtol, {100 * EPS})`.", stacklevel=3)
-        rtol = 100 * EPS
+    if rtol < 100 * EPS:   # as ballc.options: scipy would silently raise it
+        raise ValueError(f"rtol = {rtol!r} is not allowed: must be >= 100 machine "
+                         f"epsilons = {100 * EPS:.3g}")
     atol_v = np.array(np.broadcast_to(np.asarray(atol, dtype=float), (n,)))   # a writable copy
     if not (np.all(np.isfinite(atol_v)) and np.all(atol_v >= 0)):
         raise ValueError(f"atol = {atol!r} is not allowed: must be finite and >= 0")
@@ -165,42 +194,59 @@ def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
 
 
 def _event_arrays(events, n):
-    """Linear events (``coefficients``, ``offset``) and stick-margin events
-    (``stick_plane``, ``offset``: g = mu N - |lambda| + offset, evaluated in C)."""
+    """Linear events (``coefficients``, ``offset``), stick-release events
+    (``stick_plane``, ``offset``: g = mu N - |lambda| + offset, evaluated in C) and, for
+    ballc's system, any other callable g(t, y) (a user event, called from C).
+    Returns (m, coef, offset, terminal, direction, plane, user callables)."""
     m = len(events)
     coef = np.zeros((max(m, 1), n))
     offset = np.zeros(max(m, 1))
     terminal = np.zeros(max(m, 1), dtype=np.intc)
     direction = np.zeros(max(m, 1), dtype=np.intc)
     plane = np.full(max(m, 1), -1, dtype=np.intc)
+    users = []
     for k, e in enumerate(events):
         if hasattr(e, "stick_plane"):
             plane[k] = int(e.stick_plane)
-        else:
-            for attr in ("coefficients", "offset"):
-                if not hasattr(e, attr):
-                    raise TypeError(f"events[{k}] = {e!r} is neither a linear event "
-                                    "(`coefficients` and `offset`: g(y) = coefficients . y "
-                                    "+ offset) nor a stick-release event (`stick_plane`)")
+        elif hasattr(e, "coefficients"):
             coef[k] = _vector(f"events[{k}].coefficients", e.coefficients, n)
-        offset[k] = float(getattr(e, "offset", 0.0))
+            offset[k] = float(getattr(e, "offset", 0.0))
+        elif callable(e):
+            plane[k] = -2 - len(users)
+            users.append(e)
+        else:
+            raise TypeError(f"events[{k}] = {e!r} is neither a linear event (`coefficients` "
+                            "and `offset`: g(y) = coefficients . y + offset), a stick-release "
+                            "event (`stick_plane`) nor a callable g(t, y)")
+        if hasattr(e, "stick_plane"):
+            offset[k] = float(getattr(e, "offset", 0.0))
         terminal[k] = bool(getattr(e, "terminal", False))
         dirn = float(getattr(e, "direction", 0))
         direction[k] = (dirn > 0) - (dirn < 0)
-    return m, coef, offset, terminal, direction, plane
+    return m, coef, offset, terminal, direction, plane, users
 
 
 cdef object _run(radau5_problem *p, int n, int m):
     cdef radau5_result r
     cdef int rc
     cdef double[::1] tv, htv
-    cdef double[:, ::1] yv, hyv
+    cdef double[:, ::1] yv, hyv, dtv, dcv
     cdef int[::1] hev
     with nogil:
         rc = radau5_solve(p, &r)
     try:
         if rc != 0:
             raise MemoryError(r.message.decode())
+        dense = None
+        if p.dense_output:
+            dense_t = np.empty((r.n_dense, 2))
+            dense_c = np.empty((r.n_dense, 4 * n))
+            if r.n_dense:
+                dtv = dense_t
+                dcv = dense_c
+                memcpy(&dtv[0, 0], r.dense_t, r.n_dense * 2 * sizeof(double))
+                memcpy(&dcv[0, 0], r.dense_c, r.n_dense * 4 * n * sizeof(double))
+            dense = (dense_t, dense_c)
         t = np.empty(r.n_out)
         y = np.empty((r.n_out, n))
         if r.n_out:
@@ -226,12 +272,13 @@ cdef object _run(radau5_problem *p, int n, int m):
     y_events = [hit_y[hit_event == k].reshape(-1, n) for k in range(m)]
     return OptimizeResult(t=t, y=np.ascontiguousarray(y.T), t_events=t_events,
                           y_events=y_events, status=status, message=message,
-                          success=status >= 0, sol=None, **counts)
+                          success=status >= 0, sol=None, dense=dense, **counts)
 
 
 cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    rtol, atol, max_step, t_eval, events, first_step, max_nfev,
-                   radau5_event_fun event_fun=NULL, int[::1] event_plane=None):
+                   radau5_event_fun event_fun=NULL, int[::1] event_plane=None,
+                   list users=None, bint dense_output=False):
     cdef radau5_problem p
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
         raise ValueError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
@@ -240,12 +287,15 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     t0, t1, rtol, atol_v, max_step, t_eval, first = _options(
         n, t0, t1, rtol, atol, max_step, t_eval, first_step)
     y0 = _vector("y0", y0, n)
-    m, coef, offset, terminal, direction, plane = _event_arrays(list(events or ()), n)
+    m, coef, offset, terminal, direction, plane, found = _event_arrays(list(events or ()), n)
     if event_plane is not None:   # the system evaluates its own events: it reads the planes
         np.asarray(event_plane)[:plane.size] = plane
-    elif np.any(plane[:m] >= 0):
-        raise TypeError("stick-margin events need ballc's system (solve_system)")
-    nonlinear = np.ascontiguousarray(plane >= 0, dtype=np.intc)
+        users.extend(found)
+    elif np.any(plane[:m] != -1):
+        raise TypeError("this system takes linear events only (`coefficients` and "
+                        "`offset`): stick-release and callable events need ballc's "
+                        "system (solve_system)")
+    nonlinear = np.ascontiguousarray(plane != -1, dtype=np.intc)
     cdef double[::1] y0v = y0, atolv = atol_v, offv = offset
     cdef double[:, ::1] coefv = coef
     cdef int[::1] termv = terminal, dirv = direction, nlv = nonlinear
@@ -278,21 +328,28 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.ev_direction = &dirv[0]
     p.ev_nonlinear = &nlv[0]
     p.ev_fun = event_fun
+    p.dense_output = dense_output
     return _run(&p, n, m)
 
 
 def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
-                 max_step=np.inf, t_eval=None, events=(), first_step=None, max_nfev=None):
+                 max_step=np.inf, t_eval=None, events=(), first_step=None, max_nfev=None,
+                 dense_output=False):
     """Integrate ballc's equations (N_STATES states) over ``t_span`` with radau5.
 
     ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
     ``_core.System``.  ``events``: objects with ``coefficients`` (N_STATES),
     ``offset``, ``terminal`` and ``direction`` -- g(y) = coefficients . y + offset --
     or with ``stick_plane`` (0 floor, 1 ceiling) instead of ``coefficients``: the
-    stick-to-slip margin mu N - |lambda| + offset of that plane, evaluated in C.
+    stick-to-slip margin mu N - |lambda| + offset of that plane, evaluated in C; or
+    any other callable g(t, y) with optional ``terminal``/``direction`` (called from C
+    with the GIL; an exception it raises is re-raised after the integration).
     Returns a solve_ivp-shaped OptimizeResult (t, y, t_events, y_events, status,
-    message, success, nfev, njev, nlu) plus nstep and nreject.  ``max_nfev``: give
-    up (status -1, with what was computed) after that many right-hand-side calls.
+    message, success, nfev, njev, nlu) plus nstep and nreject, and ``dense``: with
+    ``dense_output``, (dense_t (steps x 2: t_old, t), dense_c (steps x 4 N_STATES:
+    y_old then 3 coefficients per state, y = y_old + sum_j c_j x^(j+1))), else None.
+    ``max_nfev``: give up (status -1, with what was computed) after that many
+    right-hand-side calls.
     """
     cdef ball_ctx ctx
     params = _vector("params", params, BALLC_N_PARAMETERS)
@@ -303,8 +360,15 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ctx.latch = &lv[0]
     ctx.flags = flags
     ctx.event_plane = &planes[0]
-    return _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
-                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes)
+    users, errors = [], []
+    ctx.user_events = <void *>users
+    ctx.errors = <void *>errors
+    sol = _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
+                 max_step, t_eval, events, first_step, max_nfev, _ball_event, planes,
+                 users, bool(dense_output))
+    if errors:
+        raise errors[0]
+    return sol
 
 
 def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),

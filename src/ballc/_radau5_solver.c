@@ -70,7 +70,7 @@ typedef struct {
     /* events */
     double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */
     int *active, *count;
-    size_t cap_out, cap_hits;
+    size_t cap_out, cap_hits, cap_dense;
 } solver_t;
 
 /* common.norm: RMS norm. */
@@ -444,6 +444,30 @@ static int store_hit(solver_t *s, int event, double t, const double *y)
     return 0;
 }
 
+/* The last accepted step's interpolant, for dense output over the whole run. */
+static int store_dense(solver_t *s)
+{
+    radau5_result *r = s->r;
+    const int n = s->n;
+    if ((size_t)r->n_dense == s->cap_dense) {
+        size_t cap = s->cap_dense ? 2 * s->cap_dense : 256;
+        double *tt = realloc(r->dense_t, cap * 2 * sizeof(double));
+        if (!tt) return -1;
+        r->dense_t = tt;
+        double *cc = realloc(r->dense_c, cap * 4 * (size_t)n * sizeof(double));
+        if (!cc) return -1;
+        r->dense_c = cc;
+        s->cap_dense = cap;
+    }
+    r->dense_t[2 * r->n_dense] = s->t_old;
+    r->dense_t[2 * r->n_dense + 1] = s->t;
+    double *c = r->dense_c + (size_t)r->n_dense * 4 * n;
+    memcpy(c, s->y_old, n * sizeof(double));
+    memcpy(c + n, s->Q, 3 * (size_t)n * sizeof(double));
+    r->n_dense++;
+    return 0;
+}
+
 /* ---- events ---- */
 
 /* g_e(t, y): c . y + offset, or the system's event function + offset, as solve_ivp
@@ -612,7 +636,9 @@ void radau5_free(radau5_result *r)
 {
     free(r->t_out); free(r->y_out);
     free(r->hit_event); free(r->hit_t); free(r->hit_y);
-    r->t_out = r->y_out = r->hit_t = r->hit_y = NULL;
+    free(r->dense_t); free(r->dense_c);
+    r->t_out = r->y_out = r->hit_t = r->hit_y = r->dense_t = r->dense_c = NULL;
+    r->n_dense = 0;
     r->hit_event = NULL;
     r->n_out = r->n_hits = 0;
 }
@@ -698,6 +724,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
             r->status = RADAU5_FAILED;
             break;
         }
+        if (p->dense_output && store_dense(&s) != 0) goto oom;
         int finished = s.direction * (s.t - p->t_bound) >= 0;
         double t_out = s.t;
         const double *y_out = s.y;

@@ -52,6 +52,7 @@ typedef struct {
     radau5_event_fun ev_fun;  /* may be NULL when no event is non-linear */
     const int *ev_terminal;   /* nonzero: stop at the first occurrence */
     const int *ev_direction;  /* +1 rising only, -1 falling only, 0 both */
+    int dense_output;         /* nonzero: keep every step's interpolant (dense_t, dense_c) */
 } radau5_problem;
 
 enum { RADAU5_REACHED = 0, RADAU5_EVENT = 1, RADAU5_FAILED = -1 };
@@ -67,6 +68,10 @@ typedef struct {
     int *hit_event;
     double *hit_t;
     double *hit_y;            /* n_hits x n */
+    long n_dense;             /* with dense_output: accepted steps, each (t_old, t) in */
+    double *dense_t;          /*   dense_t (n_dense x 2) and y_old then the 3 coefficients */
+    double *dense_c;          /*   per state in dense_c (n_dense x 4n): y(t) = y_old +
+                               *   sum_j Q_j x^(j+1), x = (t - t_old) / (t - t_old) */
 } radau5_result;
 
 /* Integrate; returns 0, or -1 when memory ran out (result->message says so).

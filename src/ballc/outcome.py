@@ -10,6 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _core
+
+PLANES = ("floor", "ceiling")
+
 #: Contacts of the classic experiment: floor, table underside, floor.
 CAME_BACK_AFTER_CONTACTS = 3
 
@@ -73,3 +77,70 @@ def format_summary(result) -> str:
     lines.append(f"the ball {verdict} (x-velocity after the first {CAME_BACK_AFTER_CONTACTS} "
                  f"contacts vs. the throw)")
     return "\n".join(lines)
+
+
+# ---- post-processing of a finished run (simulate calls these) ----
+
+def balance_warning(result, rtol):
+    """A warning for the message when the integrated energy balance does not close.
+
+    kinetic + potential + spring + dissipated is conserved by the equations for every
+    model (dissipation is integrated with the motion), so a drift beyond what the
+    tolerances allow is an integration artefact, not physics: say so.
+    """
+    balance = result.energy["balance"]
+    scale = max(abs(balance[0]), 1.0)
+    drift = float(np.max(np.abs(balance - balance[0])))
+    allowed = max(1e-6, 1e3 * float(np.max(rtol))) * scale
+    if not drift > allowed:
+        return ""
+    return (f" Warning: the energy balance (kinetic + potential + spring + dissipated) "
+            f"drifted by {drift:.3g} J ({drift / scale:.2g} of the initial energy): the "
+            "integration is not accurate at this tolerance, so neither is this result; "
+            "tighten rtol/atol.")
+
+
+#: |F_t| >= STICK_SLIP_THRESHOLD * mu F_n counts as slipping (at the Coulomb cap).
+STICK_SLIP_THRESHOLD = 0.999
+
+
+def summarize_contact_forces(result):
+    """Peak normal force and sticking / slipping time of every contact, from the
+    stored samples (solver steps, or t_eval: the resolution is that of the samples);
+    with exact Coulomb friction the sticking and slipping times come from the
+    transition events instead."""
+    scene = result.scene
+    params = scene.parameter_vector()
+    mu = scene.friction_coefficient
+    # one C call over every stored sample, each with its segment's latch and flags
+    all_forces = _core.contact_forces_per_sample(
+        np.ascontiguousarray(result.y.T), params, np.ascontiguousarray(result.latch.T),
+        np.ascontiguousarray(result.flags, dtype=np.int32))
+    for contact in result.contacts:
+        end = contact.t_end if np.isfinite(contact.t_end) else result.t[-1]
+        inside = np.flatnonzero((result.t >= contact.t_start) & (result.t <= end))
+        if inside.size == 0:
+            continue
+        k = PLANES.index(contact.plane)
+        normal = 1.0 if contact.plane == "floor" else -1.0
+        forces = all_forces[inside, 3 * k:3 * k + 3]
+        f_n = forces[:, 2] * normal
+        f_t = np.hypot(forces[:, 0], forces[:, 1])
+        contact.peak_normal_force = float(f_n.max())
+        if contact.transitions:   # exact Coulomb friction: the phases are events
+            contact.time_sticking, contact.time_slipping = _phase_times(contact, end)
+            continue
+        slipping = (f_t >= STICK_SLIP_THRESHOLD * mu * f_n) & (f_n > 0)
+        t = result.t[inside]
+        dt = np.diff(t)
+        slip_fraction = 0.5 * (slipping[1:].astype(float) + slipping[:-1])
+        contact.time_slipping = float(np.sum(dt * slip_fraction))
+        contact.time_sticking = float(np.sum(dt) - contact.time_slipping)
+
+
+def _phase_times(contact, end):
+    """(time sticking, time slipping) from a contact's transition events (s)."""
+    starts = [t for t, _ in contact.transitions] + [end]
+    durations = np.diff(starts)
+    sticking = sum(d for d, (_, phase) in zip(durations, contact.transitions) if phase == "stick")
+    return float(sticking), float(end - contact.t_start - sticking)

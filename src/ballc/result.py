@@ -103,6 +103,12 @@ class Result:
     #: (N_LATCH, n): its latched contact values (see ``ballc._core.FLAGS``/``LATCH_NAMES``).
     flags: np.ndarray | None = field(default=None, repr=False)
     latch: np.ndarray | None = field(default=None, repr=False)
+    #: solve_ivp's: per user event (simulate's ``events``), its times (s) and states
+    t_events: list | None = field(default=None, repr=False)
+    y_events: list | None = field(default=None, repr=False)
+    #: with ``dense_output=True``: sol(t), the continuous solution over [0, t[-1]]
+    #: (a ballc.dense.PiecewiseSolution), else None
+    sol: object = field(default=None, repr=False)
 
     @property
     def success(self) -> bool:

@@ -90,35 +90,6 @@ def force_scale(scene, load) -> float:
     return 64 * np.finfo(float).eps * (weight + abs(load))
 
 
-class StickRelease:
-    """The stick-to-slip event of ``plane``: g = mu N - |lambda| + offset (N).
-
-    Callable like a solve_ivp event (evaluated through ``_core``); radau5 reads
-    ``stick_plane`` and ``offset`` and evaluates it in C.
-    """
-
-    __slots__ = ("stick_plane", "offset", "terminal", "direction", "_params", "_latch",
-                 "_flags")
-
-    def __init__(self, plane: str, params, latch, flags: int, offset: float):
-        self.stick_plane = PLANES.index(plane)
-        self.offset = float(offset)
-        self.terminal = True
-        self.direction = -1
-        self._params = np.ascontiguousarray(params, dtype=float)
-        self._latch = np.array(latch, dtype=float)
-        self._flags = int(flags)
-
-    def __call__(self, t, y):
-        y = np.ascontiguousarray(y, dtype=float)
-        return float(_core.stick_state(y, self._params, self._latch, self._flags,
-                                       self.stick_plane)[3]) + self.offset
-
-    def __repr__(self):
-        return (f"StickRelease({PLANES[self.stick_plane]}: mu N - |lambda| + "
-                f"{self.offset:g})")
-
-
 def slip_stop_coefficients(params, plane: str, direction) -> np.ndarray:
     """Coefficients c of the stop event u . d = c . y (u is linear in the state)."""
     return np.asarray(direction, dtype=float) @ _core.slip_map(params, PLANES.index(plane))

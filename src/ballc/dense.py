@@ -1,0 +1,75 @@
+"""Dense output: a continuous solution y(t) over a whole run, piecewise across events.
+
+Each segment between events has its integrator's own interpolant (radau5: the
+collocation polynomial of every step, as scipy's ``RadauDenseOutput``; scipy's
+methods: their ``OdeSolution``).  :class:`PiecewiseSolution` joins them the way
+scipy's ``OdeSolution`` joins steps: ``sol(t)`` for a scalar t gives the state
+(N_STATES,), for an array of times (N_STATES, len(t)).  At an event time shared by
+two segments the later segment is used (the state after a latch or a projection).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+class Radau5Interpolant:
+    """radau5's dense output of one segment: per step (t_old, t) and, per state,
+    y(t) = y_old + c1 x + c2 x^2 + c3 x^3 with x = (t - t_old) / (t_new - t_old)."""
+
+    def __init__(self, steps, coefficients):
+        self.steps = np.asarray(steps, dtype=float).reshape(-1, 2)
+        n4 = np.asarray(coefficients).shape[1] if np.ndim(coefficients) == 2 else 0
+        self.n = n4 // 4
+        c = np.asarray(coefficients, dtype=float).reshape(len(self.steps), 4 * self.n)
+        self.y_old = c[:, :self.n]
+        self.q = c[:, self.n:].reshape(len(self.steps), self.n, 3)
+        self.t_min = float(self.steps[0, 0]) if len(self.steps) else np.nan
+        self.t_max = float(self.steps[-1, 1]) if len(self.steps) else np.nan
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        scalar = t.ndim == 0
+        tt = np.atleast_1d(t)
+        k = np.clip(np.searchsorted(self.steps[:, 1], tt, side="left"), 0, len(self.steps) - 1)
+        t_old, t_new = self.steps[k, 0], self.steps[k, 1]
+        x = (tt - t_old) / (t_new - t_old)
+        q = self.q[k]                                   # (m, n, 3)
+        y = self.y_old[k] + x[:, None] * (q[:, :, 0] + x[:, None] * (
+            q[:, :, 1] + x[:, None] * q[:, :, 2]))
+        return y[0] if scalar else y.T
+
+
+class PiecewiseSolution:
+    """y(t) over [t_start, t_end] of a run, from the interpolants of its segments."""
+
+    def __init__(self, pieces):
+        """``pieces``: [(t0, t1, interpolant)] in time order, t1 of one = t0 of the next."""
+        self.pieces = [(float(a), float(b), f) for a, b, f in pieces if b >= a]
+        self.t_min = self.pieces[0][0] if self.pieces else np.nan
+        self.t_max = self.pieces[-1][1] if self.pieces else np.nan
+        self._ends = np.array([b for _, b, _ in self.pieces])
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        scalar = t.ndim == 0
+        tt = np.atleast_1d(t)
+        if not self.pieces:
+            raise ValueError("no dense output: the run integrated nothing")
+        if np.any((tt < self.t_min) | (tt > self.t_max)) or not np.all(np.isfinite(tt)):
+            raise ValueError(f"t = {t!r} is outside the run's interval "
+                             f"[{self.t_min}, {self.t_max}]")
+        which = np.searchsorted(self._ends, tt, side="right")
+        which = np.minimum(which, len(self.pieces) - 1)
+        out = None
+        for k in np.unique(which):
+            mask = which == k
+            values = np.asarray(self.pieces[k][2](tt[mask]))
+            values = values.reshape(-1, 1) if values.ndim == 1 else values
+            if out is None:
+                out = np.empty((values.shape[0], tt.size))
+            out[:, mask] = values
+        return out[:, 0] if scalar else out
+
+    def __repr__(self):
+        return (f"PiecewiseSolution({len(self.pieces)} segments over "
+                f"[{self.t_min:.6g}, {self.t_max:.6g}] s)")

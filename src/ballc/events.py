@@ -1,0 +1,165 @@
+"""Event functions of the driver and the thresholds that keep segments off their zeros.
+
+Every event is callable like a solve_ivp event, ``event(t, y)``, with solve_ivp's
+``terminal`` and ``direction`` attributes, so scipy's methods take them as they are;
+radau5 evaluates them in C: :class:`LinearEvent` from its coefficients (on a step
+g(t) is a cubic), :class:`StickRelease` through the system (the stick force needs the
+equations of motion).
+
+A segment's events (:func:`segment_events`): contact start on each plane out of
+contact; contact end, passing through and the deepest point on each plane in contact;
+and, with exact Coulomb friction (ballc.stickslip), the slip-mode events (approach,
+stop, clear) or the stick-mode release.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core, stickslip
+
+PLANES = ("floor", "ceiling")
+_STATE = _core.STATE_INDEX
+
+
+class LinearEvent:
+    """An event that is a linear functional of the state: g(y) = coefficients . y + offset.
+
+    Callable like a solve_ivp event, ``event(t, y)``, with solve_ivp's ``terminal``
+    and ``direction`` attributes; radau5 reads ``coefficients`` and ``offset`` and
+    evaluates it in C.  Every event of the driver is of this form.
+    """
+
+    __slots__ = ("coefficients", "offset", "terminal", "direction", "_index", "_scale")
+
+    def __init__(self, coefficients, offset=0.0, terminal=False, direction=0):
+        self.coefficients = np.array(coefficients, dtype=float)
+        if self.coefficients.shape != (_core.N_STATES,):
+            raise ValueError(f"coefficients must have shape ({_core.N_STATES},), "
+                             f"got {self.coefficients.shape}")
+        self.offset = float(offset)
+        self.terminal = bool(terminal)
+        self.direction = direction
+        nonzero = np.flatnonzero(self.coefficients)
+        # one state only (all of the driver's): skip the dot product when called
+        self._index = int(nonzero[0]) if nonzero.size == 1 else None
+        self._scale = float(self.coefficients[nonzero[0]]) if nonzero.size == 1 else 0.0
+
+    @classmethod
+    def of_state(cls, name, scale=1.0, offset=0.0, terminal=False, direction=0):
+        """g(y) = scale * y[name] + offset."""
+        coefficients = np.zeros(_core.N_STATES)
+        coefficients[_STATE[name]] = scale
+        return cls(coefficients, offset, terminal, direction)
+
+    def shifted(self, delta, terminal, direction):
+        """g(y) + delta, with its own terminal and direction."""
+        return LinearEvent(self.coefficients, self.offset + delta, terminal, direction)
+
+    def __call__(self, t, y):
+        if self._index is not None:
+            return self._scale * y[self._index] + self.offset
+        return float(self.coefficients @ y) + self.offset
+
+    def __repr__(self):
+        terms = " + ".join(f"{c:g}*{_core.STATE_NAMES[i]}"
+                           for i, c in enumerate(self.coefficients) if c)
+        return (f"LinearEvent({terms} + {self.offset:g}, terminal={self.terminal}, "
+                f"direction={self.direction})")
+
+
+def penetration(plane, scene):
+    """rho(y) of ``plane`` (a LinearEvent): positive when the ball overlaps it (m)."""
+    r, h = scene.radius, scene.ceiling_height
+    if plane == "floor":
+        return LinearEvent.of_state("z", -1.0, r)
+    return LinearEvent.of_state("z", 1.0, -(h - r))
+
+
+def contact_threshold(scene, plane, rho0, entering):
+    """How far past rho = 0 a contact's start (or end) event sits, for a segment that
+    starts at penetration ``rho0`` (m).
+
+    The event is g = rho - threshold (start) or rho + threshold (end), and the threshold
+    puts g(t0) strictly (by >= 4 ulp of the boundary height) on the near side of its
+    zero.  Without it a segment starting on a boundary sits on the ~1-ulp plateau where
+    rho rounds to exactly 0, which the event search counts as a crossing at t0: a ball
+    leaving slowly would "re-enter" at once while still moving away, then "leave"
+    again, one ulp per segment, for ever.  A segment that starts a little on the far
+    side (an event root located to ~1e-14 m) raises the threshold past rho0, so that a
+    crossing within the first step cannot be masked by a second one.  The thresholds
+    are of order 1e-15 .. 1e-13 m: the contact force they leave out is negligible.
+    """
+    boundary = scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
+    base = 4 * np.spacing(boundary)
+    far_side = rho0 if entering else -rho0
+    return max(base, far_side + base)
+
+
+def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
+                    clear=0.0):
+    """Events of one segment starting at state y0: [(kind, plane, event)].
+
+    ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
+    see ballc.stickslip), ``clear`` the slip speed (m/s) below which the slip
+    direction is held fixed.  The stop and release events sit a rounding-level margin
+    past their zero, so that a segment starting on it (slip from rest, a stick that
+    starts at the cone) does not fire at once.
+    """
+    events = []
+    for plane in PLANES:
+        rho = penetration(plane, scene)
+        rho0 = rho(0.0, y0)
+        if in_contact[plane]:
+            normal = 1.0 if plane == "floor" else -1.0
+            threshold = contact_threshold(scene, plane, rho0, entering=False)
+            events.append(("leave", plane, rho.shifted(threshold, True, -1)))
+            events.append(("through", plane, rho.shifted(-scene.radius, True, 1)))
+            events.append(("deepest", plane,
+                           LinearEvent.of_state("vz", -normal, 0.0, False, -1)))
+        else:
+            threshold = contact_threshold(scene, plane, rho0, entering=True)
+            events.append(("enter", plane, rho.shifted(-threshold, True, 1)))
+        mode = coulomb[plane] if coulomb else None
+        if mode in ("slip", "slip_fixed"):
+            k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE + stickslip._SLIP_DIRECTION
+            along = stickslip.slip_stop_coefficients(params, plane, latch[k:k + 2])
+            if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
+                events.append(("approach", plane, LinearEvent(along, -clear, True, -1)))
+            else:                # fixed direction: stop at u . d = 0, or go free at 2 clear
+                margin = 4 * np.spacing(stickslip.speed_scale(scene, y0))
+                events.append(("stop", plane, LinearEvent(along, margin, True, -1)))
+                events.append(("clear", plane, LinearEvent(along, -2 * clear, True, 1)))
+        elif mode == "stick":
+            load = _core.stick_state(y0, params, latch, flags, PLANES.index(plane))[2]
+            events.append(("release", plane, StickRelease(
+                plane, params, latch, flags, stickslip.force_scale(scene, load))))
+    return events
+
+
+class StickRelease:
+    """The stick-to-slip event of ``plane``: g = mu N - |lambda| + offset (N).
+
+    Callable like a solve_ivp event (evaluated through ``_core``); radau5 reads
+    ``stick_plane`` and ``offset`` and evaluates it in C.
+    """
+
+    __slots__ = ("stick_plane", "offset", "terminal", "direction", "_params", "_latch",
+                 "_flags")
+
+    def __init__(self, plane: str, params, latch, flags: int, offset: float):
+        self.stick_plane = PLANES.index(plane)
+        self.offset = float(offset)
+        self.terminal = True
+        self.direction = -1
+        self._params = np.ascontiguousarray(params, dtype=float)
+        self._latch = np.array(latch, dtype=float)
+        self._flags = int(flags)
+
+    def __call__(self, t, y):
+        y = np.ascontiguousarray(y, dtype=float)
+        return float(_core.stick_state(y, self._params, self._latch, self._flags,
+                                       self.stick_plane)[3]) + self.offset
+
+    def __repr__(self):
+        return (f"StickRelease({PLANES[self.stick_plane]}: mu N - |lambda| + "
+                f"{self.offset:g})")

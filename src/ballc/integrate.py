@@ -1,0 +1,91 @@
+"""The one seam between the driver and an integrator: integrate one smooth segment.
+
+``method`` "radau5" runs ballc's compiled Radau IIA (scipy's Radau, step by step in
+C) on the system's C right-hand side and Jacobian; any other is handed to scipy's
+``solve_ivp`` (with the analytic Jacobian when implicit).  scipy has no call budget
+of its own: :func:`_call_budget` gives it one as a terminal event.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from . import _radau5, dense
+from .options import IMPLICIT_METHODS
+
+
+def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval, max_step,
+                      max_nfev=None, first_step=None, dense_output=False):
+    """Integrate one smooth segment; returns a solve_ivp-style solution.
+
+    This is the one seam between the driver and an integrator.  The solution has
+    ``t, y, t_events, y_events, status (0 reached t1, 1 terminal event, -1 failure),
+    message, nfev, njev, nlu`` and, with ``dense_output``, ``interpolant``: a callable
+    y(t) over [t0, t_last] (see ballc.dense).  Events are callables g(t, y) with
+    ``terminal`` and ``direction``: :class:`ballc.events.LinearEvent` and
+    :class:`ballc.events.StickRelease`, which radau5 evaluates in C, or any other
+    (a user's), which it calls back.  ``max_nfev``: give up (status -1, keeping what
+    was computed) after that many right-hand-side calls.
+    """
+    if method == "radau5":
+        sol = _radau5.solve_system(system.params, system.latch, system.flags, (t0, t1), y0,
+                                   rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
+                                   events=events, max_nfev=max_nfev, first_step=first_step,
+                                   dense_output=dense_output)
+        if dense_output:
+            sol.interpolant = dense.Radau5Interpolant(*sol.dense)
+        return sol
+    options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
+    if first_step is not None:
+        options["first_step"] = min(first_step, t1 - t0)
+    budget = [_call_budget(system, max_nfev)] if max_nfev is not None else []
+    sol = solve_ivp(system, (t0, t1), y0, method=method, rtol=rtol, atol=atol,
+                    t_eval=t_eval, events=list(events) + budget, max_step=max_step,
+                    dense_output=dense_output, **options)
+    # solve_ivp leaves t and y as empty lists when no t_eval point fell in the segment
+    sol.t = np.asarray(sol.t, dtype=float)
+    sol.y = np.asarray(sol.y, dtype=float).reshape(len(y0), sol.t.size)
+    if dense_output:
+        sol.interpolant = sol.sol
+    if budget:
+        if len(sol.t_events[-1]):
+            sol.status = -1
+            sol.message = (f"gave up at t = {sol.t[-1]:.9g} after {sol.nfev} right-hand-side "
+                           "evaluations (max_nfev)")
+        sol.t_events, sol.y_events = sol.t_events[:-1], sol.y_events[:-1]
+    return sol
+
+
+def _call_budget(system, max_nfev):
+    """A terminal solve_ivp event that stops the integration gracefully at the end of
+    the first step after which ``system`` has been called ``max_nfev`` more times
+    (solve_ivp has no call budget of its own).  It is +1 before that step's end time
+    and -1 from it on, so the event search puts the root at that step's end."""
+    start, stop = system.nfev, []
+
+    def g(t, y):
+        if not stop and system.nfev - start >= max_nfev:
+            stop.append(t)
+        return -1.0 if stop and t >= stop[0] else 1.0
+    return _event(g, True, -1)
+
+
+def _event(function, terminal, direction):
+    function.terminal = terminal
+    function.direction = direction
+    return function
+
+
+def failure_hint(scene, in_contact):
+    """Why a contact segment may defeat the integrator, when the cause is the usual one:
+    the seed's regularised Coulomb law ("max", "smooth") with a small v_s."""
+    if not any(in_contact.values()) or scene.tangential_model not in ("friction", "mixture"):
+        return ""
+    if scene.friction_coefficient == 0 or scene.effective_mixture == 1:
+        return ""
+    if scene.friction_regularization == "exact":
+        return ""
+    return (f" (in contact with regularised Coulomb friction: below the regularisation "
+            f"speed {scene.friction_regularization_speed:g} m/s friction is a viscous law "
+            "of coefficient mu F_n / v_s, too stiff to resolve for hard materials or loose "
+            "tolerances; use friction_regularization='exact' (the default), or tighter rtol)")
