@@ -25,6 +25,8 @@ def test_serial_table_has_one_row_per_combination(serial):
         == [(0.0, 0.0), (0.0, 0.1), (1.0, 0.0), (1.0, 0.1)]
     for column in ("contacts", "came_back", "energy_lost", "status", "message", "final_height"):
         assert column in serial
+    # 0.7 s of the seed throw: its floor (t = 0.156 s) and ceiling (0.575 s) contacts, as
+    # the seed's own run has them (shared NOTES); the next floor contact is at 1.03 s
     assert (serial["status"] == 0).all() and (serial["contacts"] == 2).all()
     one = ballc.simulate(BASE.replace(mixture=1.0, friction_coefficient=0.1), T_END)
     assert serial["final_height"].iloc[3] == one.position[2, -1]

@@ -5,8 +5,7 @@
 >>> print(result.contact_table())
 """
 from ._core import PARAMETER_NAMES, STATE_NAMES
-from .io import load
-from .result import Contact, Result
+from .result import Contact, Result, load
 from .rigid import RigidImpact, hunt_crossley_restitution, rigid_impact
 from .scene import TANGENTIAL_MODELS, Scene, SceneError
 from .simulate import simulate

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _core, stickslip
+from . import _core, layout, stickslip
 
 PLANES = ("floor", "ceiling")
-_STATE = _core.STATE_INDEX
+_STATE = layout.INDEX
 
 
 class LinearEvent:

@@ -6,10 +6,12 @@ solver's status, the scene (as JSON) and provenance (ballc version, generator ve
 of the compiled kernels, numpy/Python versions, creation time in UTC).
 
 >>> result.save("seed.npz");  again = ballc.load("seed.npz")
+
+This module knows the file formats only; how a Result becomes arrays and back is
+result.py's (so result.py uses io.py, never the other way round).
 """
 from __future__ import annotations
 
-import dataclasses
 import datetime
 import json
 import platform
@@ -19,11 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from . import _core
-from .result import Contact, Result
-from .scene import Scene
 
 FORMAT = "ballc-result-1"
-_CONTACT_FIELDS = [f.name for f in dataclasses.fields(Contact)]
 
 
 def provenance() -> dict:
@@ -33,41 +32,6 @@ def provenance() -> dict:
             "generator_version": _core.GENERATOR_VERSION, "numpy_version": np.__version__,
             "python_version": platform.python_version(),
             "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat()}
-
-
-def _contact_arrays(contacts) -> dict:
-    """contact_<field> -> array over contacts ((k,) or (k, 3))."""
-    arrays = {}
-    for name in _CONTACT_FIELDS:
-        values = [getattr(c, name) for c in contacts]
-        if name == "plane":
-            arrays[name] = np.array(values, dtype=str)
-        elif name == "transitions":   # variable length: one JSON text per contact
-            arrays[name] = np.array([json.dumps(v) for v in values], dtype=str)
-        elif values and np.ndim(values[0]) == 1:
-            arrays[name] = np.array(values, dtype=float).reshape(len(values), -1)
-        else:
-            arrays[name] = np.array(values, dtype=float)
-    return arrays
-
-
-def _contacts_from(arrays: dict) -> list:
-    count = len(arrays["plane"])
-    contacts = []
-    for i in range(count):
-        values = {}
-        for name in _CONTACT_FIELDS:
-            value = arrays[name][i]
-            if name == "plane":
-                values[name] = str(value)
-            elif name == "transitions":
-                values[name] = [(float(t), str(mode)) for t, mode in json.loads(str(value))]
-            elif np.ndim(value) == 1:
-                values[name] = np.array(value, dtype=float)
-            else:
-                values[name] = float(value)
-        contacts.append(Contact(**values))
-    return contacts
 
 
 def _header(result) -> dict:
@@ -109,7 +73,7 @@ def save(result, path) -> None:
         _to_dataset(result).to_netcdf(path)
         return
     header = _header(result)
-    contacts = {f"contact_{k}": v for k, v in _contact_arrays(result.contacts).items()}
+    contacts = {f"contact_{k}": v for k, v in result.contact_arrays().items()}
     np.savez_compressed(
         path, t=result.t, y=result.y, state_names=np.array(result.state_names, dtype=str),
         flags=_or_empty(result.flags, np.int32), latch=_or_empty(result.latch, float),
@@ -121,29 +85,21 @@ def _or_empty(array, dtype):
     return np.zeros(0, dtype=dtype) if array is None else np.asarray(array, dtype=dtype)
 
 
-def load(path) -> Result:
-    """Read a Result written by :func:`save` (``.npz`` or ``.nc``; any other suffix raises
-    ValueError)."""
+def read(path) -> tuple[dict, dict, dict]:
+    """(header, arrays, contact arrays) of a file written by :func:`save` (``.npz`` or
+    ``.nc``; any other suffix raises ValueError); warns when it was made by another
+    layout or kernel version.  ``ballc.load`` turns them into a Result."""
     path = _checked_suffix(path, "load a Result from")
     if path.suffix == ".nc":
-        return _from_dataset(path)
-    with np.load(path, allow_pickle=False) as data:
-        header = json.loads(str(data["header"]))
-        contacts = {k[len("contact_"):]: data[k] for k in data.files if k.startswith("contact_")}
-        arrays = {k: data[k] for k in ("t", "y", "state_names", "flags", "latch")}
-    return _result(path, header, arrays, contacts)
-
-
-def _result(path, header, arrays, contacts) -> Result:
-    stored = json.loads(header["provenance"])
-    _check_provenance(path, stored, arrays["state_names"])
-    flags, latch = arrays["flags"], arrays["latch"]
-    return Result(t=arrays["t"], y=arrays["y"], scene=Scene.from_dict(json.loads(header["scene"])),
-                  status=int(header["status"]), message=str(header["message"]),
-                  nfev=int(header["nfev"]), njev=int(header["njev"]), nlu=int(header["nlu"]),
-                  contacts=_contacts_from(contacts),
-                  state_names=tuple(str(s) for s in arrays["state_names"]),
-                  flags=flags if flags.size else None, latch=latch if latch.size else None)
+        header, arrays, contacts = _read_dataset(path)
+    else:
+        with np.load(path, allow_pickle=False) as data:
+            header = json.loads(str(data["header"]))
+            contacts = {k[len("contact_"):]: data[k] for k in data.files
+                        if k.startswith("contact_")}
+            arrays = {k: data[k] for k in ("t", "y", "state_names", "flags", "latch")}
+    _check_provenance(path, json.loads(header["provenance"]), arrays["state_names"])
+    return header, arrays, contacts
 
 
 def _to_dataset(result):
@@ -156,7 +112,7 @@ def _to_dataset(result):
     if result.flags is not None:
         variables["flags"] = (("time",), np.asarray(result.flags, dtype=np.int32))
         variables["latch"] = (("latch_name", "time"), result.latch)
-    for name, values in _contact_arrays(result.contacts).items():
+    for name, values in result.contact_arrays().items():
         dims = ("contact", f"{name}_component") if values.ndim == 2 else ("contact",)
         variables[f"contact_{name}"] = (dims, values)
     coords = {"time": ("time", result.t, {"units": "s"}),
@@ -164,7 +120,7 @@ def _to_dataset(result):
     return xr.Dataset(variables, coords=coords, attrs=_header(result))
 
 
-def _from_dataset(path) -> Result:
+def _read_dataset(path):
     import xarray as xr
     with xr.open_dataset(path) as ds:
         ds.load()
@@ -176,4 +132,4 @@ def _from_dataset(path) -> Result:
                     if k.startswith("contact_")}
         header = dict(ds.attrs)
     contacts["plane"] = contacts["plane"].astype(str)
-    return _result(path, header, arrays, contacts)
+    return header, arrays, contacts

@@ -17,16 +17,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _core
+from . import _core, layout
 from .orientation import rotation_matrix
 
 #: 1 g in m/s^2 (standard gravity), the unit of the specific force outputs.
 STANDARD_GRAVITY = 9.80665
-
-
-def _rows(name: str, count: int = 3) -> slice:
-    first = _core.STATE_NAMES.index(name)
-    return slice(first, first + count)
 
 
 def state_derivatives(result) -> np.ndarray:
@@ -46,10 +41,10 @@ def state_derivatives(result) -> np.ndarray:
 def observer_acceleration(result) -> np.ndarray:
     """(3, n) inertial acceleration of the observer point (m/s^2)."""
     dydt = state_derivatives(result)
-    centre_acceleration = dydt[_rows("vx")]
-    angular_acceleration = dydt[_rows("omega_x")]
-    omega = result.y[_rows("omega_x")]
-    rho = result.observer_position - result.y[_rows("x")]
+    centre_acceleration = dydt[layout.VELOCITY]
+    angular_acceleration = dydt[layout.ANGULAR_VELOCITY]
+    omega = result.y[layout.ANGULAR_VELOCITY]
+    rho = result.observer_position - result.y[layout.POSITION]
     return (centre_acceleration + np.cross(angular_acceleration, rho, axis=0)
             + np.cross(omega, np.cross(omega, rho, axis=0), axis=0))
 
@@ -66,6 +61,6 @@ def specific_force(result, frame: str = "inertial") -> np.ndarray:
     force[2] += result.scene.gravity
     force /= STANDARD_GRAVITY
     if frame == "ball":
-        rotation = rotation_matrix(result.y[_rows("qw", 4)].T)      # v_N = R v_A
+        rotation = rotation_matrix(result.y[layout.QUATERNION].T)      # v_N = R v_A
         force = np.einsum("nji,jn->in", rotation, force)             # v_A = R^T v_N
     return force

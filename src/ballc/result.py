@@ -1,14 +1,15 @@
 """Result of a simulation: solve_ivp-shaped arrays plus named views, energies, contacts."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import json
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from . import _core
+from . import _core, layout
 from .orientation import angles_123_from_quaternion
 
-_STATE = _core.STATE_INDEX
+_STATE = layout.INDEX
 
 
 @dataclass
@@ -115,13 +116,10 @@ class Result:
         """True only when t_end was reached (status 0)."""
         return self.status == 0
 
-    def _rows(self, first, count=3):
-        return self.y[first:first + count]
-
     @property
     def quaternion(self) -> np.ndarray:
         """(4, n) unit quaternion (qw, qx, qy, qz), ball frame -> inertial."""
-        q = self._rows(_STATE["qw"], 4)
+        q = self.y[layout.QUATERNION]
         return q / np.linalg.norm(q, axis=0)
 
     @property
@@ -132,17 +130,17 @@ class Result:
     @property
     def position(self) -> np.ndarray:
         """(3, n) centre position (m)."""
-        return self._rows(_STATE["x"])
+        return self.y[layout.POSITION]
 
     @property
     def angular_velocity(self) -> np.ndarray:
         """(3, n) angular velocity, inertial components (rad/s)."""
-        return self._rows(_STATE["omega_x"])
+        return self.y[layout.ANGULAR_VELOCITY]
 
     @property
     def velocity(self) -> np.ndarray:
         """(3, n) centre velocity (m/s)."""
-        return self._rows(_STATE["vx"])
+        return self.y[layout.VELOCITY]
 
     @property
     def observer_position(self) -> np.ndarray:
@@ -246,6 +244,21 @@ class Result:
         from .io import save
         save(self, path)
 
+    def contact_arrays(self) -> dict:
+        """field -> array over the contacts ((k,) or (k, 3)): what files store."""
+        arrays = {}
+        for name in CONTACT_FIELDS:
+            values = [getattr(c, name) for c in self.contacts]
+            if name == "plane":
+                arrays[name] = np.array(values, dtype=str)
+            elif name == "transitions":   # variable length: one JSON text per contact
+                arrays[name] = np.array([json.dumps(v) for v in values], dtype=str)
+            elif values and np.ndim(values[0]) == 1:
+                arrays[name] = np.array(values, dtype=float).reshape(len(values), -1)
+            else:
+                arrays[name] = np.array(values, dtype=float)
+        return arrays
+
     def contact_table(self) -> str:
         """The contacts as a fixed-width text table; a second header line gives the units
         (times in s, penetration in m, centre velocities in m/s)."""
@@ -266,3 +279,40 @@ class Result:
         return (f"Result(status={self.status}, message={self.message!r}, "
                 f"t=[{self.t[0]:g} .. {self.t[-1]:g}] ({self.t.size} points), "
                 f"contacts={len(self.contacts)}, nfev={self.nfev}, njev={self.njev})")
+
+
+#: Contact fields, in the order files store them.
+CONTACT_FIELDS = [f.name for f in fields(Contact)]
+
+
+def _contacts_from(arrays: dict) -> list:
+    contacts = []
+    for i in range(len(arrays["plane"])):
+        values = {}
+        for name in CONTACT_FIELDS:
+            value = arrays[name][i]
+            if name == "plane":
+                values[name] = str(value)
+            elif name == "transitions":
+                values[name] = [(float(t), str(mode)) for t, mode in json.loads(str(value))]
+            elif np.ndim(value) == 1:
+                values[name] = np.array(value, dtype=float)
+            else:
+                values[name] = float(value)
+        contacts.append(Contact(**values))
+    return contacts
+
+
+def load(path) -> Result:
+    """Read a Result written by ``Result.save`` (``.npz`` or ``.nc``; any other suffix
+    raises ValueError)."""
+    from .io import read
+    from .scene import Scene
+    header, arrays, contacts = read(path)
+    flags, latch = arrays["flags"], arrays["latch"]
+    return Result(t=arrays["t"], y=arrays["y"], scene=Scene.from_dict(json.loads(header["scene"])),
+                  status=int(header["status"]), message=str(header["message"]),
+                  nfev=int(header["nfev"]), njev=int(header["njev"]), nlu=int(header["nlu"]),
+                  contacts=_contacts_from(contacts),
+                  state_names=tuple(str(s) for s in arrays["state_names"]),
+                  flags=flags if flags.size else None, latch=latch if latch.size else None)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _core, events as ev, modes, outcome, stickslip
+from . import _core, events as ev, layout, modes, outcome, stickslip
 from .dense import PiecewiseSolution
 from .integrate import failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (re-exported)
@@ -21,13 +21,9 @@ from .progress import progress_bar
 from .result import Contact, Result
 from .scene import Scene, SceneError
 
-PLANES = ("floor", "ceiling")
-_STATE = _core.STATE_INDEX
-_QUATERNION = slice(_STATE["qw"], _STATE["qw"] + 4)
-_OMEGA, _V = _STATE["omega_x"], _STATE["vx"]
-_DISSIPATED = [_STATE["dissipated_normal"], _STATE["dissipated_tangential"]]
-_DEFLECTION = {plane: [_STATE[f"{plane}_deflection_x"], _STATE[f"{plane}_deflection_y"]]
-               for plane in PLANES}
+PLANES = layout.PLANES
+_STATE = layout.INDEX
+_QUATERNION, _DISSIPATED, _DEFLECTION = layout.QUATERNION, layout.DISSIPATED, layout.DEFLECTION
 SUCCESS = "The solver successfully reached the end of the integration interval."
 
 
@@ -92,8 +88,8 @@ class _Run:
         self.latch[k + 1:k + 4] = direction
         y[_DEFLECTION[plane]] = 0.0      # the tangential spring starts relaxed
         self.in_contact[plane] = True
-        contact = Contact(plane=plane, t_start=self.t, velocity_before=y[_V:_V + 3].copy(),
-                          angular_velocity_before=y[_OMEGA:_OMEGA + 3].copy(),
+        contact = Contact(plane=plane, t_start=self.t, velocity_before=y[layout.VELOCITY].copy(),
+                          angular_velocity_before=y[layout.ANGULAR_VELOCITY].copy(),
                           penetration_rate_at_impact=rate, digin_direction=direction)
         record_depth(contact, ev.penetration(plane, self.scene)(0, y), y)
         self.open[plane] = contact
@@ -109,8 +105,8 @@ class _Run:
         self.coulomb[plane] = None
         contact = self.open.pop(plane)
         contact.t_end = self.t
-        contact.velocity_after = y[_V:_V + 3].copy()
-        contact.angular_velocity_after = y[_OMEGA:_OMEGA + 3].copy()
+        contact.velocity_after = y[layout.VELOCITY].copy()
+        contact.angular_velocity_after = y[layout.ANGULAR_VELOCITY].copy()
         lost = y[_DISSIPATED] - self.dissipated_at_start.pop(plane)
         contact.energy_lost_normal, contact.energy_lost_tangential = map(float, lost)
 

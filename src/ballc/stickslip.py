@@ -33,11 +33,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _core
+from . import _core, layout
 
 PLANES = ("floor", "ceiling")
-_STATE = _core.STATE_INDEX
-_OMEGA, _V = _STATE["omega_x"], _STATE["vx"]
 _LATCH = {name: i for i, name in enumerate(_core.LATCH_NAMES[:_core.N_LATCH_PER_PLANE])}
 _SLIP_DIRECTION = _LATCH["floor_slip_direction_x"]
 
@@ -73,8 +71,8 @@ def set_slip_direction(latch: np.ndarray, plane: str, direction) -> None:
 
 def speed_scale(scene, y) -> float:
     """|v| + r |omega| (m/s): the scale slip speeds are compared with."""
-    return float(np.linalg.norm(y[_V:_V + 3]) + scene.radius * np.linalg.norm(
-        y[_OMEGA:_OMEGA + 3])) + 1e-300
+    return float(np.linalg.norm(y[layout.VELOCITY]) + scene.radius * np.linalg.norm(
+        y[layout.ANGULAR_VELOCITY])) + 1e-300
 
 
 def clear_speed(scene, y, rtol, atol) -> float:
