@@ -1,6 +1,7 @@
 """Plant known defects, one at a time, and check that the default test suite catches each.
 
     python -m benchmarks.plant_defects [--only NAME ...] [--full] [--no-baseline] [--keep]
+                                       [--tests PATH ...]
 
 For each defect: copy the working tree (without .git, build products, caches) to a
 temporary directory, apply one text substitution (the pattern must occur exactly the
@@ -9,7 +10,8 @@ turn a planted defect into a silent no-op), regenerate the C kernels with
 ``python -m codegen`` when the defect is in codegen/ (and check that generated/ did
 change), rebuild the extensions (``python setup.py build_ext --inplace``) and run the
 default suite there (``python -m pytest -q -x -p no:cacheprovider``, PYTHONPATH = the
-copy's src; ``--full``: without -x, to count every failing test).  A clean copy is run
+copy's src; ``--full``: without -x, to count every failing test; ``--tests``: only
+these test files, e.g. to see which oracle tests catch what).  A clean copy is run
 first (the baseline) so that a "caught" cannot be a failure that was there already.
 
 Prints a table: defect, failing tests (with -x: 1 = caught, the first failing test
@@ -97,7 +99,7 @@ def summary_of(output: str):
             first.group(1) if first else "")
 
 
-def check_one(defect: Defect | None, full: bool, keep: bool, timeout: float):
+def check_one(defect: Defect | None, full: bool, keep: bool, timeout: float, tests=()):
     started = time.perf_counter()
     copy = Path(tempfile.mkdtemp(prefix="ballc-defect-")) / "repo"
     shutil.copytree(ROOT, copy, ignore=IGNORE)
@@ -128,6 +130,7 @@ def check_one(defect: Defect | None, full: bool, keep: bool, timeout: float):
         cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
         if not full:
             cmd.append("-x")
+        cmd.extend(tests)
         rc, out = run(cmd, copy, env, log, timeout)
         failing, passed, first = summary_of(out)
         if rc not in (0, 1):     # 2: interrupted, 3: internal error, 4: usage, 5: no tests
@@ -149,6 +152,8 @@ def main(argv=None):
     parser.add_argument("--no-baseline", action="store_true",
                         help="skip the run of the unmodified copy")
     parser.add_argument("--keep", action="store_true", help="keep the temporary copies")
+    parser.add_argument("--tests", nargs="*", default=[],
+                        help="test files or ids to run instead of the default suite")
     parser.add_argument("--timeout", type=float, default=1800,
                         help="seconds per command (default 1800)")
     args = parser.parse_args(argv)
@@ -159,7 +164,8 @@ def main(argv=None):
     for defect in ([None] if not args.no_baseline else []) + defects:
         name = defect.name if defect else "(baseline: no defect)"
         print(f"... {name}", flush=True)
-        failing, passed, first, seconds = check_one(defect, args.full, args.keep, args.timeout)
+        failing, passed, first, seconds = check_one(defect, args.full, args.keep,
+                                                    args.timeout, args.tests)
         if defect is None:
             verdict = "clean" if failing == 0 else "BASELINE FAILS"
         else:
@@ -168,7 +174,8 @@ def main(argv=None):
         print(f"    {verdict}: {failing} failing, {passed} passed, {seconds:.0f} s "
               f"{first}", flush=True)
 
-    mode = "whole suite" if args.full else "-x: stops at the first failure"
+    mode = ("whole suite" if args.full else "-x: stops at the first failure") + (
+        f"; only {' '.join(args.tests)}" if args.tests else "")
     print(f"\n| defect | verdict | failing tests ({mode}) | first failing test | time (s) |")
     print("|---|---|---|---|---|")
     for name, verdict, failing, passed, first, seconds in rows:
