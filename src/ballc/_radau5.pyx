@@ -423,3 +423,26 @@ def _lu_solve(A, b):
         raise np.linalg.LinAlgError(f"singular matrix: the pivot of column {info - 1} is "
                                     "exactly zero")
     return x
+
+
+cdef extern from "_radau5_solver.h":
+    int RADAU5_N_CONSTANTS
+    void radau5_constants(double *out)
+
+
+def _constants():
+    """radau5's method constants as its C code uses them (private; for the tests that
+    compare them with scipy.integrate._ivp.radau): dict with C, E (3,), T, TI, P (3, 3),
+    MU_REAL, MU_COMPLEX, TI_COMPLEX (3,), NEWTON_MAXITER, MIN_FACTOR, MAX_FACTOR."""
+    values = np.empty(RADAU5_N_CONSTANTS)
+    cdef double[::1] v = values
+    radau5_constants(&v[0])
+    return {
+        "C": values[0:3].copy(), "E": values[3:6].copy(),
+        "T": values[6:15].reshape(3, 3).copy(), "TI": values[15:24].reshape(3, 3).copy(),
+        "P": values[24:33].reshape(3, 3).copy(), "MU_REAL": float(values[33]),
+        "MU_COMPLEX": complex(values[34], values[35]),
+        "TI_COMPLEX": values[36:39] + 1j * values[39:42],
+        "NEWTON_MAXITER": int(values[42]), "MIN_FACTOR": float(values[43]),
+        "MAX_FACTOR": float(values[44]),
+    }

@@ -771,3 +771,26 @@ done:
     free(iblock);
     return rc;
 }
+
+/* The method's constants as the solver uses them, for tests/test_radau5_constants.py
+ * (compared with scipy.integrate._ivp.radau).  out[RADAU5_N_CONSTANTS], see the header
+ * for the layout. */
+void radau5_constants(double *out)
+{
+    constants_t k;
+    init_constants(&k);
+    double *o = out;
+    for (int i = 0; i < 3; i++) *o++ = k.C[i];
+    for (int i = 0; i < 3; i++) *o++ = k.E[i];
+    for (int i = 0; i < 3; i++) for (int j = 0; j < 3; j++) *o++ = k.T[i][j];
+    for (int i = 0; i < 3; i++) for (int j = 0; j < 3; j++) *o++ = k.TI[i][j];
+    for (int i = 0; i < 3; i++) for (int j = 0; j < 3; j++) *o++ = k.P[i][j];
+    *o++ = k.mu_real;
+    *o++ = creal(k.mu_complex);
+    *o++ = cimag(k.mu_complex);
+    for (int j = 0; j < 3; j++) *o++ = creal(k.ti_complex[j]);
+    for (int j = 0; j < 3; j++) *o++ = cimag(k.ti_complex[j]);
+    *o++ = NEWTON_MAXITER;
+    *o++ = MIN_FACTOR;
+    *o++ = MAX_FACTOR;
+}

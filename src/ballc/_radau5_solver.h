@@ -79,4 +79,10 @@ typedef struct {
 int radau5_solve(const radau5_problem *problem, radau5_result *result);
 void radau5_free(radau5_result *result);
 
+/* The method's constants (tests only): out[RADAU5_N_CONSTANTS] =
+ * C[3], E[3], T[3][3], TI[3][3], P[3][3] (row-major), MU_REAL, MU_COMPLEX (re, im),
+ * TI_COMPLEX[3] (re), TI_COMPLEX[3] (im), NEWTON_MAXITER, MIN_FACTOR, MAX_FACTOR. */
+#define RADAU5_N_CONSTANTS 45
+void radau5_constants(double *out);
+
 #endif

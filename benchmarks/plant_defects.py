@@ -1,0 +1,189 @@
+"""Plant known defects, one at a time, and check that the default test suite catches each.
+
+    python -m benchmarks.plant_defects [--only NAME ...] [--full] [--no-baseline] [--keep]
+                                       [--tests PATH ...]
+
+For each defect: copy the working tree (without .git, build products, caches) to a
+temporary directory, apply one text substitution (the pattern must occur exactly the
+expected number of times, or the script stops with an error: a refactoring must not
+turn a planted defect into a silent no-op), regenerate the C kernels with
+``python -m codegen`` when the defect is in codegen/ (and check that generated/ did
+change), rebuild the extensions (``python setup.py build_ext --inplace``) and run the
+default suite there (``python -m pytest -q -x -p no:cacheprovider``, PYTHONPATH = the
+copy's src; ``--full``: without -x, to count every failing test; ``--tests``: only
+these test files, e.g. to see which oracle tests catch what).  A clean copy is run
+first (the baseline) so that a "caught" cannot be a failure that was there already.
+
+Prints a table: defect, failing tests (with -x: 1 = caught, the first failing test
+named), time.  Takes ~2-4 min per defect on 2 cores (mostly compiling).  Not part of the
+test suite.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+IGNORE = shutil.ignore_patterns(".git", "build", "dist", "__pycache__", "*.so", "*.egg-info",
+                                ".pytest_cache", ".hypothesis", "ballc-demo")
+
+
+@dataclass(frozen=True)
+class Defect:
+    name: str
+    path: str            # file in the repository
+    old: str             # exact text to replace
+    new: str
+    regenerate: bool     # codegen/ changed: run python -m codegen in the copy
+    count: int = 1       # expected number of occurrences of ``old``
+
+
+DEFECTS = [
+    Defect("ceiling damping sign flipped (HC normal force)", "codegen/contact.py",
+           "    return _hunt_crossley(model, rho, rhodot, rate_at_impact)\n",
+           "    return _hunt_crossley(model, rho, rhodot if plane == 'floor' else -rhodot, "
+           "rate_at_impact)\n", regenerate=True),
+    Defect("Hertz exponent 3/2 -> 1.4 (HC force)", "codegen/contact.py",
+           "k0 * _positive(rho)**sm.Rational(3, 2) * (1 + damping)",
+           "k0 * _positive(rho)**sm.Rational(7, 5) * (1 + damping)", regenerate=True),
+    Defect("dig-in direction latched reversed", "src/ballc/simulate.py",
+           "    return max(rate, MIN_IMPACT_RATE), direction\n",
+           "    return max(rate, MIN_IMPACT_RATE), -direction\n", regenerate=False),
+    Defect("tangential dissipation rate sign flipped", "codegen/contact.py",
+           "return f_normal*rhodot - elastic*rhodot, -me.dot(tangential_force, velocity)",
+           "return f_normal*rhodot - elastic*rhodot, me.dot(tangential_force, velocity)",
+           regenerate=True),
+    Defect("radau5 T[0][0] off in its 7th significant digit", "src/ballc/_radau5_solver.c",
+           "{0.09443876248897524, -0.14125529502095421, 0.03002919410514742}",
+           "{0.09443877248897524, -0.14125529502095421, 0.03002919410514742}",
+           regenerate=False),
+]
+
+
+def run(cmd, cwd, env, log, timeout):
+    """Run ``cmd``; append its output to ``log``; return (returncode, output)."""
+    proc = subprocess.run(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    with open(log, "a") as f:
+        f.write(f"$ {' '.join(cmd)}\n{proc.stdout}\n")
+    return proc.returncode, proc.stdout
+
+
+def plant(copy: Path, defect: Defect):
+    target = copy / defect.path
+    text = target.read_text()
+    found = text.count(defect.old)
+    if found != defect.count:
+        raise SystemExit(f"defect {defect.name!r}: pattern found {found} times in "
+                         f"{defect.path} (expected {defect.count}); update DEFECTS:\n"
+                         f"{defect.old!r}")
+    target.write_text(text.replace(defect.old, defect.new))
+
+
+def summary_of(output: str):
+    """(failed + errors, passed, first failing test id) from pytest -q output."""
+    counts = {}
+    for key in ("failed", "passed", "error", "errors"):
+        m = re.findall(rf"(\d+) {key}\b", output)
+        counts[key] = int(m[-1]) if m else 0
+    first = re.search(r"^(?:FAILED|ERROR) (\S+)", output, re.MULTILINE)
+    return (counts["failed"] + counts["error"] + counts["errors"], counts["passed"],
+            first.group(1) if first else "")
+
+
+def check_one(defect: Defect | None, full: bool, keep: bool, timeout: float, tests=()):
+    started = time.perf_counter()
+    copy = Path(tempfile.mkdtemp(prefix="ballc-defect-")) / "repo"
+    shutil.copytree(ROOT, copy, ignore=IGNORE)
+    log = copy.parent / "log.txt"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(copy / "src"), str(copy)]),
+           "PYTHONDONTWRITEBYTECODE": "1"}
+    try:
+        if defect is not None:
+            plant(copy, defect)
+            if defect.regenerate:
+                before = {p.name: p.read_text() for p in (copy / "generated").iterdir()}
+                rc, out = run([sys.executable, "-m", "codegen"], copy, env, log, timeout)
+                if rc != 0:
+                    raise SystemExit(f"python -m codegen failed for {defect.name!r}:\n{out}")
+                after = {p.name: p.read_text() for p in (copy / "generated").iterdir()}
+                kernels = {k for k in after if k.endswith(".c")}
+                if all(before.get(k) == after[k] for k in kernels):
+                    raise SystemExit(f"defect {defect.name!r} did not change the generated "
+                                     "kernels")
+        rc, out = run([sys.executable, "setup.py", "build_ext", "--inplace"], copy, env, log,
+                      timeout)
+        if rc != 0:
+            raise SystemExit(f"build failed ({defect and defect.name}); see {log}")
+        rc, out = run([sys.executable, "-c", "import ballc; print(ballc.__file__)"], copy, env,
+                      log, 60)
+        if not out.strip().startswith(str(copy)):
+            raise SystemExit(f"the copy imports ballc from {out.strip()}, not from {copy}")
+        cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
+        if not full:
+            cmd.append("-x")
+        cmd.extend(tests)
+        rc, out = run(cmd, copy, env, log, timeout)
+        failing, passed, first = summary_of(out)
+        if rc not in (0, 1):     # 2: interrupted, 3: internal error, 4: usage, 5: no tests
+            raise SystemExit(f"pytest exited with {rc}; see {log}\n{out[-2000:]}")
+        return failing, passed, first, time.perf_counter() - started
+    finally:
+        if not keep:
+            shutil.rmtree(copy.parent, ignore_errors=True)
+        else:
+            print(f"    kept {copy} (log: {log})", flush=True)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--only", nargs="*", default=None,
+                        help="run only defects whose name contains one of these words")
+    parser.add_argument("--full", action="store_true",
+                        help="run the whole suite (no -x): count every failing test")
+    parser.add_argument("--no-baseline", action="store_true",
+                        help="skip the run of the unmodified copy")
+    parser.add_argument("--keep", action="store_true", help="keep the temporary copies")
+    parser.add_argument("--tests", nargs="*", default=[],
+                        help="test files or ids to run instead of the default suite")
+    parser.add_argument("--timeout", type=float, default=1800,
+                        help="seconds per command (default 1800)")
+    args = parser.parse_args(argv)
+
+    defects = [d for d in DEFECTS
+               if args.only is None or any(w.lower() in d.name.lower() for w in args.only)]
+    rows = []
+    for defect in ([None] if not args.no_baseline else []) + defects:
+        name = defect.name if defect else "(baseline: no defect)"
+        print(f"... {name}", flush=True)
+        failing, passed, first, seconds = check_one(defect, args.full, args.keep,
+                                                    args.timeout, args.tests)
+        if defect is None:
+            verdict = "clean" if failing == 0 else "BASELINE FAILS"
+        else:
+            verdict = "caught" if failing else "NOT caught"
+        rows.append((name, verdict, failing, passed, first, seconds))
+        print(f"    {verdict}: {failing} failing, {passed} passed, {seconds:.0f} s "
+              f"{first}", flush=True)
+
+    mode = ("whole suite" if args.full else "-x: stops at the first failure") + (
+        f"; only {' '.join(args.tests)}" if args.tests else "")
+    print(f"\n| defect | verdict | failing tests ({mode}) | first failing test | time (s) |")
+    print("|---|---|---|---|---|")
+    for name, verdict, failing, passed, first, seconds in rows:
+        print(f"| {name} | {verdict} | {failing} ({passed} passed) | {first or '-'} | "
+              f"{seconds:.0f} |")
+    missed = [r[0] for r in rows if r[1] in ("NOT caught", "BASELINE FAILS")]
+    return 1 if missed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
