@@ -111,17 +111,18 @@ def hertz_contact_time(scene: Scene, speed: float) -> float:
     return 3.2145 * (m / scene.hertz_stiffness) ** 0.4 * speed ** -0.2
 
 
-def _default_atol(scene, speed, rtol):
-    # Overlaps are small: the absolute tolerance must resolve the Hertz penetration
-    # (and the energies, m v^2), not the radius.
+def _default_atol(scene, speed):
+    # Overlaps are small: the absolute tolerance must resolve the Hertz penetration, not
+    # the radius (1e-6 of it), but not much below simulate's 1e-10 either: much tighter
+    # (1e-15 m) stalls the compliant law's stick/slip at the first touch.
     m = scene.mass + scene.observer_mass
     depth = (1.25 * m * speed ** 2 / scene.hertz_stiffness) ** 0.4
-    return rtol * min(depth, 0.5 * m * speed ** 2, scene.radius)
+    return min(1e-10, 1e-6 * depth, 1e-6 * 0.5 * m * speed ** 2)
 
 
 def impact(scene: Scene, velocity, angular_velocity=(0.0, 0.0, 0.0), plane: str = "floor",
            *, gap: float = 1e-6, rtol: float = 1e-10, atol: float | None = None,
-           method: str = "radau5") -> Impact:
+           method: str = "radau5", max_nfev: int | None = 2_000_000) -> Impact:
     """One impact of ``scene``'s ball on ``plane`` from the given incident state.
 
     Parameters
@@ -138,10 +139,13 @@ def impact(scene: Scene, velocity, angular_velocity=(0.0, 0.0, 0.0), plane: str 
     gap : float
         Start this many radii clear of the plane (default 1e-6), in (0, 0.5].
     rtol, atol : float
-        simulate's tolerances; atol default: rtol times the smallest of the Hertz
-        penetration, m v^2/2 and the radius (so tiny balls keep their accuracy).
+        simulate's tolerances; atol default: the smallest of 1e-10 and 1e-6 times the
+        Hertz penetration and m v^2/2 (so that tiny balls keep their accuracy).
     method : str
         simulate's integrator.
+    max_nfev : int or None
+        simulate's call budget (default 2e6, a few seconds: one impact of a
+        well-posed scene takes ~1e4).  When it is exhausted, RuntimeError.
 
     Returns
     -------
@@ -181,12 +185,12 @@ def impact(scene: Scene, velocity, angular_velocity=(0.0, 0.0, 0.0), plane: str 
     start = scene.replace(position=(0.0, 0.0, z0), velocity=tuple(v0),
                           angular_velocity=tuple(w))
     if atol is None:
-        atol = _default_atol(scene, approach, rtol)
+        atol = _default_atol(scene, approach)
     t_gap = clearance / approach
     t_end = t_gap + 3.0 * hertz_contact_time(scene, approach)
     for _ in range(8):
         result = simulate(start, t_end, method=method, rtol=rtol, atol=atol,
-                          progress=False)
+                          progress=False, max_nfev=max_nfev)
         done = [c for c in result.contacts if c.plane == plane and np.isfinite(c.t_end)]
         if done or result.status != 0:
             break
