@@ -126,7 +126,8 @@ def test_fit_impacts_recovers_known_parameters():
     base = steel(gravity=0.0)
     table = ballc.impact_table(base.replace(**truth), angles=[10, 25, 40, 55, 70],
                                speed=2.0, spin=[0.0, 50.0, -80.0, 0.0, 120.0])
-    data = table[list(ballc.impact.__globals__["INCIDENT_COLUMNS"])
+    from ballc.impact import INCIDENT_COLUMNS
+    data = table[list(INCIDENT_COLUMNS)
                  + ["vx_after", "vz_after", "wy_after"]].copy()
     data.loc[1, "wy_after"] = np.nan                     # an unmeasured value
     fit = ballc.fit_impacts(base.replace(friction_coefficient=0.3,

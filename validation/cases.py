@@ -99,7 +99,8 @@ def hertz_reference(scene, speed, times):
         return [y[1], -k0 * max(y[0], 0.0) ** 1.5 / m]
     leave = lambda t, y: y[0] if t > 0 else 1.0  # noqa: E731
     leave.terminal, leave.direction = True, -1
-    sol = solve_ivp(rhs, (0, 10 * ballc.impact.__globals__["hertz_contact_time"](scene, speed)),
+    from ballc.impact import hertz_contact_time
+    sol = solve_ivp(rhs, (0, 10 * hertz_contact_time(scene, speed)),
                     [0.0, speed], method="DOP853", rtol=1e-12, atol=1e-20, dense_output=True,
                     events=leave)
     t_c = sol.t_events[0][0]

@@ -217,9 +217,9 @@ def impact(scene: Scene, velocity, angular_velocity=(0.0, 0.0, 0.0), plane: str 
 def impact_table(scene: Scene, angles=(15.0, 30.0, 45.0, 60.0, 75.0), speed: float = 1.0,
                  spin=0.0, plane: str = "floor", **options):
     """Impacts at incident ``angles`` (degrees from the plane's normal: 0 = head-on,
-    as in Chung & Ooi), all at ``speed`` (m/s), in the x-z plane, with ``spin``
-    (rad/s about y, one value or one per angle; positive spin about +y moves the
-    floor contact point along -x... see ``contact_point_velocity``).
+    as in Chung & Ooi), all at ``speed`` (m/s), in the x-z plane (tangential velocity
+    along +x), with ``spin`` (rad/s about y, one value or one per angle; on the floor
+    the contact point moves at u_x = v_x - r w_y, so positive spin is backspin).
 
     Returns a pandas DataFrame, one row per impact: ``angle`` (deg), ``speed``,
     ``spin``, the incident ``vx..wz`` and rebound ``vx_after..wz_after``, ``e_n``,
