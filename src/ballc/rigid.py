@@ -118,3 +118,53 @@ def hunt_crossley_restitution(c_tau: float) -> float:
     upper = min(1.0, 1.0 / a) * (1 - 1e-15)
     return brentq(lambda e: a * (1 + e) - np.log((1 + a) / (1 - a * e)), 1e-300, upper,
                   xtol=1e-15, rtol=4 * np.finfo(float).eps)
+
+
+#: Smallest restitution ballc's Hunt-Crossley bracket can give: the limit c_tau -> 0
+#: (a = 3/2) of ``hunt_crossley_restitution``, about 0.4877.
+def _hunt_crossley_restitution_of_a(a: float) -> float:
+    from scipy.optimize import brentq
+    if a == 0:
+        return 1.0
+    upper = min(1.0, 1.0 / a) * (1 - 1e-15)
+    return brentq(lambda e: a * (1 + e) - np.log((1 + a) / (1 - a * e)), 1e-300, upper,
+                  xtol=1e-15, rtol=4 * np.finfo(float).eps)
+
+
+MIN_HUNT_CROSSLEY_RESTITUTION = _hunt_crossley_restitution_of_a(1.5)
+
+
+def c_tau_for_restitution(restitution: float) -> float:
+    """The c_tau whose Hunt-Crossley impact has the exit/entry speed ratio ``restitution``.
+
+    The inverse of :func:`hunt_crossley_restitution`: solves
+    a (1 + e) = ln((1 + a) / (1 - a e)) for a, then c_tau = 1 - 2 a / 3.  The bracket
+    1 + 3/2 (1 - c_tau) rhodot / rhodot^- with c_tau in (0, 1] only reaches
+    e in (MIN_HUNT_CROSSLEY_RESTITUTION, 1] = (0.4877..., 1]: a smaller restitution raises
+    ValueError (that damping law cannot represent it; see docs/validation.md).
+    """
+    from scipy.optimize import brentq
+    try:
+        e = float(restitution)
+    except (TypeError, ValueError):
+        raise ValueError(f"restitution = {restitution!r} is not allowed: must be a number "
+                         "in (0.4877, 1]") from None
+    if isinstance(restitution, (bool, np.bool_)) or not np.isfinite(e) or not e <= 1:
+        raise ValueError(f"restitution = {restitution!r} is not allowed: must be a number "
+                         f"in ({MIN_HUNT_CROSSLEY_RESTITUTION:.6g}, 1]")
+    if e <= MIN_HUNT_CROSSLEY_RESTITUTION:
+        raise ValueError(
+            f"restitution = {restitution!r} is not allowed: ballc's Hunt-Crossley force "
+            f"cannot dissipate that much (its restitution is > "
+            f"{MIN_HUNT_CROSSLEY_RESTITUTION:.6g} for every c_tau in (0, 1])")
+    if e == 1:
+        return 1.0
+    # e(a) falls monotonically from 1 (a = 0) to the minimum (a = 3/2).  Within 1e-4 of
+    # e = 1 the root of the restitution equation is lost in rounding (its terms cancel
+    # to O(a^3)): there c_tau is interpolated linearly, an O((1 - e)^2) ~ 1e-8 error.
+    near = 1.0 - 1e-4
+    if e > near:
+        return 1.0 - (1.0 - e) / (1.0 - near) * (1.0 - c_tau_for_restitution(near))
+    a = brentq(lambda a: _hunt_crossley_restitution_of_a(a) - e, 1e-6, 1.5,
+               xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    return 1.0 - a / 1.5
