@@ -276,3 +276,26 @@ def test_work_precision_has_no_cliff(name):
     assert calls == sorted(calls), calls
     assert errors[3] > errors[6] > errors[9] > errors[12], errors
     assert errors[3] < 0.2 and errors[9] < 1e-6
+
+
+def test_a_ten_micron_steel_ball_settles_to_rolling():
+    """Kratos's Chung & Ooi test 5 ball (steel, R = 10 um, e = 1, mu = 0.3) at
+    V_t / (mu V_n) = 3 < 3.5 (1 + e): the rigid Coulomb map says it leaves rolling at
+    5/7 of its tangential speed.  Its slip stops within ~1e-16 s of a 1e-8-s contact:
+    the stop event must be found inside such short steps (it once fired at the step's
+    start, 100,000 times)."""
+    radius, density = 1e-5, 7850.0
+    mass = 4 / 3 * math.pi * radius ** 3 * density
+    v_n, v_t = 3.9, 0.9 * 3.9
+    scene = ballc.Scene(mass=mass, radius=radius, inertia=(0.4 * mass * radius ** 2,) * 3,
+                        observer_mass=0.0, gravity=0.0, ball_youngs_modulus=2.08e11,
+                        plane_youngs_modulus=2.08e11, ball_poisson_ratio=0.3,
+                        plane_poisson_ratio=0.3, c_tau=1.0, friction_coefficient=0.3,
+                        tangential_model="friction", ceiling_height=1.0,
+                        position=(0, 0, radius * (1 + 1e-6)), velocity=(v_t, 0, -v_n))
+    result = ballc.simulate(scene, 2e-7, rtol=1e-10, atol=1e-16, max_nfev=200_000)
+    assert result.status == 0, result.message
+    (contact,) = result.contacts
+    assert [phase for _, phase in contact.transitions] == ["slip", "stick"]
+    assert contact.velocity_after[0] == pytest.approx(5 / 7 * v_t, rel=1e-6)
+    assert contact.velocity_after[2] == pytest.approx(v_n, rel=1e-6)

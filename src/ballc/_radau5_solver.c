@@ -516,11 +516,13 @@ static double dense_event_at(void *ctx, double tt)
     return event_value(q->s, q->e, tt, q->s->ev_y);
 }
 
-/* scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c), xtol = rtol = 4 eps as in
- * solve_ivp's solve_event_equation. */
+/* scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c) with rtol = 4 eps as in
+ * solve_ivp's solve_event_equation, but xtol = 4 eps times the step instead of 4 eps
+ * (seconds): a root inside a step shorter than ~1e-15 s (a 10-um steel ball's contact
+ * lasts 1e-8 s, its slip stops within 1e-16 s) is still located, not put at an end. */
 static double brentq(scalar_fn f, void *q, double xa, double xb)
 {
-    const double xtol = 4 * EPS, rtol = 4 * EPS;
+    const double xtol = 4 * EPS * fabs(xb - xa), rtol = 4 * EPS;
     double xpre = xa, xcur = xb, xblk = 0, fblk = 0, spre = 0, scur = 0;
     double fpre = f(q, xpre), fcur = f(q, xcur);
     if (fpre == 0) return xpre;

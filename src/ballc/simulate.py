@@ -72,6 +72,7 @@ class _Run:
         self.dissipated_at_start: dict[str, np.ndarray] = {}
         self.contacts: list[Contact] = []
         self.status, self.message = 0, SUCCESS
+        self.last_transition, self.stalled = None, 0   # mode changes that left t unchanged
 
     def flags(self, with_coulomb=True):
         return modes.flags(self.scene, self.in_contact, self.coulomb if with_coulomb else None)
@@ -146,11 +147,14 @@ class _Run:
 
     def coulomb_event(self, kind, plane):
         """The next exact-Coulomb mode after event ``kind`` on ``plane`` (see stickslip)."""
-        if self.transitions[plane] >= stickslip.MAX_TRANSITIONS:
+        self.stalled = self.stalled + 1 if self.t == self.last_transition else 0
+        self.last_transition = self.t
+        if (self.transitions[plane] >= stickslip.MAX_TRANSITIONS
+                or self.stalled >= stickslip.MAX_STALLED):
             self.status = -1
             self.message = (f"stick-slip transitions on the {plane} did not settle: "
-                            f"{self.transitions[plane]} mode changes in one contact by "
-                            f"t = {self.t:.9g} s")
+                            f"{self.transitions[plane]} mode changes in one contact, "
+                            f"{self.stalled} of them at t = {self.t:.17g} s")
             return
         u = stickslip.slip_velocity(self.params, plane, self.y)
         speed = float(np.hypot(*u))

@@ -51,6 +51,10 @@ MAX_RELATCH = 1000
 #: settle (a Zeno-like sequence), and the run stops honestly.
 MAX_TRANSITIONS = 100_000
 
+#: At most this many mode changes in a row without time moving on: an event that keeps
+#: firing at its segment's start.  The run stops honestly instead of looping.
+MAX_STALLED = 100
+
 
 def uses_exact_coulomb(scene) -> bool:
     """Whether ``scene``'s contacts have a Coulomb part integrated as stick/slip events."""
