@@ -204,3 +204,16 @@ def test_pure_friction_never_comes_back(mu):
     result = seed_throw(tangential_model="friction", friction_coefficient=mu)
     assert result.status == 0
     assert all(c.velocity_after[0] <= 0 for c in result.contacts)
+
+
+@pytest.mark.parametrize("c_tau", [0.5, 0.9, 0.99, 0.9933, 0.9934, 0.999, 0.99993, 0.999999, 1 - 1e-9, 1 - 1e-13])
+def test_hunt_crossley_restitution_near_one(c_tau):
+    """Close to c_tau = 1 the defining equation loses its residual to rounding; the
+    function must still solve it: a(1 + e) = ln((1 + a)/(1 - a e)) to 1e-13, checked in
+    50-digit arithmetic (mpmath, which sympy brings)."""
+    mp = pytest.importorskip("mpmath")
+    mp.mp.dps = 50
+    e = ballc.hunt_crossley_restitution(c_tau)
+    a = mp.mpf(1.5) * (1 - mp.mpf(c_tau))
+    exact = mp.findroot(lambda x: a * (1 + x) - mp.log((1 + a) / (1 - a * x)), 1 - 2 * a / 3)
+    assert abs(e - float(exact)) <= 1e-13
