@@ -71,7 +71,12 @@ cdef inline void _check(name, Py_ssize_t got, Py_ssize_t expected) except *:
         raise ValueError(f"{name} must have length {expected}, got {got}")
 
 
-DEF BALLC_MAX_STATES = 64
+cdef enum:
+    BALLC_MAX_STATES = 64   # the stack buffer System copies a state into
+
+if BALLC_N_STATES > BALLC_MAX_STATES:   # a layout that outgrew the buffer: refuse to load
+    raise ImportError(f"ballc._core: {BALLC_N_STATES} states exceed the {BALLC_MAX_STATES}-"
+                      "state buffer of System; raise BALLC_MAX_STATES in _core.pyx")
 
 
 cdef inline void _copy_state(const double[:] y, double *ys) except *:
