@@ -33,7 +33,7 @@ from codegen.seed_reference import (SEED_INITIAL_STATE, SEED_PARAMETER_NAMES, an
                                     seed_default_parameter_values, seed_energies,
                                     seed_state_derivative)
 # the seed <-> ballc mapping of parameters and random states (reused, not duplicated)
-from test_against_seed import brackets_positive, random_scene, random_state, seed_parameters
+from test_against_seed import comparable_states, seed_parameters
 
 _S = _core.STATE_INDEX
 _DISSIPATED_NORMAL = _S["dissipated_normal"]
@@ -185,12 +185,7 @@ def test_total_dissipation_rate_is_the_seeds_energy_loss_rate(seed_model, rng, m
     brackets are positive (ballc's no-adhesion clamp, absent from the seed, inactive).
     A rate with the wrong sign, a wrong share of the Hertz spring or a wrong plane's
     force all break it."""
-    checked = 0
-    while checked < 25:
-        scene = random_scene(rng, model)
-        y, seed_y, latch, flags = random_state(rng, scene, plane)
-        if not brackets_positive(scene, y, latch, plane):
-            continue
+    for scene, y, seed_y, latch, flags in comparable_states(rng, model, plane, 25):
         ydot = _core.rhs(y, scene.parameter_vector(), latch, flags)
         ours = ydot[_DISSIPATED_NORMAL] + ydot[_DISSIPATED_TANGENTIAL]
         theirs = -_seed_energy_rate(seed_y, seed_parameters(scene, latch))
@@ -198,7 +193,6 @@ def test_total_dissipation_rate_is_the_seeds_energy_loss_rate(seed_model, rng, m
         rho = r - y[_S["z"]] if plane == "floor" else y[_S["z"]] - (scene.ceiling_height - r)
         scale = power_scale(scene, y, rho, latch, plane)
         assert ours == pytest.approx(theirs, abs=1e-9 * scale), (ours, theirs, scale)
-        checked += 1
 
 
 def test_digin_injects_energy_at_a_rebound_state(seed_model):
