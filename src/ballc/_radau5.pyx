@@ -63,6 +63,7 @@ cdef extern from "_radau5_solver.h":
         int status
         char message[240]
         long nfev, njev, nlu, nstep, nreject
+        double h_next
         long n_out
         double *t_out
         double *y_out
@@ -265,7 +266,8 @@ cdef object _run(radau5_problem *p, int n, int m):
             memcpy(&htv[0], r.hit_t, r.n_hits * sizeof(double))
             memcpy(&hyv[0, 0], r.hit_y, r.n_hits * n * sizeof(double))
         status, message = r.status, r.message.decode()
-        counts = dict(nfev=r.nfev, njev=r.njev, nlu=r.nlu, nstep=r.nstep, nreject=r.nreject)
+        counts = dict(nfev=r.nfev, njev=r.njev, nlu=r.nlu, nstep=r.nstep, nreject=r.nreject,
+                      h_next=r.h_next)
     finally:
         radau5_free(&r)
     t_events = [hit_t[hit_event == k] for k in range(m)]

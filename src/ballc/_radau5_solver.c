@@ -768,6 +768,7 @@ oom:
     r->status = RADAU5_FAILED;
     snprintf(r->message, sizeof r->message, "out of memory");
 done:
+    r->h_next = s.h_abs;
     free(dblock);
     free(cblock);
     free(iblock);

@@ -61,6 +61,7 @@ typedef struct {
     int status;               /* RADAU5_REACHED, RADAU5_EVENT or RADAU5_FAILED */
     char message[240];
     long nfev, njev, nlu, nstep, nreject;
+    double h_next;            /* the step size the controller chose for the next step */
     long n_out;               /* stored points: t_out (n_out), y_out (n_out x n) */
     double *t_out;
     double *y_out;

@@ -25,6 +25,8 @@ PLANES = layout.PLANES
 _STATE = layout.INDEX
 _QUATERNION, _DISSIPATED, _DEFLECTION = layout.QUATERNION, layout.DISSIPATED, layout.DEFLECTION
 SUCCESS = "The solver successfully reached the end of the integration interval."
+#: Events after which the next segment starts with the last segment's next step size.
+CARRY_STEP = ("approach", "stop", "clear", "release")
 
 
 def _check_options(scene, t_end, method="radau5", rtol=1e-10, atol=1e-10, max_step=np.inf):
@@ -343,6 +345,10 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             break
         kind, plane, _ = driver_events[index]
         run.handle(kind, plane)
+        if kind in CARRY_STEP and getattr(sol, "h_next", 0) > 0:
+            # within a contact the dynamics do not jump at a stick/slip transition: go on
+            # with the step the controller had chosen instead of a fresh start
+            first = min(sol.h_next, options.max_step)
 
     if bar is not None:
         bar.update((t_end if run.status == 0 else run.t) - bar.n)
