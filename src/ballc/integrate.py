@@ -27,6 +27,8 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
     (a user's), which it calls back.  ``max_nfev``: give up (status -1, keeping what
     was computed) after that many right-hand-side calls.
     """
+    if first_step is not None:   # a step carried over may be longer than what is left
+        first_step = min(first_step, t1 - t0)
     if method == "radau5":
         sol = _radau5.solve_system(system.params, system.latch, system.flags, (t0, t1), y0,
                                    rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
@@ -37,7 +39,7 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
         return sol
     options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
     if first_step is not None:
-        options["first_step"] = min(first_step, t1 - t0)
+        options["first_step"] = first_step
     budget = [_call_budget(system, max_nfev)] if max_nfev is not None else []
     sol = solve_ivp(system, (t0, t1), y0, method=method, rtol=rtol, atol=atol,
                     t_eval=t_eval, events=list(events) + budget, max_step=max_step,
