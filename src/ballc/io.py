@@ -122,8 +122,19 @@ def _or_empty(array, dtype):
 
 
 def load(path) -> Result:
-    """Read a Result written by :func:`save` (``.npz`` or ``.nc``; any other suffix raises
-    ValueError)."""
+    """Read a Result written by :meth:`Result.save`.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.npz`` file, or ``.nc`` (netCDF, needs xarray); any other suffix raises
+        ValueError.
+
+    Returns
+    -------
+    Result
+        The saved run: times (s), states (SI units), contacts and scene.
+    """
     path = _checked_suffix(path, "load a Result from")
     if path.suffix == ".nc":
         return _from_dataset(path)
