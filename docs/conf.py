@@ -70,6 +70,8 @@ sphinx_gallery_conf = {
     "download_all_examples": False,
     "remove_config_comments": True,
     "abort_on_example_error": True,
+    # examples unchanged since the last build are not run again, unless this is set
+    "run_stale_examples": os.environ.get("BALLC_DOCS_RUN_ALL") == "1",
     "min_reported_time": 1,
     "write_computation_times": False,
     "show_memory": False,

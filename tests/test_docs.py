@@ -83,7 +83,8 @@ def test_docs_build_warning_free(tmp_path):
     html = tmp_path / "html"
     done = subprocess.run([sys.executable, "-m", "sphinx", "-W", "-b", "html",
                            "-d", str(tmp_path / "doctrees"), "docs", str(html)],
-                          cwd=REPOSITORY, capture_output=True, text=True, timeout=1100)
+                          cwd=REPOSITORY, capture_output=True, text=True, timeout=1100,
+                          env={**os.environ, "BALLC_DOCS_RUN_ALL": "1"})   # run every example
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     for page in ["index", "api", "user_guide", "gallery/index"] + [
             f"gallery/{name}" for name in GALLERY]:
