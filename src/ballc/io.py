@@ -86,9 +86,21 @@ def _or_empty(array, dtype):
 
 
 def read(path) -> tuple[dict, dict, dict]:
-    """(header, arrays, contact arrays) of a file written by :func:`save` (``.npz`` or
-    ``.nc``; any other suffix raises ValueError); warns when it was made by another
-    layout or kernel version.  ``ballc.load`` turns them into a Result."""
+    """The parts of a file written by ``Result.save``; ``ballc.load`` turns them into a
+    Result.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.npz`` file, or ``.nc`` (netCDF, needs xarray); any other suffix raises
+        ValueError.
+
+    Returns
+    -------
+    tuple of dict
+        (header, arrays, contact arrays); warns when the file was made by another
+        state layout or kernel version.
+    """
     path = _checked_suffix(path, "load a Result from")
     if path.suffix == ".nc":
         header, arrays, contacts = _read_dataset(path)

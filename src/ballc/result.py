@@ -19,6 +19,33 @@ class Contact:
     ``t_end`` and the ``*_after`` values are NaN when the simulation ended during
     the contact.  Velocities are of the ball's centre; angular velocities are in
     inertial components.
+
+    Attributes
+    ----------
+    plane : str
+        "floor" or "ceiling".
+    t_start, t_end : float
+        Start and end of the contact (s).
+    velocity_before, velocity_after : ndarray, shape (3,)
+        Centre velocity at ``t_start`` and at ``t_end`` (m/s).
+    angular_velocity_before, angular_velocity_after : ndarray, shape (3,)
+        Angular velocity at ``t_start`` and at ``t_end`` (rad/s).
+    penetration_rate_at_impact : float
+        The latched penetration rate rhodot^- at ``t_start`` (m/s).
+    digin_direction : ndarray, shape (3,)
+        Unit vector along the contact point's velocity at ``t_start`` (1).
+    max_penetration : float
+        Largest penetration depth (m).
+    contact_point : ndarray, shape (2,)
+        Centre (x, y) when the penetration was largest: the contact point (m).
+    peak_normal_force : float
+        Largest normal force over the stored samples (N).
+    energy_lost_normal, energy_lost_tangential : float
+        Work dissipated by the normal and by the tangential force (J).
+    time_sticking, time_slipping : float
+        Time with the tangential force below, and at, the Coulomb cap mu F_n (s).
+    transitions : list of (float, str)
+        Exact Coulomb friction: the start (s) of each "slip" or "stick" phase.
     """
 
     plane: str                       # "floor" or "ceiling"
@@ -43,9 +70,12 @@ class Contact:
 
     @property
     def duration(self) -> float:
+        """t_end - t_start (s)."""
         return self.t_end - self.t_start
 
     def as_dict(self) -> dict:
+        """The contact as one flat row (the contact table's columns, units in
+        ``ballc.result.CONTACT_UNITS``)."""
         row = {"plane": self.plane, "t_start": self.t_start, "t_end": self.t_end,
                "duration": self.duration, "max_penetration": self.max_penetration,
                "contact_point_x": float(self.contact_point[0]),
@@ -87,6 +117,32 @@ class Result:
     ``y`` has one row per state (``state_names``) and one column per time in ``t``.
     ``status``: 0 reached t_end, 1 stopped by a terminal condition (see ``message``),
     -1 the integrator failed; in every case the arrays hold what was computed.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Sample times (s): every solver step and every contact event, or ``t_eval``.
+    y : ndarray, shape (len(state_names), n)
+        States at ``t``, SI units: quaternion (1), centre position (m), angular
+        velocity (rad/s, inertial), centre velocity (m/s), dissipated work (J),
+        tangential deflections (m).
+    scene : Scene
+        The simulated scene.
+    status : int
+        0: ``t_end`` reached; 1: a terminal condition (the ball passed through a
+        plane); -1: the integrator failed.
+    message : str
+        What happened, in words.
+    nfev, njev, nlu : int
+        Right-hand-side and Jacobian evaluations, LU decompositions.
+    contacts : list of Contact
+        One per contact, in time order.
+    state_names : tuple of str
+        Name of each row of ``y`` (``ballc.STATE_NAMES``).
+    flags : ndarray, shape (n,)
+        Right-hand-side flags of the segment that computed each sample (int).
+    latch : ndarray, shape (N_LATCH, n)
+        The latched contact values of that segment (SI units).
     """
 
     t: np.ndarray
@@ -304,8 +360,19 @@ def _contacts_from(arrays: dict) -> list:
 
 
 def load(path) -> Result:
-    """Read a Result written by ``Result.save`` (``.npz`` or ``.nc``; any other suffix
-    raises ValueError)."""
+    """Read a Result written by :meth:`Result.save`.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.npz`` file, or ``.nc`` (netCDF, needs xarray); any other suffix raises
+        ValueError.
+
+    Returns
+    -------
+    Result
+        The saved run: times (s), states (SI units), contacts and scene.
+    """
     from .io import read
     from .scene import Scene
     header, arrays, contacts = read(path)

@@ -26,7 +26,21 @@ import numpy as np
 
 @dataclass(frozen=True)
 class RigidImpact:
-    """Velocities after one rigid impact (SI units, inertial components)."""
+    """Velocities after one rigid impact (SI units, inertial components).
+
+    Attributes
+    ----------
+    velocity : ndarray, shape (3,)
+        Centre velocity after the impact (m/s).
+    angular_velocity : ndarray, shape (3,)
+        Angular velocity after the impact (rad/s).
+    normal_impulse : float
+        Normal impulse P_n (N s).
+    tangential_impulse : ndarray, shape (3,)
+        Tangential impulse P_t, in the plane (N s).
+    sticking : bool
+        True when the contact point stuck (it left with -e_t u); False when it slid.
+    """
 
     velocity: np.ndarray           # centre velocity after (m/s)
     angular_velocity: np.ndarray   # angular velocity after (rad/s)
@@ -52,16 +66,23 @@ def rigid_impact(velocity, angular_velocity, *, mass=1.0, radius=1.0, inertia=No
     velocity, angular_velocity : 3 floats
         Centre velocity (m/s) and angular velocity (rad/s) just before the impact.
     mass, radius : float
-        kg, m.
+        Mass (kg) and radius (m) of the ball.
     inertia : float, optional
         Central moment of inertia (kg m^2); default 2/5 m r^2 (solid sphere).
     restitution : float
-        Normal restitution e in [0, 1].
+        Normal restitution e (1), in [0, 1].
     friction_coefficient : float
-        Coulomb mu >= 0.
+        Coulomb mu (1), >= 0.
     tangential_restitution : float
-        e_t in [-1, 1]: 0 = the contact point ends rolling when it sticks (pure
+        e_t (1), in [-1, 1]: 0 = the contact point ends rolling when it sticks (pure
         Coulomb), 1 = its tangential velocity is reversed (a perfect superball).
+    plane : str
+        "floor" (normal +z) or "ceiling" (normal -z).
+
+    Returns
+    -------
+    RigidImpact
+        Velocity (m/s), angular velocity (rad/s) and impulses (N s) after the impact.
     """
     v = _vector("velocity", velocity)
     w = _vector("angular_velocity", angular_velocity)
@@ -108,6 +129,16 @@ def hunt_crossley_restitution(c_tau: float) -> float:
 
     Solves a (1 + e) = ln((1 + a) / (1 - a e)), a = 3/2 (1 - c_tau): e depends on c_tau
     only, not on the speed or the stiffness.  c_tau = 1 gives e = 1.
+
+    Parameters
+    ----------
+    c_tau : float
+        Hunt-Crossley parameter (1), in (0, 1] (``Scene.c_tau``).
+
+    Returns
+    -------
+    float
+        Coefficient of restitution e = exit / entry normal speed (1).
     """
     if not 0 < c_tau <= 1:
         raise ValueError(f"c_tau = {c_tau!r} is not allowed: must be in (0, 1]")

@@ -1,50 +1,8 @@
 """Scene: every parameter and initial condition of one simulation, with units.
 
-Defaults are the seed's (shared/seed/ball_between_two_planes.txt).  SI units.
-
-=================================  ==============  ===========  ====================
-field                              seed symbol     unit         default
-=================================  ==============  ===========  ====================
-mass                               m               kg           1.0
-observer_mass                      mo              kg           1e-4
-radius                             r               m            1.0
-gravity                            g               m/s^2        9.81
-ceiling_height                     H               m            10.0
-inertia (about ball x, y, z)       iXX, iYY, iZZ   kg m^2       2/5 m r^2 each
-observer_position (ball frame)     alpha, beta,    r (radius)   (0.7, 0, 0.7)
-                                   gamma
-ball_youngs_modulus                Eb              Pa           3e3
-plane_youngs_modulus               Ep              Pa           2e10
-ball_poisson_ratio                 nyb             1            0.25
-plane_poisson_ratio                nyp             1            0.15
-c_tau                              ctau            1            0.9
-friction_coefficient               mu              1            0.1
-mixture                            mixtur          1            0.375
-tangential_model                   -               -            "mixture"
-friction_regularization_speed      (1e-10 in the   m/s          1e-10
-                                   seed's code)
-friction_regularization            -               -            "exact" (or "max", "smooth")
-tangential_stiffness_ratio         -               1            Mindlin (compliant)
-position (centre)                  m1, m2, m3      m            (0, 0, 5)
-velocity (centre)                  um1, um2, um3   m/s          (-5, 5, -25)
-angles (body-fixed 123)            q1, q2, q3      rad          (0, 0, 0)
-angular_velocity (inertial comps)  u1, u2, u3      rad/s        (0, 0, 0)
-=================================  ==============  ===========  ====================
-
-``tangential_model`` is "mixture" (force = (1 - mixture) friction + mixture dig-in),
-"friction" (mixture taken as 0), "dig-in" (mixture taken as 1) or "compliant"
-(ballc's tangential-compliance model: an elastic tangential spring of stiffness
-``tangential_stiffness_ratio`` times the normal contact stiffness, damped like the
-normal force, capped at mu F_n; default ratio: Mindlin's, from the Poisson ratios
-and moduli).  ``friction_regularization`` is "exact" (Coulomb's law itself, the
-limit v_s -> 0 of the seed's: stick and slip are separate modes, their transitions
-integrator events; see ballc.stickslip), "max" (the seed's literal
-v_t / max(|v_t|, v_s)) or "smooth" (v_t / sqrt(|v_t|^2 + v_s^2)), v_s being
-``friction_regularization_speed`` (used by "max" and "smooth" only).
-A scene may start in contact with a plane (0 < z < H): see simulate's notes on what
-such a start latches.
-The seed's latched values rhodtu, rhodto, ru1..3, ro1..3 are not parameters: ballc
-latches them itself at each contact start.
+Defaults are the seed's (the gallery example "ball bouncing between two planes" by
+Peter Stahlecker).  SI units.  The fields, their units, seed symbols and defaults are
+in :class:`Scene`'s docstring (its Parameters and the table in its Notes).
 """
 from __future__ import annotations
 
@@ -58,6 +16,7 @@ import numpy as np
 from . import _core
 from .orientation import quaternion_from_angles_123
 
+#: The values of ``Scene.tangential_model``.
 TANGENTIAL_MODELS = ("mixture", "friction", "dig-in", "compliant")
 FRICTION_REGULARIZATIONS = ("exact", "max", "smooth")
 
@@ -82,9 +41,106 @@ class SceneError(ValueError):
 class Scene:
     """One ball between a floor (z = 0) and a ceiling (z = ceiling_height).
 
-    All quantities in SI units; see the module docstring for the table of fields,
-    units, seed symbols and defaults.  ``Scene(**fields)`` validates; invalid values
-    raise :class:`SceneError` naming the field, the value and what is allowed.
+    All quantities in SI units.  ``Scene(**fields)`` validates; invalid values raise
+    :class:`SceneError` naming the field, the value and what is allowed (an unknown
+    field gets a "did you mean").  Scenes are frozen: :meth:`replace` makes a changed
+    copy.
+
+    Parameters
+    ----------
+    mass : float
+        Mass of the ball (kg), > 0.  Default 1.0.
+    observer_mass : float
+        Mass of the observer particle inside the ball (kg), >= 0.  Default 1e-4.
+    radius : float
+        Radius of the ball (m), > 0.  Default 1.0.
+    gravity : float
+        Gravitational acceleration, pointing along -z (m/s^2), >= 0.  Default 9.81.
+    ceiling_height : float
+        Height H of the ceiling above the floor (m), > 2 radius.  Default 10.0.
+    inertia : tuple of 3 float, optional
+        Principal moments of inertia about the ball's x, y, z axes (kg m^2).
+        Default (None): 2/5 mass radius^2 each, a solid sphere.
+    observer_position : tuple of 3 float
+        Position of the observer in the ball frame, in units of the radius (1).
+        Default (0.7, 0, 0.7).
+    ball_youngs_modulus, plane_youngs_modulus : float
+        Young's moduli of the ball and of both planes (Pa), > 0.
+        Defaults 3e3 and 2e10.
+    ball_poisson_ratio, plane_poisson_ratio : float
+        Poisson ratios of the ball and of the planes (1), in (-1, 0.5].
+        Defaults 0.25 and 0.15.
+    c_tau : float
+        Hunt-Crossley parameter (1), in (0, 1]: 1 is perfectly elastic; close to the
+        coefficient of restitution of a normal impact for c_tau near 1.  Default 0.9.
+    friction_coefficient : float
+        Coulomb friction coefficient mu (1), >= 0.  Default 0.1.
+    mixture : float
+        Weight of the dig-in law in the "mixture" model (1), in [0, 1]: tangential
+        force = (1 - mixture) friction + mixture dig-in.  Default 0.375.
+    tangential_model : str
+        "mixture" (default), "friction" (mixture taken as 0), "dig-in" (mixture taken
+        as 1) or "compliant": ballc's tangential-compliance model, an elastic
+        tangential spring of stiffness ``tangential_stiffness_ratio`` times the normal
+        contact stiffness, damped like the normal force, capped at mu F_n.
+    friction_regularization_speed : float
+        Regularisation speed v_s of the "max" and "smooth" friction laws (m/s), > 0.
+        Default 1e-10, as in the seed's code.
+    friction_regularization : str
+        "exact" (default: Coulomb's law itself, the limit v_s -> 0 of the seed's; stick
+        and slip are separate modes whose transitions are integrator events, see
+        ``ballc.stickslip``), "max" (the seed's literal v_t / max(abs(v_t), v_s)) or
+        "smooth" (v_t / sqrt(abs(v_t)^2 + v_s^2)).
+    tangential_stiffness_ratio : float, optional
+        Tangential / normal contact stiffness ratio kappa of the compliant model (1).
+        Default (None): Mindlin's 4 G* / E*, from the Poisson ratios and the moduli.
+    position : tuple of 3 float
+        Initial position of the centre (m), 0 < z < ceiling_height.  Default (0, 0, 5).
+    velocity : tuple of 3 float
+        Initial velocity of the centre (m/s).  Default (-5, 5, -25).
+    angles : tuple of 3 float
+        Initial orientation as the seed's body-fixed 123 angles q1, q2, q3 (rad).
+        Default (0, 0, 0).
+    angular_velocity : tuple of 3 float
+        Initial angular velocity, inertial components (rad/s).  Default (0, 0, 0).
+
+    Notes
+    -----
+    The fields with the seed's symbols (the seed's defaults are ballc's):
+
+    =================================  ==============  ===========  ====================
+    field                              seed symbol     unit         default
+    =================================  ==============  ===========  ====================
+    mass                               m               kg           1.0
+    observer_mass                      mo              kg           1e-4
+    radius                             r               m            1.0
+    gravity                            g               m/s^2        9.81
+    ceiling_height                     H               m            10.0
+    inertia (about ball x, y, z)       iXX, iYY, iZZ   kg m^2       2/5 m r^2 each
+    observer_position (ball frame)     alpha, beta,    r (radius)   (0.7, 0, 0.7)
+                                       gamma
+    ball_youngs_modulus                Eb              Pa           3e3
+    plane_youngs_modulus               Ep              Pa           2e10
+    ball_poisson_ratio                 nyb             1            0.25
+    plane_poisson_ratio                nyp             1            0.15
+    c_tau                              ctau            1            0.9
+    friction_coefficient               mu              1            0.1
+    mixture                            mixtur          1            0.375
+    tangential_model                   (none)          (none)       "mixture"
+    friction_regularization_speed      (1e-10 in the   m/s          1e-10
+                                       seed's code)
+    friction_regularization            (none)          (none)       "exact" (or "max",
+                                                                    "smooth")
+    tangential_stiffness_ratio         (none)          1            Mindlin (compliant)
+    position (centre)                  m1, m2, m3      m            (0, 0, 5)
+    velocity (centre)                  um1, um2, um3   m/s          (-5, 5, -25)
+    angles (body-fixed 123)            q1, q2, q3      rad          (0, 0, 0)
+    angular_velocity (inertial comps)  u1, u2, u3      rad/s        (0, 0, 0)
+    =================================  ==============  ===========  ====================
+
+    A scene may start in contact with a plane (0 < z < H): see :func:`simulate`'s
+    notes on what such a start latches.  The seed's latched values rhodtu, rhodto,
+    ru1..3, ro1..3 are not parameters: ballc latches them itself at each contact start.
     """
 
     mass: float = 1.0
@@ -153,6 +209,7 @@ class Scene:
         return cls(**values)
 
     def to_dict(self) -> dict:
+        """Every field by name (SI units), as ``from_dict`` and the TOML files take them."""
         return asdict(self)
 
     @classmethod
