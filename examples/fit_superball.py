@@ -1,4 +1,8 @@
-"""Fit the compliant model to superball bounces with ballc.fit_impacts, then throw the
+"""
+Fitting the compliant model to bounces
+======================================
+
+Fit the compliant model to superball bounces with ballc.fit_impacts, then throw the
 ball under the table.
 
     python examples/fit_superball.py [--out DIR]

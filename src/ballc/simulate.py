@@ -208,6 +208,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     Parameters
     ----------
     scene : Scene
+        The ball, the planes, the contact models and the initial state (SI units).
     t_end : float
         End time (s), > 0.
     method : str
