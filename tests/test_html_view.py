@@ -47,3 +47,18 @@ def test_bad_options_are_named(result, tmp_path, options, message):
 def test_refuses_other_suffixes(result, tmp_path):
     with pytest.raises(ValueError, match=r"\.html"):
         write_html(result, tmp_path / "x.png")
+
+
+def test_cli_run_writes_the_view(tmp_path):
+    """`ballc run --html` writes view.html beside the figures (one subprocess, 0.3 s)."""
+    import os
+    import subprocess
+    import sys
+    pytest.importorskip("meshcat")
+    ballc.Scene().to_toml(tmp_path / "scene.toml")
+    done = subprocess.run([sys.executable, "-m", "ballc", "run", "scene.toml", "--t-end", "0.3",
+                           "--out", "out", "--html"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=300, env={**os.environ, "MPLBACKEND": "Agg"})
+    assert done.returncode == 0, done.stderr
+    page = (tmp_path / "out" / "view.html").read_text()
+    assert "<html" in page.lower() and "http://" not in page and "https://" not in page

@@ -74,9 +74,11 @@ def _workers(text: str) -> int:
     return workers
 
 
-def write_outputs(result, out: Path, *, animate: bool, frames: int) -> list[Path]:
+def write_outputs(result, out: Path, *, animate: bool, frames: int,
+                  html: bool = False) -> list[Path]:
     """Figures (PNG), contact table (CSV) and optionally the animation (GIF, + MP4 with
-    ffmpeg) of ``result`` into ``out``; returns the paths written."""
+    ffmpeg) and the interactive 3-D view (view.html) of ``result`` into ``out``; returns
+    the paths written."""
     import matplotlib
     matplotlib.use("Agg")            # files only: never open a window
     import matplotlib.pyplot as plt
@@ -105,7 +107,20 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int) -> list[Path
             animation = make_animation(result, out / name, frames=frames)
             plt.close(animation._fig)
             written.append(out / name)
+    if html:
+        result.to_html(out / "view.html")
+        written.append(out / "view.html")
     return written
+
+
+def _check_html(wanted: bool) -> None:
+    """--html needs meshcat: say so before anything is simulated."""
+    if wanted:
+        from .html_view import _import_meshcat
+        try:
+            _import_meshcat()
+        except ImportError as error:
+            raise CommandError(f"--html: {error}") from None
 
 
 # --- checks made before anything is simulated or written ---
@@ -182,12 +197,12 @@ def _report(result, written, seconds, animate) -> None:
     print(f"[{seconds['simulate']:.2f} s simulation, {seconds['outputs']:.2f} s {outputs}]")
 
 
-def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False):
+def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False, html=False):
     from .simulate import simulate
     started = time.perf_counter()
     result = simulate(scene, t_end, **options)
     simulated = time.perf_counter()
-    written = write_outputs(result, out, animate=animate, frames=frames)
+    written = write_outputs(result, out, animate=animate, frames=frames, html=html)
     if save:
         result.save(out / "result.npz")
         written.append(out / "result.npz")
@@ -199,11 +214,12 @@ def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False)
 def _demo(args) -> int:
     scene = Scene()
     t_end, options = _simulate_options(scene, args.t_end, {})
+    _check_html(args.html)
     out = _output_folder(Path(args.out))
     print(f"ballc demo: the seed scene (c_tau {scene.c_tau}, mu {scene.friction_coefficient}, "
           f"mixture {scene.mixture}) for {t_end:g} s -> {out}/")
     result = _simulate_and_write(scene, t_end, options, out, not args.no_animation,
-                                 args.frames)
+                                 args.frames, html=args.html)
     return 0 if result.success else 1
 
 
@@ -216,11 +232,12 @@ def _run(args) -> int:
     options = {name: settings.get(name) for name in ("rtol", "atol", "method")}
     options.update({k: v for k, v in overrides.items() if v is not None})
     t_end, options = _simulate_options(scene, t_end, options)
+    _check_html(args.html)
     out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
     described = "".join(f", {k} {v}" for k, v in options.items())
     print(f"ballc run {path} for {t_end:g} s{described} -> {out}/")
     result = _simulate_and_write(scene, t_end, options, out, args.animate, args.frames,
-                                 save=True)
+                                 save=True, html=args.html)
     return 0 if result.success else 1
 
 
@@ -252,6 +269,8 @@ def main(argv=None) -> int:
     demo.add_argument("--frames", type=_frames, default=DEMO_FRAMES,
                       help=f"animation frames, >= 1 (default {DEMO_FRAMES})")
     demo.add_argument("--no-animation", action="store_true", help="skip the GIF/MP4")
+    demo.add_argument("--html", action="store_true",
+                      help="also write view.html, an interactive 3-D view (needs meshcat)")
     demo.set_defaults(run=_demo)
 
     run = commands.add_parser("run", help="simulate a scene file (TOML)")
@@ -269,6 +288,8 @@ def main(argv=None) -> int:
     run.add_argument("--out", default=None,
                      help=f"output folder (default: {OUTPUT_ROOT}/<the file's stem>)")
     run.add_argument("--animate", action="store_true", help="also write the 3D animation")
+    run.add_argument("--html", action="store_true",
+                     help="also write view.html, an interactive 3-D view (needs meshcat)")
     run.add_argument("--frames", type=_frames, default=DEMO_FRAMES,
                      help=f"animation frames, >= 1 (default {DEMO_FRAMES})")
     run.set_defaults(run=_run)

@@ -295,6 +295,12 @@ class Result:
         from .animate import animate
         return animate(self, path, **options)
 
+    def to_html(self, path, **options):
+        """Write a self-contained HTML page with an interactive 3-D view of the run
+        (meshcat; ``pip install 'ballc[html]'``); options as ballc.html_view.write_html."""
+        from .html_view import write_html
+        return write_html(self, path, **options)
+
     def save(self, path) -> None:
         """Write to ``path``: .npz (always) or .nc (netCDF, needs xarray). See ballc.io."""
         from .io import save
