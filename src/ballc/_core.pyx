@@ -1,8 +1,13 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
-"""Bridge to the generated C: typed memoryviews in, C called, arrays out.
+"""Bridge to the compiled core: typed memoryviews in, C called, arrays out.
 
 Private: use the ``ballc`` package.  Every entry point checks lengths; typed
 memoryviews reject wrong dtypes and non-contiguous arrays with ValueError.
+
+The one extension module of ballc: the generated kernels, ``_system.c``, the radau5
+solver and its LU are compiled and linked once, here.  The solver's bridge lives in
+``_radau5_bridge.pxi`` (included at the end) and is imported as ``ballc._radau5``, a
+thin module that re-exports it.
 """
 import numpy as np
 
@@ -265,3 +270,8 @@ def remove_slip(const double[::1] y, const double[::1] params, int flags, int pl
     if status != BALLC_OK:
         raise FloatingPointError(f"remove_slip failed with C status {status}")
     return out
+
+
+# ---- the radau5 integrator (imported as ballc._radau5) ----
+
+include "_radau5_bridge.pxi"

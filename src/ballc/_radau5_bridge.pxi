@@ -1,15 +1,16 @@
-# cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
-"""Bridge to the compiled Radau IIA (order 5) integrator in ``_radau5_solver.c``.
-
-Private: use ``ballc.simulate(..., method="radau5")``.  This module checks and
-converts arguments, hands a C right-hand side to ``radau5_solve`` and turns its
-buffers into arrays.  The whole integration runs in C without the GIL: no Python
-per step; the Newton systems are solved by ballc's own LU (``_lu.c``), no LAPACK.
-
-``solve_system`` integrates ballc's equations (``ballc_rhs`` / ``ballc_jacobian``);
-``solve_linear`` integrates y' = A y (a generic entry point, used to test the
-integrator against the matrix exponential); ``_lu_solve`` exposes the LU for tests.
-"""
+# Included by _core.pyx (one extension, one compiled copy of the kernels); compiled
+# with its directives (boundscheck=False, wraparound=False, initializedcheck=False).
+# Bridge to the compiled Radau IIA (order 5) integrator in ``_radau5_solver.c``.
+#
+# Private: use ``ballc.simulate(..., method="radau5")``; imported as ``ballc._radau5``
+# (a thin module re-exporting these names).  This part of ``_core`` checks and
+# converts arguments, hands a C right-hand side to ``radau5_solve`` and turns its
+# buffers into arrays.  The whole integration runs in C without the GIL: no Python
+# per step; the Newton systems are solved by ballc's own LU (``_lu.c``), no LAPACK.
+#
+# ``solve_system`` integrates ballc's equations (``ballc_rhs`` / ``ballc_jacobian``);
+# ``solve_linear`` integrates y' = A y (a generic entry point, used to test the
+# integrator against the matrix exponential); ``_lu_solve`` exposes the LU for tests.
 import warnings
 
 import numpy as np
@@ -17,15 +18,6 @@ from scipy.optimize import OptimizeResult
 
 from libc.string cimport memcpy
 
-
-cdef extern from "ballc_kernels.h":
-    int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH
-
-cdef extern from "_system.h":
-    int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
-    int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
-    int ballc_stick_state(const double *, const double *, const double *, int, int,
-                          double *) nogil
 
 cdef extern from "_lu.h":
     int BALLC_LU_OK
