@@ -62,6 +62,8 @@ cdef extern from "_radau5_solver.h":
         int *hit_event
         double *hit_t
         double *hit_y
+        int profiled
+        double prof[7]
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
     void radau5_free(radau5_result *) nogil
 
@@ -212,6 +214,9 @@ cdef object _run(radau5_problem *p, int n, int m):
             memcpy(&hyv[0, 0], r.hit_y, r.n_hits * n * sizeof(double))
         status, message = r.status, r.message.decode()
         counts = dict(nfev=r.nfev, njev=r.njev, nlu=r.nlu, nstep=r.nstep, nreject=r.nreject)
+        if r.profiled:   # a -DRADAU5_PROFILE build (benchmarks/profile_step.py)
+            counts["profile"] = dict(zip(("fun", "jac", "factor", "solve", "events",
+                                          "total", "total_ns"), [r.prof[i] for i in range(7)]))
     finally:
         radau5_free(&r)
     t_events = [hit_t[hit_event == k] for k in range(m)]
