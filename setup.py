@@ -28,10 +28,12 @@ core = Extension(
 class BuildExt(build_ext):
     """build_ext that removes what older builds left in place: a stale in-place
     ``_radau5`` extension (before the single core) would shadow ``_radau5.py`` and run
-    its own, older copy of the kernels."""
+    its own, older copy of the kernels (``tests/test_core_bridge.py`` checks for it).
+    Done for in-place builds and for editable installs, which copy the extension into
+    the source tree."""
 
     def run(self):
-        if self.inplace:
+        if self.inplace or getattr(self, "editable_mode", False):
             for stale in Path("src/ballc").glob("_radau5.*.so"):
                 stale.unlink()
             for stale in Path("src/ballc").glob("_radau5.*.pyd"):
