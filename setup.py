@@ -1,22 +1,45 @@
-"""Build the compiled core: generated/ kernels + src/ballc glue, bridged by Cython."""
+"""Build the compiled core: generated/ kernels + src/ballc glue, bridged by Cython.
+
+One extension module, ``ballc._core``: the generated kernels, ``_system.c``, the
+radau5 solver and its LU are compiled and linked once, so no build or partial
+rebuild can leave two copies of the model that disagree.  ``ballc._radau5`` is a
+plain Python module re-exporting the solver's bridge (``_radau5_bridge.pxi``, included
+by ``_core.pyx``).
+"""
+from pathlib import Path
+
 from Cython.Build import cythonize
 from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
 
 core = Extension(
     "ballc._core",
-    sources=["src/ballc/_core.pyx", "src/ballc/_system.c", "generated/ballc_kernels.c"],
+    sources=["src/ballc/_core.pyx", "src/ballc/_system.c", "generated/ballc_kernels.c",
+             "src/ballc/_radau5_solver.c", "src/ballc/_lu.c"],
     include_dirs=["generated", "src/ballc"],
-    extra_compile_args=["-O2", "-std=c99"],
+    depends=["src/ballc/_radau5_bridge.pxi", "src/ballc/_system.h", "src/ballc/_lu.h",
+             "src/ballc/_radau5_solver.h", "generated/ballc_kernels.h"],
+    # -fno-math-errno: sqrt never sets errno, so it is one instruction and repeated
+    # calls in the generated kernels are shared (the results are the same bits).
+    extra_compile_args=["-O2", "-std=c99", "-fno-math-errno"],
 )
 
-# The compiled Radau IIA integrator; it calls ballc_rhs / ballc_jacobian directly, so it
-# links its own copy of the system and kernels.  Its linear algebra is _lu.c (no LAPACK).
-radau5 = Extension(
-    "ballc._radau5",
-    sources=["src/ballc/_radau5.pyx", "src/ballc/_radau5_solver.c", "src/ballc/_lu.c",
-             "src/ballc/_system.c", "generated/ballc_kernels.c"],
-    include_dirs=["generated", "src/ballc"],
-    extra_compile_args=["-O2", "-std=c99"],
-)
 
-setup(ext_modules=cythonize([core, radau5], compiler_directives={"language_level": 3}))
+class BuildExt(build_ext):
+    """build_ext that removes what older builds left in place: a stale in-place
+    ``_radau5`` extension (before the single core) would shadow ``_radau5.py`` and run
+    its own, older copy of the kernels (``tests/test_core_bridge.py`` checks for it).
+    Done for in-place builds and for editable installs, which copy the extension into
+    the source tree."""
+
+    def run(self):
+        if self.inplace or getattr(self, "editable_mode", False):
+            for stale in Path("src/ballc").glob("_radau5.*.so"):
+                stale.unlink()
+            for stale in Path("src/ballc").glob("_radau5.*.pyd"):
+                stale.unlink()
+        super().run()
+
+
+setup(ext_modules=cythonize([core], compiler_directives={"language_level": 3}),
+      cmdclass={"build_ext": BuildExt})

@@ -78,7 +78,8 @@ def forward_jacobian(outputs, variables, prefix="j"):
 
 
 class BallcPrinter(C99CodePrinter):
-    """C99 printer with compact Heaviside and exact small integer powers."""
+    """C99 printer with compact Heaviside, exact small integer powers and half-integer
+    powers as products with one square root."""
 
     def _print_Heaviside(self, expr):
         arg = self._print(expr.args[0])
@@ -87,9 +88,16 @@ class BallcPrinter(C99CodePrinter):
 
     def _print_Pow(self, expr):
         base, exp = expr.as_base_exp()
-        if exp.is_Integer and 2 <= exp <= 4:
+        if exp.is_Integer and 2 <= abs(exp) <= 4:
             b = self._print(base)
-            return "(" + "*".join([f"({b})"] * int(exp)) + ")"
+            product = "(" + "*".join([f"({b})"] * abs(int(exp))) + ")"
+            return product if exp > 0 else f"(1.0/{product})"
+        if exp.is_Rational and exp.q == 2 and 3 <= abs(exp.p) <= 5:
+            # x^(3/2) = x sqrt(x), x^(5/2) = x^2 sqrt(x): a multiply and a square root
+            # instead of pow (the Hertz force and its derivatives)
+            b = self._print(base)
+            factors = "*".join([f"({b})"] * (abs(exp.p) // 2) + [f"sqrt({b})"])
+            return f"({factors})" if exp > 0 else f"(1.0/({factors}))"
         return super()._print_Pow(expr)
 
 

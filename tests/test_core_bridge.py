@@ -10,6 +10,23 @@ Y = ballc.Scene().initial_state()
 L = np.ones(_core.N_LATCH)
 
 
+def test_one_compiled_core():
+    """The kernels are compiled once: the solver's bridge is ``_core``'s own, and
+    ``ballc._radau5`` is a plain module re-exporting it (a stale ``_radau5`` extension
+    from an older build would shadow it with its own copy of the kernels)."""
+    import importlib.machinery
+
+    from ballc import _radau5
+    assert _radau5.__file__.endswith(".py")
+    assert _radau5.solve_system is _core.solve_system
+    assert _radau5.solve_linear is _core.solve_linear
+    assert _radau5._lu_solve is _core._lu_solve
+    here = _core.__file__.rsplit("/", 1)[0]
+    compiled = [f for f in __import__("os").listdir(here)
+                if any(f.endswith(s) for s in importlib.machinery.EXTENSION_SUFFIXES)]
+    assert compiled == [_core.__file__.rsplit("/", 1)[1]]
+
+
 def test_layout_comes_from_generated_code():
     assert _core.STATE_NAMES[:4] == ("qw", "qx", "qy", "qz") and len(_core.STATE_NAMES) == _core.N_STATES
     assert len(_core.PARAMETER_NAMES) == _core.N_PARAMETERS == P.size

@@ -1,8 +1,13 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
-"""Bridge to the generated C: typed memoryviews in, C called, arrays out.
+"""Bridge to the compiled core: typed memoryviews in, C called, arrays out.
 
 Private: use the ``ballc`` package.  Every entry point checks lengths; typed
 memoryviews reject wrong dtypes and non-contiguous arrays with ValueError.
+
+The one extension module of ballc: the generated kernels, ``_system.c``, the radau5
+solver and its LU are compiled and linked once, here.  The solver's bridge lives in
+``_radau5_bridge.pxi`` (included at the end) and is imported as ``ballc._radau5``, a
+thin module that re-exports it.
 """
 import numpy as np
 from libc.math cimport NAN
@@ -292,3 +297,6 @@ def contact_forces_per_sample(const double[:, ::1] states, const double[::1] par
                 for j in range(6):
                     o[i, j] = NAN
     return out
+# ---- the radau5 integrator (imported as ballc._radau5) ----
+
+include "_radau5_bridge.pxi"

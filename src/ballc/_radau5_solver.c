@@ -2,6 +2,9 @@
  * scipy/integrate/_ivp/radau.py) and of solve_ivp's event and output logic
  * (scipy/integrate/_ivp/ivp.py), for dense Jacobians and linear events.
  * Comments name the scipy function each part mirrors. */
+#ifdef RADAU5_PROFILE
+#define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
+#endif
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -15,6 +18,20 @@
 #define MIN_FACTOR 0.2     /* Minimum allowed decrease in a step size. */
 #define MAX_FACTOR 10.0    /* Maximum allowed increase in a step size. */
 #define EPS DBL_EPSILON
+
+/* Compiled with -DRADAU5_PROFILE (benchmarks/profile_step.py): time-stamp-counter
+ * ticks of the right-hand side, Jacobian (with partition), factorisations and
+ * solves, and of the whole radau5_solve, in result->prof.  Otherwise no-ops. */
+#ifdef RADAU5_PROFILE
+#include <time.h>
+#include <x86intrin.h>
+static __thread double *prof_acc;
+#define PROF_START unsigned long long prof_t0_ = __rdtsc()
+#define PROF_STOP(k) (prof_acc[k] += (double)(__rdtsc() - prof_t0_))
+#else
+#define PROF_START (void)0
+#define PROF_STOP(k) (void)0
+#endif
 
 typedef double _Complex cplx;
 
@@ -62,8 +79,16 @@ typedef struct {
     double t, t_old, h_abs, h_abs_old, error_norm_old;
     int have_h_abs_old, have_error_norm_old, have_sol, current_jac, lu_valid;
     double *y, *f, *y_old, *J, *Z, *Q;      /* Z, Q: of the last accepted step */
-    double *LU_real; int *piv_real;
+    double *LU_real; int *piv_real;       /* nc x nc: the coupled block (see partition) */
     cplx *LU_complex; int *piv_complex;
+    /* Structure of J (partition): the coupled states (columns of J with a nonzero entry)
+     * and the outputs (zero columns: nothing depends on them).  Ordered [coupled,
+     * outputs], M = mu/h I - J is lower block-triangular, [[M_cc, 0], [-J_oc, mu/h I]]:
+     * only M_cc is factored; the outputs follow by substitution. */
+    int nc, no, *cidx, *oidx;
+    double *Joc;                          /* no x nc, row-major */
+    double lu_mr; cplx lu_mc;             /* mu_real / h, mu_complex / h of the factors */
+    double *xc; cplx *xcc;                /* nc: gathered right-hand sides */
     /* scratch */
     double *y_new, *f_new, *scale, *Z0, *Znew, *W, *F, *dW, *tmp, *err, *ZE;
     cplx *ctmp;
@@ -83,49 +108,111 @@ static double rms(const double *x, int n)
 
 static int call_fun(solver_t *s, double t, const double *y, double *f)
 {
+    PROF_START;
     s->r->nfev++;
-    if (s->p->fun(s->p->ctx, t, y, f) != 0) return -1;
-    for (int i = 0; i < s->n; i++)
-        if (!isfinite(f[i])) return -1;
-    return 0;
+    int rc = s->p->fun(s->p->ctx, t, y, f);
+    for (int i = 0; i < s->n && rc == 0; i++)
+        if (!isfinite(f[i])) rc = -1;
+    PROF_STOP(RADAU5_PROF_FUN);
+    return rc == 0 ? 0 : -1;
+}
+
+/* Split the states into coupled ones (a nonzero entry in their column of J) and
+ * outputs (a zero column), and gather J_oc.  The split is exact for this J: the
+ * Newton matrix built from it is block-triangular, whatever made the column zero. */
+static void partition(solver_t *s)
+{
+    const int n = s->n;
+    s->nc = s->no = 0;
+    for (int j = 0; j < n; j++) {
+        int zero = 1;
+        for (int i = 0; i < n && zero; i++) zero = s->J[i * n + j] == 0.0;
+        if (zero) s->oidx[s->no++] = j;
+        else s->cidx[s->nc++] = j;
+    }
+    for (int a = 0; a < s->no; a++)
+        for (int b = 0; b < s->nc; b++)
+            s->Joc[a * s->nc + b] = s->J[s->oidx[a] * n + s->cidx[b]];
 }
 
 static int call_jac(solver_t *s, double t, const double *y)
 {
+    PROF_START;
     s->r->njev++;
-    if (s->p->jac(s->p->ctx, t, y, s->J) != 0) return -1;
-    for (int i = 0; i < s->n * s->n; i++)
-        if (!isfinite(s->J[i])) return -1;
-    return 0;
+    int rc = s->p->jac(s->p->ctx, t, y, s->J);
+    for (int i = 0; i < s->n * s->n && rc == 0; i++)
+        if (!isfinite(s->J[i])) rc = -1;
+    if (rc == 0) partition(s);
+    PROF_STOP(RADAU5_PROF_JAC);
+    return rc == 0 ? 0 : -1;
 }
 
-/* LU of MU_REAL / h I - J and MU_COMPLEX / h I - J (row-major, as J; see _lu.h). */
+/* LU of the coupled block of MU_REAL / h I - J and MU_COMPLEX / h I - J (row-major,
+ * as J; see _lu.h and partition). */
 static int factor(solver_t *s, double h)
 {
-    int n = s->n;
+    PROF_START;
+    const int n = s->n, nc = s->nc;
     double mr = s->k.mu_real / h;
     cplx mc = s->k.mu_complex / h;
-    for (int i = 0; i < n; i++)
-        for (int j = 0; j < n; j++) {
-            double a = -s->J[i * n + j];
-            s->LU_real[i * n + j] = a + (i == j ? mr : 0.0);
-            s->LU_complex[i * n + j] = a + (i == j ? mc : 0.0);
+    for (int a = 0; a < nc; a++)
+        for (int b = 0; b < nc; b++) {
+            double v = -s->J[s->cidx[a] * n + s->cidx[b]];
+            s->LU_real[a * nc + b] = v + (a == b ? mr : 0.0);
+            s->LU_complex[a * nc + b] = v + (a == b ? mc : 0.0);
         }
-    int info_r = ballc_lu_factor(n, s->LU_real, s->piv_real);
-    int info_c = ballc_lu_factor_complex(n, s->LU_complex, s->piv_complex);
+    s->lu_mr = mr;
+    s->lu_mc = mc;
+    int info_r = ballc_lu_factor(nc, s->LU_real, s->piv_real);
+    int info_c = ballc_lu_factor_complex(nc, s->LU_complex, s->piv_complex);
     s->r->nlu += 2;
     s->lu_valid = 1;
+    PROF_STOP(RADAU5_PROF_FACTOR);
     return (info_r == BALLC_LU_OK && info_c == BALLC_LU_OK) ? 0 : -1;
 }
 
+/* (mu/h I - J) x = b, b (n) overwritten by x: the coupled block by LU, then each
+ * output o from its row, mu/h x_o - J_oc x_c = b_o. */
 static void solve_real(solver_t *s, double *b)
 {
-    ballc_lu_solve(s->n, s->LU_real, s->piv_real, b);
+    PROF_START;
+    const int nc = s->nc, no = s->no;
+    if (no == 0) {
+        ballc_lu_solve(nc, s->LU_real, s->piv_real, b);
+    } else {
+        double *x = s->xc;
+        for (int a = 0; a < nc; a++) x[a] = b[s->cidx[a]];
+        ballc_lu_solve(nc, s->LU_real, s->piv_real, x);
+        for (int a = 0; a < nc; a++) b[s->cidx[a]] = x[a];
+        for (int o = 0; o < no; o++) {
+            const double *row = s->Joc + (size_t)o * nc;
+            double v = b[s->oidx[o]];
+            for (int a = 0; a < nc; a++) v += row[a] * x[a];
+            b[s->oidx[o]] = v / s->lu_mr;
+        }
+    }
+    PROF_STOP(RADAU5_PROF_SOLVE);
 }
 
 static void solve_complex(solver_t *s, cplx *b)
 {
-    ballc_lu_solve_complex(s->n, s->LU_complex, s->piv_complex, b);
+    PROF_START;
+    const int nc = s->nc, no = s->no;
+    if (no == 0) {
+        ballc_lu_solve_complex(nc, s->LU_complex, s->piv_complex, b);
+    } else {
+        cplx *x = s->xcc;
+        for (int a = 0; a < nc; a++) x[a] = b[s->cidx[a]];
+        ballc_lu_solve_complex(nc, s->LU_complex, s->piv_complex, x);
+        for (int a = 0; a < nc; a++) b[s->cidx[a]] = x[a];
+        for (int o = 0; o < no; o++) {
+            const double *row = s->Joc + (size_t)o * nc;
+            cplx v = b[s->oidx[o]];
+            for (int a = 0; a < nc; a++) v += row[a] * x[a];
+            b[s->oidx[o]] = v / s->lu_mc;
+        }
+    }
+    PROF_STOP(RADAU5_PROF_SOLVE);
 }
 
 /* radau.solve_collocation_system: Z (3 x n) starts as Z0 and ends as the solution. */
@@ -655,6 +742,13 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         return -1;
     }
 
+#ifdef RADAU5_PROFILE
+    prof_acc = r->prof;
+    struct timespec prof_ts0, prof_ts1;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &prof_ts0);
+    unsigned long long prof_total0 = __rdtsc();
+    r->profiled = 1;
+#endif
     solver_t s;
     memset(&s, 0, sizeof s);
     s.p = p;
@@ -668,10 +762,11 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     size_t nd = (size_t)n * (1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1) /* y f y_old y_new f_new scale tmp err ZE */
          + (size_t)n * n * 2                                /* J, LU_real */
          + (size_t)n * 3 * 7                                /* Z Q Z0 Znew W F dW */
-         + (size_t)m * 3 + (size_t)n;                       /* g g_new roots, ev_y */
+         + (size_t)m * 3 + (size_t)n                        /* g g_new roots, ev_y */
+         + (size_t)n * n + (size_t)n;                       /* Joc, xc */
     double *dblock = calloc(nd, sizeof(double));
-    cplx *cblock = calloc((size_t)n * n + n, sizeof(cplx));
-    int *iblock = calloc(2 * (size_t)n + 2 * (size_t)m + 2, sizeof(int));
+    cplx *cblock = calloc((size_t)n * n + 2 * (size_t)n, sizeof(cplx));
+    int *iblock = calloc(4 * (size_t)n + 2 * (size_t)m + 2, sizeof(int));
     int rc = 0;
     if (!dblock || !cblock || !iblock) goto oom;
     double *d = dblock;
@@ -682,9 +777,11 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.Z = d; d += 3 * n; s.Q = d; d += 3 * n; s.Z0 = d; d += 3 * n; s.Znew = d; d += 3 * n;
     s.W = d; d += 3 * n; s.F = d; d += 3 * n; s.dW = d; d += 3 * n;
     s.g = d; d += m; s.g_new = d; d += m; s.roots = d; d += m; s.ev_y = d; d += n;
-    s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n;
+    s.Joc = d; d += n * n; s.xc = d; d += n;
+    s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n; s.xcc = s.ctmp + n;
     s.piv_real = iblock; s.piv_complex = iblock + n;
     s.active = iblock + 2 * n; s.count = iblock + 2 * n + m;
+    s.cidx = iblock + 2 * n + 2 * m; s.oidx = s.cidx + n;
 
     s.t = p->t0;
     memcpy(s.y, p->y0, n * sizeof(double));
@@ -732,8 +829,10 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         const double *y_out = s.y;
         int terminate = 0;
         if (m > 0) {
+            PROF_START;
             for (int e = 0; e < m; e++) s.g_new[e] = event_value(&s, e, s.t, s.y);
             terminate = handle_events(&s, &t_out);
+            PROF_STOP(RADAU5_PROF_EVENTS);
             if (terminate < 0) goto oom;
             if (terminate) {
                 dense(&s, t_out, s.tmp);
@@ -769,6 +868,12 @@ oom:
     snprintf(r->message, sizeof r->message, "out of memory");
 done:
     r->h_next = s.h_abs;
+#ifdef RADAU5_PROFILE
+    r->prof[RADAU5_PROF_TOTAL] += (double)(__rdtsc() - prof_total0);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &prof_ts1);
+    r->prof[RADAU5_PROF_TOTAL_NS] += 1e9 * (double)(prof_ts1.tv_sec - prof_ts0.tv_sec)
+                                     + (double)(prof_ts1.tv_nsec - prof_ts0.tv_nsec);
+#endif
     free(dblock);
     free(cblock);
     free(iblock);

@@ -16,7 +16,11 @@
  * Generic in the system: the right-hand side and Jacobian are C callbacks, the
  * dimension is a run-time value.  The Newton systems are solved by ballc's own
  * small LU with partial pivoting (_lu.h: fixed loop order, no BLAS, no threads),
- * so results do not depend on the machine's LAPACK or its threading.
+ * so results do not depend on the machine's LAPACK or its threading.  Only the
+ * coupled states are factored: states whose column of the Jacobian is zero (pure
+ * outputs, e.g. positions nothing depends on, accumulated work) make mu/h I - J
+ * lower block-triangular, so they follow from the coupled block's solution by
+ * substitution; they stay in the error norm and in the Newton convergence test.
  */
 #ifndef BALLC_RADAU5_H
 #define BALLC_RADAU5_H
@@ -57,6 +61,13 @@ typedef struct {
 
 enum { RADAU5_REACHED = 0, RADAU5_EVENT = 1, RADAU5_FAILED = -1 };
 
+/* result->prof (only in a build with -DRADAU5_PROFILE; zeros otherwise): CPU
+ * time-stamp-counter ticks spent in each part and in the whole radau5_solve, and the
+ * latter in nanoseconds of thread CPU time: the parts are shares of the ticks (a
+ * preemption falls on a part in proportion to its length), scaled to the CPU time. */
+enum { RADAU5_PROF_FUN = 0, RADAU5_PROF_JAC, RADAU5_PROF_FACTOR, RADAU5_PROF_SOLVE,
+       RADAU5_PROF_EVENTS, RADAU5_PROF_TOTAL, RADAU5_PROF_TOTAL_NS, RADAU5_PROF_N };
+
 typedef struct {
     int status;               /* RADAU5_REACHED, RADAU5_EVENT or RADAU5_FAILED */
     char message[240];
@@ -73,6 +84,8 @@ typedef struct {
     double *dense_t;          /*   dense_t (n_dense x 2) and y_old then the 3 coefficients */
     double *dense_c;          /*   per state in dense_c (n_dense x 4n): y(t) = y_old +
                                *   sum_j Q_j x^(j+1), x = (t - t_old) / (t - t_old) */
+    int profiled;             /* 1 in a -DRADAU5_PROFILE build */
+    double prof[RADAU5_PROF_N];
 } radau5_result;
 
 /* Integrate; returns 0, or -1 when memory ran out (result->message says so).

@@ -1,30 +1,24 @@
-# cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
-"""Bridge to the compiled Radau IIA (order 5) integrator in ``_radau5_solver.c``.
+# Included by _core.pyx (one extension, one compiled copy of the kernels); compiled
+# with its directives (boundscheck=False, wraparound=False, initializedcheck=False).
+# Bridge to the compiled Radau IIA (order 5) integrator in ``_radau5_solver.c``.
+#
+# Private: use ``ballc.simulate(..., method="radau5")``; imported as ``ballc._radau5``
+# (a thin module re-exporting these names).  This part of ``_core`` checks and
+# converts arguments, hands a C right-hand side to ``radau5_solve`` and turns its
+# buffers into arrays.  The whole integration runs in C without the GIL: no Python
+# per step; the Newton systems are solved by ballc's own LU (``_lu.c``), no LAPACK.
+#
+# ``solve_system`` integrates ballc's equations (``ballc_rhs`` / ``ballc_jacobian``);
+# ``solve_linear`` integrates y' = A y (a generic entry point, used to test the
+# integrator against the matrix exponential); ``_lu_solve`` exposes the LU for tests.
 
-Private: use ``ballc.simulate(..., method="radau5")``.  This module checks and
-converts arguments, hands a C right-hand side to ``radau5_solve`` and turns its
-buffers into arrays.  The whole integration runs in C without the GIL: no Python
-per step; the Newton systems are solved by ballc's own LU (``_lu.c``), no LAPACK.
-
-``solve_system`` integrates ballc's equations (``ballc_rhs`` / ``ballc_jacobian``);
-``solve_linear`` integrates y' = A y (a generic entry point, used to test the
-integrator against the matrix exponential); ``_lu_solve`` exposes the LU for tests.
-"""
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from libc.math cimport isfinite
 from libc.string cimport memcpy
 from libc.math cimport NAN
 
-
-cdef extern from "ballc_kernels.h":
-    int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH
-
-cdef extern from "_system.h":
-    int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
-    int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
-    int ballc_stick_state(const double *, const double *, const double *, int, int,
-                          double *) nogil
 
 cdef extern from "_lu.h":
     int BALLC_LU_OK
@@ -74,6 +68,8 @@ cdef extern from "_radau5_solver.h":
         long n_dense
         double *dense_t
         double *dense_c
+        int profiled
+        double prof[7]
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
     void radau5_free(radau5_result *) nogil
 
@@ -154,33 +150,56 @@ cdef int _linear_jac(void *ctx, double t, const double *y, double *jac) noexcept
 
 # ---- argument checks ----
 
+# The checks run once per segment (simulate calls solve_system per smooth piece), so
+# they loop in C rather than through numpy's ufunc machinery.
+
+cdef bint _finite(const double[::1] a) noexcept:
+    cdef Py_ssize_t i
+    for i in range(a.shape[0]):
+        if not isfinite(a[i]):
+            return False
+    return True
+
+
+cdef bint _finite_nonnegative(const double[::1] a) noexcept:
+    cdef Py_ssize_t i
+    for i in range(a.shape[0]):
+        if not (isfinite(a[i]) and a[i] >= 0):
+            return False
+    return True
+
+
 def _vector(name, value, n):
     a = np.ascontiguousarray(value, dtype=float)
     if a.shape != (n,):
         raise ValueError(f"{name} must have shape ({n},), got {a.shape}")
-    if not np.all(np.isfinite(a)):
+    if not _finite(a):
         raise ValueError(f"{name} = {value!r} is not allowed: must be finite")
     return a
 
 
 def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
     t0, t1 = float(t0), float(t1)
-    if not (np.isfinite(t0) and np.isfinite(t1)):
+    if not (isfinite(t0) and isfinite(t1)):
         raise ValueError(f"t_span = ({t0}, {t1}) is not allowed: must be finite")
     rtol = float(rtol) if np.ndim(rtol) == 0 else rtol
-    if not isinstance(rtol, float) or not (np.isfinite(rtol) and rtol > 0):
+    if not isinstance(rtol, float) or not (isfinite(rtol) and rtol > 0):
         raise ValueError(f"rtol = {rtol!r} is not allowed: must be one finite number > 0")
     if rtol < 100 * EPS:   # as ballc.options: scipy would silently raise it
         raise ValueError(f"rtol = {rtol!r} is not allowed: must be >= 100 machine "
                          f"epsilons = {100 * EPS:.3g}")
-    atol_v = np.array(np.broadcast_to(np.asarray(atol, dtype=float), (n,)))   # a writable copy
-    if not (np.all(np.isfinite(atol_v)) and np.all(atol_v >= 0)):
+    if isinstance(atol, (float, int)):
+        atol_v = np.empty(n)   # a writable copy
+        atol_v.fill(atol)
+    else:
+        atol_v = np.array(np.broadcast_to(np.asarray(atol, dtype=float), (n,)))
+    if not _finite_nonnegative(atol_v):
         raise ValueError(f"atol = {atol!r} is not allowed: must be finite and >= 0")
     max_step = float(max_step)
     if not max_step > 0:
         raise ValueError(f"max_step = {max_step!r} is not allowed: must be > 0")
     first = 0.0 if first_step is None else float(first_step)
-    if first_step is not None and not (np.isfinite(first) and 0 < first <= abs(t1 - t0)):
+    if first_step is not None and not (isfinite(first) and 0 < first <= abs(t1 - t0)):
         raise ValueError(f"first_step = {first_step!r} is not allowed: must be in "
                          f"(0, {abs(t1 - t0)}]")
     if t_eval is not None:
@@ -209,8 +228,14 @@ def _event_arrays(events, n):
     for k, e in enumerate(events):
         if hasattr(e, "stick_plane"):
             plane[k] = int(e.stick_plane)
+            offset[k] = float(getattr(e, "offset", 0.0))
         elif hasattr(e, "coefficients"):
-            coef[k] = _vector(f"events[{k}].coefficients", e.coefficients, n)
+            c = e.coefficients
+            if not (isinstance(c, np.ndarray) and c.shape == (n,) and c.dtype == np.float64):
+                c = _vector(f"events[{k}].coefficients", c, n)
+            coef[k] = c
+            if not _finite(coef[k]):
+                _vector(f"events[{k}].coefficients", c, n)   # raises, naming it
             offset[k] = float(getattr(e, "offset", 0.0))
         elif callable(e):
             plane[k] = -2 - len(users)
@@ -219,8 +244,6 @@ def _event_arrays(events, n):
             raise TypeError(f"events[{k}] = {e!r} is neither a linear event (`coefficients` "
                             "and `offset`: g(y) = coefficients . y + offset), a stick-release "
                             "event (`stick_plane`) nor a callable g(t, y)")
-        if hasattr(e, "stick_plane"):
-            offset[k] = float(getattr(e, "offset", 0.0))
         terminal[k] = bool(getattr(e, "terminal", False))
         dirn = float(getattr(e, "direction", 0))
         direction[k] = (dirn > 0) - (dirn < 0)
@@ -265,13 +288,20 @@ cdef object _run(radau5_problem *p, int n, int m):
             memcpy(&hev[0], r.hit_event, r.n_hits * sizeof(int))
             memcpy(&htv[0], r.hit_t, r.n_hits * sizeof(double))
             memcpy(&hyv[0, 0], r.hit_y, r.n_hits * n * sizeof(double))
-        status, message = r.status, r.message.decode()
+        status, message, r_hits = r.status, r.message.decode(), r.n_hits
         counts = dict(nfev=r.nfev, njev=r.njev, nlu=r.nlu, nstep=r.nstep, nreject=r.nreject,
                       h_next=r.h_next)
+        if r.profiled:   # a -DRADAU5_PROFILE build (benchmarks/profile_step.py)
+            counts["profile"] = dict(zip(("fun", "jac", "factor", "solve", "events",
+                                          "total", "total_ns"), [r.prof[i] for i in range(7)]))
     finally:
         radau5_free(&r)
-    t_events = [hit_t[hit_event == k] for k in range(m)]
-    y_events = [hit_y[hit_event == k].reshape(-1, n) for k in range(m)]
+    if r_hits:
+        t_events = [hit_t[hit_event == k] for k in range(m)]
+        y_events = [hit_y[hit_event == k].reshape(-1, n) for k in range(m)]
+    else:
+        t_events = [np.empty(0) for k in range(m)]
+        y_events = [np.empty((0, n)) for k in range(m)]
     return OptimizeResult(t=t, y=np.ascontiguousarray(y.T), t_events=t_events,
                           y_events=y_events, status=status, message=message,
                           success=status >= 0, sol=None, dense=dense, **counts)
@@ -357,7 +387,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     params = _vector("params", params, BALLC_N_PARAMETERS)
     latch = _vector("latch", latch, BALLC_N_LATCH)
     cdef double[::1] pv = params, lv = latch
-    cdef int[::1] planes = np.full(max(len(events or ()), 1), -1, dtype=np.intc)
+    planes_array = np.empty(max(len(events or ()), 1), dtype=np.intc)
+    planes_array.fill(-1)
+    cdef int[::1] planes = planes_array
     ctx.params = &pv[0]
     ctx.latch = &lv[0]
     ctx.flags = flags

@@ -1,0 +1,14 @@
+"""The compiled Radau IIA (order 5) integrator: a thin view of ``ballc._core``.
+
+Private: use ``ballc.simulate(..., method="radau5")``.  The solver, its LU and the
+system it integrates are compiled once, into ``ballc._core`` (see
+``_radau5_bridge.pxi``); this module only re-exports its entry points, so there is
+one copy of the kernels in the process, never two that could disagree.
+
+``solve_system`` integrates ballc's equations; ``solve_linear`` integrates y' = A y
+(used to test the integrator against the matrix exponential); ``_lu_solve`` exposes
+ballc's LU for tests.
+"""
+from ._core import EPS, _lu_solve, solve_linear, solve_system
+
+__all__ = ["solve_system", "solve_linear"]
