@@ -7,8 +7,8 @@ one copy of the kernels in the process, never two that could disagree.
 
 ``solve_system`` integrates ballc's equations; ``solve_linear`` integrates y' = A y
 (used to test the integrator against the matrix exponential); ``_lu_solve`` exposes
-ballc's LU for tests.
+ballc's LU and ``_constants`` radau5's method constants for tests.
 """
-from ._core import EPS, _lu_solve, solve_linear, solve_system
+from ._core import EPS, _constants, _lu_solve, solve_linear, solve_system
 
 __all__ = ["solve_system", "solve_linear"]
