@@ -13,6 +13,8 @@ stop, clear) or the stick-mode release.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from . import _core, layout, stickslip
@@ -52,8 +54,15 @@ class LinearEvent:
         return cls(coefficients, offset, terminal, direction)
 
     def shifted(self, delta, terminal, direction):
-        """g(y) + delta, with its own terminal and direction."""
-        return LinearEvent(self.coefficients, self.offset + delta, terminal, direction)
+        """g(y) + delta, with its own terminal and direction (shares the coefficients,
+        which are never written: one per segment and event, so kept cheap)."""
+        event = LinearEvent.__new__(LinearEvent)
+        event.coefficients, event._index, event._scale = (self.coefficients, self._index,
+                                                          self._scale)
+        event.offset = self.offset + float(delta)
+        event.terminal = bool(terminal)
+        event.direction = direction
+        return event
 
     def __call__(self, t, y):
         if self._index is not None:
@@ -67,12 +76,22 @@ class LinearEvent:
                 f"direction={self.direction})")
 
 
+@functools.lru_cache(maxsize=64)
+def _penetration_of(plane, radius, ceiling_height):
+    if plane == "floor":
+        return LinearEvent.of_state("z", -1.0, radius)
+    return LinearEvent.of_state("z", 1.0, -(ceiling_height - radius))
+
+
+@functools.lru_cache(maxsize=64)
+def _deepest_of(plane):
+    normal = 1.0 if plane == "floor" else -1.0
+    return LinearEvent.of_state("vz", -normal, 0.0, False, -1)
+
+
 def penetration(plane, scene):
     """rho(y) of ``plane`` (a LinearEvent): positive when the ball overlaps it (m)."""
-    r, h = scene.radius, scene.ceiling_height
-    if plane == "floor":
-        return LinearEvent.of_state("z", -1.0, r)
-    return LinearEvent.of_state("z", 1.0, -(h - r))
+    return _penetration_of(plane, float(scene.radius), float(scene.ceiling_height))
 
 
 def contact_threshold(scene, plane, rho0, entering):
@@ -110,12 +129,10 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
         rho = penetration(plane, scene)
         rho0 = rho(0.0, y0)
         if in_contact[plane]:
-            normal = 1.0 if plane == "floor" else -1.0
             threshold = contact_threshold(scene, plane, rho0, entering=False)
             events.append(("leave", plane, rho.shifted(threshold, True, -1)))
             events.append(("through", plane, rho.shifted(-scene.radius, True, 1)))
-            events.append(("deepest", plane,
-                           LinearEvent.of_state("vz", -normal, 0.0, False, -1)))
+            events.append(("deepest", plane, _deepest_of(plane)))
         else:
             threshold = contact_threshold(scene, plane, rho0, entering=True)
             events.append(("enter", plane, rho.shifted(-threshold, True, 1)))

@@ -31,6 +31,8 @@ decisions at the mode boundaries; the driver (simulate.py) holds the segment loo
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import _core, layout
@@ -75,8 +77,9 @@ def set_slip_direction(latch: np.ndarray, plane: str, direction) -> None:
 
 def speed_scale(scene, y) -> float:
     """|v| + r |omega| (m/s): the scale slip speeds are compared with."""
-    return float(np.linalg.norm(y[layout.VELOCITY]) + scene.radius * np.linalg.norm(
-        y[layout.ANGULAR_VELOCITY])) + 1e-300
+    vx, vy, vz = y[layout.VELOCITY]
+    wx, wy, wz = y[layout.ANGULAR_VELOCITY]
+    return math.hypot(vx, vy, vz) + scene.radius * math.hypot(wx, wy, wz) + 1e-300
 
 
 def clear_speed(scene, y, rtol, atol) -> float:
