@@ -203,6 +203,9 @@ def output_kernels(model: Model):
         Kernel("contact_kinematics", "Per plane (floor, ceiling): rho, rhodot, contact-point"
                " velocity x y z (10).", kin, []),
         Kernel("observer_position", "Observer position in N (3).", observer_position, []),
+        Kernel("hertz_stiffness", "Hertz stiffness k0 (N/m^(3/2)) of the ball on a plane (1): "
+               "the one formula, also behind Scene.hertz_stiffness.",
+               [contact.hertz_stiffness(model)], []),
     ]
 
 

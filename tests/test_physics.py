@@ -217,3 +217,12 @@ def test_hunt_crossley_restitution_near_one(c_tau):
     a = mp.mpf(1.5) * (1 - mp.mpf(c_tau))
     exact = mp.findroot(lambda x: a * (1 + x) - mp.log((1 + a) / (1 - a * x)), 1 - 2 * a / 3)
     assert abs(e - float(exact)) <= 1e-13
+
+
+def test_hertz_stiffness_is_the_textbook_formula():
+    """k0 = 4/3 E* sqrt(r), 1/E* = (1 - nu_b^2)/E_b + (1 - nu_p^2)/E_p (Johnson, Contact
+    Mechanics, eq. 4.22), written here independently of the generated kernel it reads."""
+    scene = ballc.Scene(ball_youngs_modulus=3e3, plane_youngs_modulus=2e10, radius=0.7,
+                        ball_poisson_ratio=0.25, plane_poisson_ratio=0.15)
+    e_star = 1 / ((1 - 0.25 ** 2) / 3e3 + (1 - 0.15 ** 2) / 2e10)
+    assert scene.hertz_stiffness == pytest.approx(4 / 3 * e_star * 0.7 ** 0.5, rel=1e-14)

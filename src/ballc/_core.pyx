@@ -23,6 +23,7 @@ cdef extern from "ballc_kernels.h":
     void ballc_energy(const double *, const double *, const double *, double *) nogil
     void ballc_contact_kinematics(const double *, const double *, const double *, double *) nogil
     void ballc_observer_position(const double *, const double *, const double *, double *) nogil
+    void ballc_hertz_stiffness(const double *, const double *, const double *, double *) nogil
     int BALLC_FLOOR_SLIP_NOUT
     void ballc_floor_slip(const double *, const double *, const double *, double *) nogil
     void ballc_ceiling_slip(const double *, const double *, const double *, double *) nogil
@@ -300,3 +301,12 @@ def contact_forces_per_sample(const double[:, ::1] states, const double[::1] par
 # ---- the radau5 integrator (imported as ballc._radau5) ----
 
 include "_radau5_bridge.pxi"
+
+
+def hertz_stiffness(const double[::1] params):
+    """k0 (N/m^(3/2)) of the generated contact law, from the parameter vector."""
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    cdef double state[BALLC_MAX_STATES]
+    cdef double k0
+    ballc_hertz_stiffness(state, &params[0], NULL, &k0)
+    return k0

@@ -71,6 +71,7 @@ cdef extern from "_radau5_solver.h":
         int profiled
         double prof[7]
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
+    int RADAU5_DONE, RADAU5_OUT_OF_MEMORY
     void radau5_free(radau5_result *) nogil
 
 
@@ -259,8 +260,10 @@ cdef object _run(radau5_problem *p, int n, int m):
     with nogil:
         rc = radau5_solve(p, &r)
     try:
-        if rc != 0:
+        if rc == RADAU5_OUT_OF_MEMORY:
             raise MemoryError(r.message.decode())
+        if rc != RADAU5_DONE:
+            raise ValueError(r.message.decode())
         dense = None
         if p.dense_output:
             dense_t = np.empty((r.n_dense, 2))

@@ -94,7 +94,7 @@ typedef struct {
     cplx *ctmp;
     /* events */
     double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */
-    int *active, *count;
+    int *active;
     size_t cap_out, cap_hits, cap_dense;
 } solver_t;
 
@@ -489,19 +489,36 @@ static double initial_step(solver_t *s)
 
 /* ---- output buffers ---- */
 
+/* *buffer grown to hold ``count`` items of ``size`` bytes; 0, or -1 when memory ran
+ * out (the old buffer is kept, so what was stored can still be returned). */
+static int grow(void *buffer, size_t count, size_t size)
+{
+    void **slot = buffer;
+    void *grown = realloc(*slot, count * size);
+    if (!grown) return -1;
+    *slot = grown;
+    return 0;
+}
+
+/* Room for one more item in buffers of capacity *cap holding *used items: doubled
+ * (from ``first``) when full.  Each buffer i holds ``sizes[i]`` bytes per item. */
+static int reserve(size_t *cap, long used, size_t first, int k, void **buffers[],
+                   const size_t sizes[])
+{
+    if ((size_t)used < *cap) return 0;
+    size_t next = *cap ? 2 * *cap : first;
+    for (int i = 0; i < k; i++)
+        if (grow(buffers[i], next, sizes[i]) != 0) return -1;
+    *cap = next;
+    return 0;
+}
+
 static int store_point(solver_t *s, double t, const double *y)
 {
     radau5_result *r = s->r;
-    if ((size_t)r->n_out == s->cap_out) {
-        size_t cap = s->cap_out ? 2 * s->cap_out : 256;
-        double *tt = realloc(r->t_out, cap * sizeof(double));
-        if (!tt) return -1;
-        r->t_out = tt;
-        double *yy = realloc(r->y_out, cap * s->n * sizeof(double));
-        if (!yy) return -1;
-        r->y_out = yy;
-        s->cap_out = cap;
-    }
+    void **buffers[] = {(void **)&r->t_out, (void **)&r->y_out};
+    const size_t sizes[] = {sizeof(double), s->n * sizeof(double)};
+    if (reserve(&s->cap_out, r->n_out, 256, 2, buffers, sizes) != 0) return -1;
     r->t_out[r->n_out] = t;
     memcpy(r->y_out + r->n_out * s->n, y, s->n * sizeof(double));
     r->n_out++;
@@ -511,19 +528,9 @@ static int store_point(solver_t *s, double t, const double *y)
 static int store_hit(solver_t *s, int event, double t, const double *y)
 {
     radau5_result *r = s->r;
-    if ((size_t)r->n_hits == s->cap_hits) {
-        size_t cap = s->cap_hits ? 2 * s->cap_hits : 16;
-        int *e = realloc(r->hit_event, cap * sizeof(int));
-        if (!e) return -1;
-        r->hit_event = e;
-        double *tt = realloc(r->hit_t, cap * sizeof(double));
-        if (!tt) return -1;
-        r->hit_t = tt;
-        double *yy = realloc(r->hit_y, cap * s->n * sizeof(double));
-        if (!yy) return -1;
-        r->hit_y = yy;
-        s->cap_hits = cap;
-    }
+    void **buffers[] = {(void **)&r->hit_event, (void **)&r->hit_t, (void **)&r->hit_y};
+    const size_t sizes[] = {sizeof(int), sizeof(double), s->n * sizeof(double)};
+    if (reserve(&s->cap_hits, r->n_hits, 16, 3, buffers, sizes) != 0) return -1;
     r->hit_event[r->n_hits] = event;
     r->hit_t[r->n_hits] = t;
     memcpy(r->hit_y + r->n_hits * s->n, y, s->n * sizeof(double));
@@ -536,16 +543,9 @@ static int store_dense(solver_t *s)
 {
     radau5_result *r = s->r;
     const int n = s->n;
-    if ((size_t)r->n_dense == s->cap_dense) {
-        size_t cap = s->cap_dense ? 2 * s->cap_dense : 256;
-        double *tt = realloc(r->dense_t, cap * 2 * sizeof(double));
-        if (!tt) return -1;
-        r->dense_t = tt;
-        double *cc = realloc(r->dense_c, cap * 4 * (size_t)n * sizeof(double));
-        if (!cc) return -1;
-        r->dense_c = cc;
-        s->cap_dense = cap;
-    }
+    void **buffers[] = {(void **)&r->dense_t, (void **)&r->dense_c};
+    const size_t sizes[] = {2 * sizeof(double), 4 * (size_t)n * sizeof(double)};
+    if (reserve(&s->cap_dense, r->n_dense, 256, 2, buffers, sizes) != 0) return -1;
     r->dense_t[2 * r->n_dense] = s->t_old;
     r->dense_t[2 * r->n_dense + 1] = s->t;
     double *c = r->dense_c + (size_t)r->n_dense * 4 * n;
@@ -687,7 +687,6 @@ static int handle_events(solver_t *s, double *t_stop)
     }
     if (m == 0) return 0;
     for (int i = 0; i < m; i++) {
-        s->count[s->active[i]]++;
         s->roots[i] = event_root(s, s->active[i]);
         if (p->ev_terminal[s->active[i]]) terminate = 1;
     }
@@ -739,7 +738,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     r->status = RADAU5_FAILED;
     if (n <= 0 || m < 0) {
         snprintf(r->message, sizeof r->message, "n = %d and n_events = %d: need n > 0, n_events >= 0", n, m);
-        return -1;
+        return RADAU5_BAD_PROBLEM;
     }
 
 #ifdef RADAU5_PROFILE
@@ -780,7 +779,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.Joc = d; d += n * n; s.xc = d; d += n;
     s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n; s.xcc = s.ctmp + n;
     s.piv_real = iblock; s.piv_complex = iblock + n;
-    s.active = iblock + 2 * n; s.count = iblock + 2 * n + m;
+    s.active = iblock + 2 * n;
     s.cidx = iblock + 2 * n + 2 * m; s.oidx = s.cidx + n;
 
     s.t = p->t0;
@@ -863,7 +862,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     }
     goto done;
 oom:
-    rc = -1;
+    rc = RADAU5_OUT_OF_MEMORY;
     r->status = RADAU5_FAILED;
     snprintf(r->message, sizeof r->message, "out of memory");
 done:

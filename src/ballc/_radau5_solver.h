@@ -60,6 +60,8 @@ typedef struct {
 } radau5_problem;
 
 enum { RADAU5_REACHED = 0, RADAU5_EVENT = 1, RADAU5_FAILED = -1 };
+/* What radau5_solve returns (result->status says how the integration ended). */
+enum { RADAU5_DONE = 0, RADAU5_OUT_OF_MEMORY = -1, RADAU5_BAD_PROBLEM = -2 };
 
 /* result->prof (only in a build with -DRADAU5_PROFILE; zeros otherwise): CPU
  * time-stamp-counter ticks spent in each part and in the whole radau5_solve, and the
@@ -83,12 +85,13 @@ typedef struct {
     long n_dense;             /* with dense_output: accepted steps, each (t_old, t) in */
     double *dense_t;          /*   dense_t (n_dense x 2) and y_old then the 3 coefficients */
     double *dense_c;          /*   per state in dense_c (n_dense x 4n): y(t) = y_old +
-                               *   sum_j Q_j x^(j+1), x = (t - t_old) / (t - t_old) */
+                               *   sum_j Q_j x^(j+1), x = (t - t_old) / (t_new - t_old) */
     int profiled;             /* 1 in a -DRADAU5_PROFILE build */
     double prof[RADAU5_PROF_N];
 } radau5_result;
 
-/* Integrate; returns 0, or -1 when memory ran out (result->message says so).
+/* Integrate; returns RADAU5_DONE, RADAU5_OUT_OF_MEMORY or RADAU5_BAD_PROBLEM (a bad
+ * dimension; result->message says which).
  * The result always holds what was computed; release it with radau5_free. */
 int radau5_solve(const radau5_problem *problem, radau5_result *result);
 void radau5_free(radau5_result *result);

@@ -246,10 +246,9 @@ class Scene:
 
     @property
     def hertz_stiffness(self) -> float:
-        """k0 = 4 / (3 (sigma_b + sigma_p)) sqrt(r), N/m^(3/2)."""
-        sigma_b = (1 - self.ball_poisson_ratio ** 2) / self.ball_youngs_modulus
-        sigma_p = (1 - self.plane_poisson_ratio ** 2) / self.plane_youngs_modulus
-        return 4.0 / (3.0 * (sigma_b + sigma_p)) * math.sqrt(self.radius)
+        """k0 = 4 / (3 (sigma_b + sigma_p)) sqrt(r), sigma = (1 - nu^2) / E, N/m^(3/2):
+        evaluated by the generated kernel, so the formula exists once (codegen/contact.py)."""
+        return float(_core.hertz_stiffness(self.parameter_vector()))
 
     def parameter_vector(self) -> np.ndarray:
         """Parameters in the generated layout order (``ballc._core.PARAMETER_NAMES``)."""
