@@ -91,12 +91,22 @@ def test_pure_digin_passes_through_the_floor_with_honest_status():
 @pytest.mark.slow
 def test_trajectory_matches_seed_pipeline():
     """The seed's own pipeline (side-effecting gradient, 123 angles, lambdify) at
-    rtol = atol = 1e-12 and ballc agree on the contact times and the final state."""
+    rtol = atol = 1e-12 and ballc (exact Coulomb friction, the v_s -> 0 limit of the
+    seed's law) agree on the whole 5-s trajectory to 1e-5 (the seed's own final-state
+    error is ~2e-6, limited by its formulation), and on the contact times to the
+    resolution of the seed's samples."""
     from codegen.seed_reference import run_seed_pipeline
     seed = run_seed_pipeline(5.0)
     ours = ballc.simulate(ballc.Scene(), 5.0, rtol=1e-12, atol=1e-12, t_eval=seed["t"])
-    np.testing.assert_allclose(ours.position, seed["y"][3:6], atol=2e-3)
-    np.testing.assert_allclose(ours.velocity, seed["y"][9:12], atol=2e-2)
+    np.testing.assert_allclose(ours.position, seed["y"][3:6], atol=1e-5)
+    # Velocities: 1e-5 in flight (measured 1.8e-6).  Inside a contact the acceleration
+    # is ~1e3 m/s^2 and the seed latches its impact values somewhere in a 1-cm band
+    # from inside its RHS: its contact forces are shifted by ~1e-7 s, 1e-4 m/s there.
+    inside = np.zeros(seed["t"].size, dtype=bool)
+    for contact in ours.contacts:
+        inside |= (seed["t"] >= contact.t_start) & (seed["t"] <= contact.t_end)
+    np.testing.assert_allclose(ours.velocity[:, ~inside], seed["y"][9:12, ~inside], atol=1e-5)
+    np.testing.assert_allclose(ours.velocity[:, inside], seed["y"][9:12, inside], atol=2e-4)
     seed_times = [t for t, _ in seed["contacts"]]
     np.testing.assert_allclose([c.t_start for c in ours.contacts], seed_times, atol=2e-3)
 
