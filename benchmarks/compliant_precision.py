@@ -16,13 +16,13 @@ Prints the tables and writes them to docs/compliant_precision.md.
 from __future__ import annotations
 
 import argparse
-import time
 from pathlib import Path
 
 import numpy as np
 
 import ballc
-from ballc import _core
+
+from .seed_tolerance import _IDX, measure  # one timing loop for both tables
 
 T_END = 5.0
 TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
@@ -32,20 +32,7 @@ SCENES = {
                                               tangential_stiffness_ratio=2 / 7,
                                               friction_coefficient=1.0),
 }
-_IDX = [_core.STATE_NAMES.index(n) for n in ("x", "y", "z", "vx", "vy", "vz")]
 DOCS = Path(__file__).resolve().parent.parent / "docs"
-
-
-def measure(scene, tol, repeat, max_nfev):
-    best, result = np.inf, None
-    for _ in range(repeat):
-        started = time.process_time()
-        result = ballc.simulate(scene, T_END, rtol=tol, atol=tol, max_nfev=max_nfev)
-        cpu = time.process_time() - started
-        best = min(best, cpu)
-        if cpu > 2.0 or result.status != 0:
-            break
-    return best, result
 
 
 def main(argv=None):
