@@ -139,12 +139,18 @@ def _on_local_pool(tasks, workers, progress):
     size = max(1, math.ceil(len(tasks) / (16 * workers)))
     batches = [(start, tasks[start:start + size]) for start in range(0, len(tasks), size)]
     rows = [None] * len(tasks)
+    bar = _bar(None, progress, len(tasks)) if progress else None
     with ProcessPoolExecutor(max_workers=workers) as pool:
         futures = {pool.submit(_run_batch, batch): start for start, batch in batches}
-        for future in _bar(as_completed(futures), progress, len(futures)):
+        for future in as_completed(futures):
             start = futures[future]
-            for offset, row in enumerate(future.result()):
+            done = future.result()
+            for offset, row in enumerate(done):
                 rows[start + offset] = row
+            if bar is not None:
+                bar.update(len(done))      # the bar counts runs, not batches
+    if bar is not None:
+        bar.close()
     return rows
 
 
