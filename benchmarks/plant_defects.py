@@ -54,7 +54,7 @@ DEFECTS = [
     Defect("Hertz exponent 3/2 -> 1.4 (HC force)", "codegen/contact.py",
            "k0 * _positive(rho)**sm.Rational(3, 2) * (1 + damping)",
            "k0 * _positive(rho)**sm.Rational(7, 5) * (1 + damping)", regenerate=True),
-    Defect("dig-in direction latched reversed", "src/ballc/simulate.py",
+    Defect("dig-in direction latched reversed", "src/ballc/modes.py",
            "    return max(rate, MIN_IMPACT_RATE), direction\n",
            "    return max(rate, MIN_IMPACT_RATE), -direction\n", regenerate=False),
     Defect("tangential dissipation rate sign flipped", "codegen/contact.py",

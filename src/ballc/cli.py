@@ -156,14 +156,15 @@ def _output_folder(out: Path) -> Path:
 def _simulate_options(scene, t_end, options: dict):
     """(t_end, options for ballc.simulate) checked by ballc.simulate's own validation;
     options not given take simulate's defaults."""
-    from .simulate import _check_options, simulate
+    from .options import check_options
+    from .simulate import simulate
     defaults = {name: parameter.default
                 for name, parameter in inspect.signature(simulate).parameters.items()
                 if name in ("method", "rtol", "atol")}
     given = {name: value for name, value in options.items() if value is not None}
     merged = {**defaults, **given}
-    t_end = _check_options(scene, t_end, method=merged["method"], rtol=merged["rtol"],
-                           atol=merged["atol"])
+    t_end = check_options(scene, t_end, method=merged["method"], rtol=merged["rtol"],
+                          atol=merged["atol"]).t_end
     return t_end, given
 
 

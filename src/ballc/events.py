@@ -138,8 +138,8 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
             events.append(("enter", plane, rho.shifted(-threshold, True, 1)))
         mode = coulomb[plane] if coulomb else None
         if mode in ("slip", "slip_fixed"):
-            k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE + stickslip._SLIP_DIRECTION
-            along = stickslip.slip_stop_coefficients(params, plane, latch[k:k + 2])
+            along = stickslip.slip_stop_coefficients(params, plane,
+                                                     stickslip.slip_direction(latch, plane))
             if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
                 events.append(("approach", plane, LinearEvent(along, -clear, True, -1)))
             else:                # fixed direction: stop at u . d = 0, or go free at 2 clear

@@ -16,7 +16,7 @@ import numpy as np
 from . import _core, events as ev, layout, modes, outcome, stickslip
 from .dense import PiecewiseSolution
 from .integrate import failure_hint, integrate_segment
-from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (re-exported)
+from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
 from .result import Contact, Result
 from .scene import Scene, SceneError
@@ -27,11 +27,6 @@ _QUATERNION, _DISSIPATED, _DEFLECTION = layout.QUATERNION, layout.DISSIPATED, la
 SUCCESS = "The solver successfully reached the end of the integration interval."
 #: Events after which the next segment starts with the last segment's next step size.
 CARRY_STEP = ("approach", "stop", "clear", "release")
-
-
-def _check_options(scene, t_end, method="radau5", rtol=1e-10, atol=1e-10, max_step=np.inf):
-    """t_end, after checking the options (see ballc.options.check_options)."""
-    return check_options(scene, t_end, method, rtol, atol, max_step).t_end
 
 
 def check_initial_state(scene, y0):

@@ -70,9 +70,18 @@ def mode_flags(plane: str, mode: str | None) -> int:
     return _core.FLAGS[f"{plane}_{mode}"] if mode else 0
 
 
-def set_slip_direction(latch: np.ndarray, plane: str, direction) -> None:
+def _slip_direction_slice(plane: str) -> slice:
     k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE + _SLIP_DIRECTION
-    latch[k:k + 2] = direction
+    return slice(k, k + 2)
+
+
+def slip_direction(latch: np.ndarray, plane: str) -> np.ndarray:
+    """The slip direction d latched for ``plane`` (a view into ``latch``)."""
+    return latch[_slip_direction_slice(plane)]
+
+
+def set_slip_direction(latch: np.ndarray, plane: str, direction) -> None:
+    latch[_slip_direction_slice(plane)] = direction
 
 
 def speed_scale(scene, y) -> float:
