@@ -21,7 +21,10 @@ core = Extension(
              "src/ballc/_radau5_solver.h", "generated/ballc_kernels.h"],
     # -fno-math-errno: sqrt never sets errno, so it is one instruction and repeated
     # calls in the generated kernels are shared (the results are the same bits).
-    extra_compile_args=["-O2", "-std=c99", "-fno-math-errno"],
+    # -fcx-limited-range: complex * and / as the textbook formulas (radau5's complex
+    # Newton system; its values are finite and far from overflow), not libgcc's
+    # __muldc3 / __divdc3 with their inf/NaN recovery.
+    extra_compile_args=["-O2", "-std=c99", "-fno-math-errno", "-fcx-limited-range"],
 )
 
 

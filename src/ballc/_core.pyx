@@ -35,6 +35,10 @@ cdef extern from "_system.h":
     int BALLC_OK
     int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
     int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
+    int ballc_rhs_checked_inputs(const double *, const double *, const double *, int,
+                                 double *) nogil
+    int ballc_jacobian_checked_inputs(const double *, const double *, const double *, int,
+                                      double *) nogil
     int ballc_contact_forces(const double *, const double *, const double *, int, double *) nogil
     int ballc_stick_state(const double *, const double *, const double *, int, int,
                           double *) nogil

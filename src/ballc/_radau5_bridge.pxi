@@ -90,11 +90,11 @@ ctypedef struct ball_ctx:
 
 cdef int _ball_fun(void *ctx, double t, const double *y, double *f) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
-    return ballc_rhs(y, c.params, c.latch, c.flags, f)
+    return ballc_rhs_checked_inputs(y, c.params, c.latch, c.flags, f)
 
 cdef int _ball_jac(void *ctx, double t, const double *y, double *jac) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
-    return ballc_jacobian(y, c.params, c.latch, c.flags, jac)
+    return ballc_jacobian_checked_inputs(y, c.params, c.latch, c.flags, jac)
 
 cdef int _ball_event(void *ctx, int e, double t, const double *y, double *g) noexcept nogil:
     """The stick-to-slip margin mu N - |lambda| of the event's plane, or a user event."""
@@ -183,7 +183,8 @@ def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
     t0, t1 = float(t0), float(t1)
     if not (isfinite(t0) and isfinite(t1)):
         raise ValueError(f"t_span = ({t0}, {t1}) is not allowed: must be finite")
-    rtol = float(rtol) if np.ndim(rtol) == 0 else rtol
+    if not isinstance(rtol, float):
+        rtol = float(rtol) if np.ndim(rtol) == 0 else rtol
     if not isinstance(rtol, float) or not (isfinite(rtol) and rtol > 0):
         raise ValueError(f"rtol = {rtol!r} is not allowed: must be one finite number > 0")
     if rtol < 100 * EPS:   # as ballc.options: scipy would silently raise it
@@ -219,36 +220,38 @@ def _event_arrays(events, n):
     (``stick_plane``, ``offset``: g = mu N - |lambda| + offset, evaluated in C) and, for
     ballc's system, any other callable g(t, y) (a user event, called from C).
     Returns (m, coef, offset, terminal, direction, plane, user callables)."""
-    m = len(events)
-    coef = np.zeros((max(m, 1), n))
-    offset = np.zeros(max(m, 1))
-    terminal = np.zeros(max(m, 1), dtype=np.intc)
-    direction = np.zeros(max(m, 1), dtype=np.intc)
-    plane = np.full(max(m, 1), -1, dtype=np.intc)
+    cdef Py_ssize_t m = len(events), k, size = max(len(events), 1)
+    coef = np.zeros((size, n))
+    reals = np.zeros(size)
+    ints = np.zeros((3, size), dtype=np.intc)
+    cdef double[::1] offset = reals
+    cdef int[:, ::1] iv = ints   # terminal, direction, plane
+    iv[2, :] = -1
     users = []
-    for k, e in enumerate(events):
-        if hasattr(e, "stick_plane"):
-            plane[k] = int(e.stick_plane)
-            offset[k] = float(getattr(e, "offset", 0.0))
-        elif hasattr(e, "coefficients"):
-            c = e.coefficients
+    for k in range(m):
+        e = events[k]
+        c = getattr(e, "coefficients", None)   # the driver's events are LinearEvents
+        if c is not None:
             if not (isinstance(c, np.ndarray) and c.shape == (n,) and c.dtype == np.float64):
                 c = _vector(f"events[{k}].coefficients", c, n)
             coef[k] = c
             if not _finite(coef[k]):
                 _vector(f"events[{k}].coefficients", c, n)   # raises, naming it
             offset[k] = float(getattr(e, "offset", 0.0))
+        elif hasattr(e, "stick_plane"):
+            iv[2, k] = int(e.stick_plane)
+            offset[k] = float(getattr(e, "offset", 0.0))
         elif callable(e):
-            plane[k] = -2 - len(users)
+            iv[2, k] = -2 - len(users)
             users.append(e)
         else:
             raise TypeError(f"events[{k}] = {e!r} is neither a linear event (`coefficients` "
                             "and `offset`: g(y) = coefficients . y + offset), a stick-release "
                             "event (`stick_plane`) nor a callable g(t, y)")
-        terminal[k] = bool(getattr(e, "terminal", False))
+        iv[0, k] = bool(getattr(e, "terminal", False))
         dirn = float(getattr(e, "direction", 0))
-        direction[k] = (dirn > 0) - (dirn < 0)
-    return m, coef, offset, terminal, direction, plane, users
+        iv[1, k] = (dirn > 0) - (dirn < 0)
+    return m, coef, reals, ints[0], ints[1], ints[2], users
 
 
 cdef object _run(radau5_problem *p, int n, int m):
@@ -299,15 +302,37 @@ cdef object _run(radau5_problem *p, int n, int m):
                                           "total", "total_ns"), [r.prof[i] for i in range(7)]))
     finally:
         radau5_free(&r)
-    if r_hits:
-        t_events = [hit_t[hit_event == k] for k in range(m)]
-        y_events = [hit_y[hit_event == k].reshape(-1, n) for k in range(m)]
-    else:
-        t_events = [np.empty(0) for k in range(m)]
-        y_events = [np.empty((0, n)) for k in range(m)]
+    t_events, y_events = _group_hits(hit_event, hit_t, hit_y, m, n)
     return OptimizeResult(t=t, y=np.ascontiguousarray(y.T), t_events=t_events,
                           y_events=y_events, status=status, message=message,
                           success=status >= 0, sol=None, dense=dense, **counts)
+
+
+cdef tuple _group_hits(const int[::1] event, const double[::1] t, const double[:, ::1] y,
+                       int m, int n):
+    """Per event k, the times (hits,) and states (hits, n) of its hits, in order."""
+    cdef Py_ssize_t h, k, i
+    cdef double[::1] tv
+    cdef double[:, ::1] yv
+    t_events, y_events = [], []
+    counts = [0] * m
+    for h in range(event.shape[0]):
+        counts[event[h]] += 1
+    for k in range(m):
+        te = np.empty(counts[k])
+        ye = np.empty((counts[k], n))
+        if counts[k]:
+            tv = te
+            yv = ye
+            i = 0
+            for h in range(event.shape[0]):
+                if event[h] == k:
+                    tv[i] = t[h]
+                    yv[i, :] = y[h, :]
+                    i += 1
+        t_events.append(te)
+        y_events.append(ye)
+    return t_events, y_events
 
 
 cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,

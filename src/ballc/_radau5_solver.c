@@ -86,7 +86,8 @@ typedef struct {
      * outputs], M = mu/h I - J is lower block-triangular, [[M_cc, 0], [-J_oc, mu/h I]]:
      * only M_cc is factored; the outputs follow by substitution. */
     int nc, no, *cidx, *oidx;
-    double *Joc;                          /* no x nc, row-major */
+    double *Joc;                          /* J_oc's nonzeros, row by row (CSR) */
+    int *joc_col, *joc_start;             /* their coupled column; row o: [start[o], start[o+1]) */
     double lu_mr; cplx lu_mc;             /* mu_real / h, mu_complex / h of the factors */
     double *xc; cplx *xcc;                /* nc: gathered right-hand sides */
     /* scratch */
@@ -111,8 +112,9 @@ static int call_fun(solver_t *s, double t, const double *y, double *f)
     PROF_START;
     s->r->nfev++;
     int rc = s->p->fun(s->p->ctx, t, y, f);
-    for (int i = 0; i < s->n && rc == 0; i++)
-        if (!isfinite(f[i])) rc = -1;
+    double finite = 0.0;   /* x - x: 0 for a finite x, NaN otherwise; no branch per entry */
+    for (int i = 0; i < s->n; i++) finite += f[i] - f[i];
+    if (finite != 0.0) rc = -1;
     PROF_STOP(RADAU5_PROF_FUN);
     return rc == 0 ? 0 : -1;
 }
@@ -130,9 +132,18 @@ static void partition(solver_t *s)
         if (zero) s->oidx[s->no++] = j;
         else s->cidx[s->nc++] = j;
     }
-    for (int a = 0; a < s->no; a++)
-        for (int b = 0; b < s->nc; b++)
-            s->Joc[a * s->nc + b] = s->J[s->oidx[a] * n + s->cidx[b]];
+    int k = 0;   /* J_oc is sparse (x, y: one velocity each; idle deflections: none) */
+    for (int a = 0; a < s->no; a++) {
+        s->joc_start[a] = k;
+        for (int b = 0; b < s->nc; b++) {
+            double v = s->J[s->oidx[a] * n + s->cidx[b]];
+            if (v != 0.0) {
+                s->Joc[k] = v;
+                s->joc_col[k++] = b;
+            }
+        }
+    }
+    s->joc_start[s->no] = k;
 }
 
 static int call_jac(solver_t *s, double t, const double *y)
@@ -185,9 +196,9 @@ static void solve_real(solver_t *s, double *b)
         ballc_lu_solve(nc, s->LU_real, s->piv_real, x);
         for (int a = 0; a < nc; a++) b[s->cidx[a]] = x[a];
         for (int o = 0; o < no; o++) {
-            const double *row = s->Joc + (size_t)o * nc;
             double v = b[s->oidx[o]];
-            for (int a = 0; a < nc; a++) v += row[a] * x[a];
+            for (int q = s->joc_start[o]; q < s->joc_start[o + 1]; q++)
+                v += s->Joc[q] * x[s->joc_col[q]];
             b[s->oidx[o]] = v / s->lu_mr;
         }
     }
@@ -205,11 +216,12 @@ static void solve_complex(solver_t *s, cplx *b)
         for (int a = 0; a < nc; a++) x[a] = b[s->cidx[a]];
         ballc_lu_solve_complex(nc, s->LU_complex, s->piv_complex, x);
         for (int a = 0; a < nc; a++) b[s->cidx[a]] = x[a];
+        cplx inverse = 1.0 / s->lu_mc;
         for (int o = 0; o < no; o++) {
-            const double *row = s->Joc + (size_t)o * nc;
             cplx v = b[s->oidx[o]];
-            for (int a = 0; a < nc; a++) v += row[a] * x[a];
-            b[s->oidx[o]] = v / s->lu_mc;
+            for (int q = s->joc_start[o]; q < s->joc_start[o + 1]; q++)
+                v += s->Joc[q] * x[s->joc_col[q]];
+            b[s->oidx[o]] = v * inverse;
         }
     }
     PROF_STOP(RADAU5_PROF_SOLVE);
@@ -765,7 +777,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
          + (size_t)n * n + (size_t)n;                       /* Joc, xc */
     double *dblock = calloc(nd, sizeof(double));
     cplx *cblock = calloc((size_t)n * n + 2 * (size_t)n, sizeof(cplx));
-    int *iblock = calloc(4 * (size_t)n + 2 * (size_t)m + 2, sizeof(int));
+    int *iblock = calloc(5 * (size_t)n + 2 * (size_t)m + 3 + (size_t)n * n, sizeof(int));
     int rc = 0;
     if (!dblock || !cblock || !iblock) goto oom;
     double *d = dblock;
@@ -781,6 +793,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.piv_real = iblock; s.piv_complex = iblock + n;
     s.active = iblock + 2 * n;
     s.cidx = iblock + 2 * n + 2 * m; s.oidx = s.cidx + n;
+    s.joc_start = s.oidx + n; s.joc_col = s.joc_start + n + 1;
 
     s.t = p->t0;
     memcpy(s.y, p->y0, n * sizeof(double));

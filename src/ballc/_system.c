@@ -44,11 +44,12 @@ typedef struct {
     double D;
 } schur_t;
 
+/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one. */
 static int all_finite(const double *v, int n)
 {
-    for (int i = 0; i < n; i++)
-        if (!isfinite(v[i])) return 0;
-    return 1;
+    double s = 0.0;
+    for (int i = 0; i < n; i++) s += v[i] - v[i];
+    return s == 0.0;
 }
 
 /* Every input the equations may read must be finite: a NaN would otherwise slip
@@ -282,9 +283,19 @@ static int any_stick(int flags)
 int ballc_rhs(const double *state, const double *params, const double *latch,
               int flags, double *xdot)
 {
+    if (!all_finite(params, BALLC_N_PARAMETERS) || !all_finite(latch, BALLC_N_LATCH)) {
+        for (int i = 0; i < NS; i++) xdot[i] = NAN;
+        return BALLC_NOT_FINITE;
+    }
+    return ballc_rhs_checked_inputs(state, params, latch, flags, xdot);
+}
+
+int ballc_rhs_checked_inputs(const double *state, const double *params, const double *latch,
+                             int flags, double *xdot)
+{
     schur_t factor;
     evaluation_t ev;
-    if (!inputs_finite(state, params, latch)) {
+    if (!all_finite(state, NS)) {
         for (int i = 0; i < NS; i++) xdot[i] = NAN;
         return BALLC_NOT_FINITE;
     }
@@ -374,13 +385,13 @@ static int difference_jacobian(const double *state, const double *params, const 
                                int flags, double *jac)
 {
     double f0[NS], f1[NS], y[NS];
-    int status = ballc_rhs(state, params, latch, flags, f0);
+    int status = ballc_rhs_checked_inputs(state, params, latch, flags, f0);
     if (status != BALLC_OK) return status;
     memcpy(y, state, sizeof y);
     for (int j = 0; j < NS; j++) {
         y[j] = state[j] + 1.4901161193847656e-08 * fmax(1.0, fabs(state[j]));
         double h = y[j] - state[j];
-        status = ballc_rhs(y, params, latch, flags, f1);
+        status = ballc_rhs_checked_inputs(y, params, latch, flags, f1);
         y[j] = state[j];
         if (status != BALLC_OK) return status;
         for (int i = 0; i < NS; i++) jac[i * NS + j] = (f1[i] - f0[i]) / h;
@@ -421,10 +432,18 @@ static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const dou
 int ballc_jacobian(const double *state, const double *params, const double *latch,
                    int flags, double *jac)
 {
+    if (!all_finite(params, BALLC_N_PARAMETERS) || !all_finite(latch, BALLC_N_LATCH))
+        return BALLC_NOT_FINITE;
+    return ballc_jacobian_checked_inputs(state, params, latch, flags, jac);
+}
+
+int ballc_jacobian_checked_inputs(const double *state, const double *params,
+                                  const double *latch, int flags, double *jac)
+{
     schur_t factor;
     evaluation_t ev;
     double udot[NU];
-    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
+    if (!all_finite(state, NS)) return BALLC_NOT_FINITE;
     if (any_stick(flags)) return difference_jacobian(state, params, latch, flags, jac);
     int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;

@@ -55,6 +55,13 @@ int ballc_rhs(const double *state, const double *params, const double *latch,
 int ballc_jacobian(const double *state, const double *params, const double *latch,
                    int flags, double *jac);
 
+/* The same, for callers that have checked once that params and latch are finite
+ * (the integrator's adapters, per segment): only the state is checked, per call. */
+int ballc_rhs_checked_inputs(const double *state, const double *params, const double *latch,
+                             int flags, double *xdot);
+int ballc_jacobian_checked_inputs(const double *state, const double *params,
+                                  const double *latch, int flags, double *jac);
+
 /* Stick state of ``plane`` (0 floor, 1 ceiling) under ``flags`` (which must hold that
  * plane's FRICTION and STICK flags): out = [lambda_x, lambda_y, N, mu N - |lambda|],
  * the constraint force that keeps the slip velocity constant, the friction share's
