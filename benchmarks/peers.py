@@ -703,7 +703,10 @@ def write_markdown(bench, tolerances, args, elapsed, path):
               "peer whose errors bracket it) over radau5's CPU; raw / C-level (Python "
               "callback cost subtracted).  `n/r`: the peer never got that accurate at any "
               "measured tolerance; `<`: the peer was more accurate than that even at its "
-              "loosest tolerance (no CPU to interpolate).", "",
+              "loosest tolerance (no CPU to interpolate).  Where radau5's err6 over all "
+              "segments is O(1) (the near-singular segments diverged, loose tolerances) the "
+              "(all) ratios compare diverged trajectories and mean nothing: read the "
+              "(regular) ones there.", "",
               "| radau5 tol | radau5 err6 | " + " | ".join(f"{p} (all)" for p in PEERS)
               + " | radau5 err6 (regular) | " + " | ".join(f"{p} (regular)" for p in PEERS)
               + " |", "|---|---|" + "---|" * len(PEERS) + "---|" + "---|" * len(PEERS)]
