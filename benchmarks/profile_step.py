@@ -35,12 +35,14 @@ LABELS = {"fun": "RHS", "jac": "Jacobian", "factor": "factor", "solve": "solves"
           "events": "events"}
 
 
-def build_profiled(where: Path) -> Path:
-    """Build ballc with -DRADAU5_PROFILE into where/lib (a copy of the package)."""
+def build_profiled(where: Path, quiet: bool = False) -> Path:
+    """Build ballc with -DRADAU5_PROFILE into where/lib (a copy of the package);
+    ``quiet``: the compiler's output only when the build fails."""
     lib, tmp = where / "lib", where / "tmp"
     env = dict(os.environ, CFLAGS=(os.environ.get("CFLAGS", "") + " -DRADAU5_PROFILE").strip())
     subprocess.run([sys.executable, "setup.py", "-q", "build_ext", "--build-lib", str(lib),
-                    "--build-temp", str(tmp), "--force"], cwd=ROOT, env=env, check=True)
+                    "--build-temp", str(tmp), "--force"], cwd=ROOT, env=env, check=True,
+                   capture_output=quiet)
     for source in (ROOT / "src" / "ballc").glob("*.py"):
         shutil.copy2(source, lib / "ballc" / source.name)
     return lib

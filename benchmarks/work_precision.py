@@ -1,6 +1,6 @@
 """Work-precision: CPU time against error, per integrator, on three scenes.
 
-    python -m benchmarks.work_precision [--quick] [--budget SECONDS]
+    python -m benchmarks.work_precision [--quick] [--budget SECONDS] [--peers]
 
 For each scene a reference is computed with radau5 at rtol = atol = 1e-13 (its
 distance to radau5 at 1e-12 is printed as the reference's own uncertainty).  Then
@@ -32,7 +32,9 @@ Also measured: the per-scene specialisations (contact kernels skipped in free
 flight, observer kernels skipped when observer_mass = 0), as CPU per RHS call of the
 same trajectory with the kernels switched on and off.
 
-Writes docs/work_precision.png and docs/work_precision.md.
+Writes docs/work_precision.png and docs/work_precision.md.  ``--peers`` then runs
+``benchmarks.peers`` (ballc's radau5 against SUNDIALS CVODE and Hairer's RADAU5 on the
+same compiled system; docs/peers.md), which needs ``pip install ".[bench]"``.
 """
 from __future__ import annotations
 
@@ -78,6 +80,11 @@ LAWS = {
 GRID_MU = (0.0, 0.1, 0.4, 0.8)
 GRID_MIXTURE = (0.0, 0.375, 0.7)
 GRID_T_END = 1.2
+PEERS_NOTE = ("Against other stiff solvers on the same compiled right-hand side and "
+              "Jacobian -- SUNDIALS CVODE (BDF, Adams) and Hairer's RADAU5 (Fortran and "
+              "assimulo's C translation) -- segment by segment: [peers](peers.md) "
+              "(`python -m benchmarks.peers`, or `--peers` here; needs "
+              "`pip install \".[bench]\"`).")
 _IDX = [_core.STATE_NAMES.index(n) for n in ("x", "y", "z", "vx", "vy", "vz")]
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 
@@ -215,7 +222,13 @@ def main(argv=None):
                         help="CPU seconds per ballc run before it is reported as too "
                              "slow (default 8, quick 5)")
     parser.add_argument("--no-seed", action="store_true", help="skip the seed's pipeline")
+    parser.add_argument("--peers", action="store_true",
+                        help="then run benchmarks.peers (radau5 against CVODE and Hairer's "
+                             "RADAU5; needs pip install \".[bench]\"; --quick passed on)")
     args = parser.parse_args(argv)
+    if args.peers:   # fail now, not after the main run, when a peer is missing
+        from benchmarks import peers
+        peers.import_peers()
     tolerances = QUICK_TOLERANCES if args.quick else TOLERANCES
     seed_tolerances = () if args.no_seed else ((1e-12,) if args.quick else SEED_TOLERANCES)
     budget = args.budget or (5.0 if args.quick else 8.0)
@@ -263,6 +276,8 @@ def main(argv=None):
                     args, tolerances, DOCS / "work_precision.md")
     print(f"wrote {DOCS / 'work_precision.png'} and {DOCS / 'work_precision.md'} "
           f"({elapsed:.0f} s)")
+    if args.peers:
+        peers.main(["--quick"] if args.quick else [])
 
 
 def _reference(references, law_references, scene_name, method):
@@ -366,7 +381,8 @@ def _write_markdown(results, references, law_references, grid, special, budget, 
              "velocity (m/s) at t = 5 s; contact error = max |difference| of contact start/end "
              "times (s), \"count\" when the number of contacts differs.  Reference: radau5 at "
              "rtol = atol = 1e-13.  `> budget`: the run exceeded "
-             f"{budget:g} s of CPU and was stopped.", "", "![work-precision](work_precision.png)", ""]
+             f"{budget:g} s of CPU and was stopped.", "", "![work-precision](work_precision.png)", "",
+             PEERS_NOTE, ""]
     for scene_name in SCENES:
         ref, (ref_final, ref_contact) = references[scene_name]
         lines += [f"## {scene_name}", "", f"{SCENE_NOTES[scene_name]}.  Reference "

@@ -1,0 +1,75 @@
+"""benchmarks/peers.py: the segment recording and replay it rests on.
+
+The recording must not change what ballc.simulate computes, the segments must chain
+from 0 to t_end, and radau5 replaying each segment from its recorded start state must
+reproduce the recorded end state to the order of the tolerance.  The peers' part runs
+only when the optional peers are installed (``pip install ".[bench]"``).  No timings.
+"""
+import numpy as np
+import pytest
+
+import ballc
+from benchmarks import peers
+
+T_END = 1.2   # the first floor and ceiling contacts of the seed throw
+
+
+@pytest.fixture(scope="module")
+def recorded():
+    result, segments = peers.record_segments(t_end=T_END, rtol=1e-12, atol=1e-12)
+    return result, segments
+
+
+def test_recording_changes_nothing(recorded):
+    result, _ = recorded
+    plain = ballc.simulate(ballc.Scene(), T_END, rtol=1e-12, atol=1e-12)
+    assert np.array_equal(plain.t, result.t)
+    assert np.array_equal(plain.y, result.y)
+    assert plain.nfev == result.nfev
+
+
+def test_segments_chain_from_start_to_end(recorded):
+    result, segments = recorded
+    assert result.status == 0
+    assert segments[0].t0 == 0.0 and segments[-1].t1 == T_END
+    for before, after in zip(segments, segments[1:]):
+        assert after.t0 == before.t1
+    kinds = {s.flags for s in segments}
+    assert len(kinds) >= 3    # free flight, floor contact, ceiling contact at least
+    assert sum(s.nfev for s in segments) == result.nfev
+
+
+@pytest.mark.parametrize("tol, bound", [(1e-8, 1e-6), (1e-10, 1e-8), (1e-12, 1e-10)])
+def test_radau5_replay_reproduces_the_reference(recorded, tol, bound):
+    _, segments = recorded
+    worst = 0.0
+    for seg in peers.replayable(segments):
+        y, counts = peers.run_radau5(seg, None, tol)
+        assert counts["nfev"] > 0
+        worst = max(worst, max(peers.errors(y, seg.y1)))
+    assert worst < bound
+
+
+def test_rotation_error():
+    q = np.array([1.0, 0.0, 0.0, 0.0])
+    assert np.allclose(peers._rotation_error(q, q), 0)
+    half = 0.5e-3                                   # a 1e-3 rad turn about y
+    turned = np.array([np.cos(half), 0.0, np.sin(half), 0.0])
+    assert np.allclose(peers._rotation_error(turned, q), [0, 1e-3, 0], atol=1e-15)
+    assert np.allclose(peers._rotation_error(-turned, q), [0, 1e-3, 0], atol=1e-15)
+
+
+def test_peers_replay_a_contact(recorded):
+    pytest.importorskip("sksundae")
+    pytest.importorskip("assimulo")
+    _, segments = recorded
+    segments = [s for s in peers.replayable(segments) if not peers.near_singular(s)][:4]
+    for name, run in peers.contenders().items():
+        for seg in segments:
+            y, counts = run(seg, seg.system(), 1e-8)
+            assert peers.errors(y, seg.y1)[0] < 1e-4, name
+            assert counts["nfev"] > 0 and counts["njev"] > 0, name
+
+
+def test_missing_peer_message():
+    assert 'pip install ".[bench]"' in peers.MISSING
