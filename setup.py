@@ -24,7 +24,7 @@ core = Extension(
     # -fcx-limited-range: complex * and / as the textbook formulas (radau5's complex
     # Newton system; its values are finite and far from overflow), not libgcc's
     # __muldc3 / __divdc3 with their inf/NaN recovery.
-    extra_compile_args=["-O2", "-std=c99", "-fno-math-errno", "-fcx-limited-range"],
+    extra_compile_args=["-O3", "-std=c99", "-fno-math-errno", "-fcx-limited-range"],
 )
 
 

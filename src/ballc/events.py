@@ -14,6 +14,7 @@ stop, clear) or the stick-mode release.
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 
@@ -109,7 +110,7 @@ def contact_threshold(scene, plane, rho0, entering):
     are of order 1e-15 .. 1e-13 m: the contact force they leave out is negligible.
     """
     boundary = scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
-    base = 4 * np.spacing(boundary)
+    base = 4 * math.ulp(boundary)
     far_side = rho0 if entering else -rho0
     return max(base, far_side + base)
 
@@ -143,7 +144,7 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
             if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
                 events.append(("approach", plane, LinearEvent(along, -clear, True, -1)))
             else:                # fixed direction: stop at u . d = 0, or go free at 2 clear
-                margin = 4 * np.spacing(stickslip.speed_scale(scene, y0))
+                margin = 4 * math.ulp(stickslip.speed_scale(scene, y0))
                 events.append(("stop", plane, LinearEvent(along, margin, True, -1)))
                 events.append(("clear", plane, LinearEvent(along, -2 * clear, True, 1)))
         elif mode == "stick":

@@ -11,6 +11,8 @@ behind ballc.integrate, and a finished run is post-processed by ballc.outcome.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import _core, events as ev, layout, modes, outcome, stickslip
@@ -335,7 +337,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             pieces.append((run.t, t_hit, sol.interpolant))
         run.t = t_hit
         run.y = np.array(sol.y_events[index][-1])
-        run.y[_QUATERNION] /= np.linalg.norm(run.y[_QUATERNION])
+        run.y[_QUATERNION] /= math.hypot(*run.y[_QUATERNION])
         if index >= n_driver:   # a terminal user event
             run.status, run.message = 1, "A termination event occurred."
             break

@@ -95,7 +95,8 @@ def clear_speed(scene, y, rtol, atol) -> float:
     """The slip speed (m/s) below which the slip direction is held fixed: well above
     the integration error of u, rtol (|v| + r |omega|) + atol, so that a free-direction
     step never has to cross the singular u = 0."""
-    return CLEAR_FACTOR * (float(rtol) * speed_scale(scene, y) + float(np.max(atol)))
+    largest_atol = atol if isinstance(atol, float) else float(np.max(atol))
+    return CLEAR_FACTOR * (float(rtol) * speed_scale(scene, y) + largest_atol)
 
 
 def force_scale(scene, load) -> float:
@@ -104,13 +105,34 @@ def force_scale(scene, load) -> float:
     return 64 * np.finfo(float).eps * (weight + abs(load))
 
 
+def slip_map(params, plane: str) -> np.ndarray:
+    """du/dy (2 x N_STATES) of ``plane``'s slip velocity u (u is linear in the state);
+    the maps of the last parameter vector are kept (a run asks for them at every
+    event).  Read-only: shared between callers."""
+    global _slip_maps
+    key = params.tobytes()
+    cached = _slip_maps            # one read: a consistent (key, maps) pair across threads
+    if cached[0] != key:
+        cached = (key, {})
+        _slip_maps = cached
+    found = cached[1].get(plane)
+    if found is None:
+        found = _core.slip_map(params, PLANES.index(plane))
+        found.flags.writeable = False
+        cached[1][plane] = found
+    return found
+
+
+_slip_maps: tuple = (b"", {})
+
+
 def slip_stop_coefficients(params, plane: str, direction) -> np.ndarray:
     """Coefficients c of the stop event u . d = c . y (u is linear in the state)."""
-    return np.asarray(direction, dtype=float) @ _core.slip_map(params, PLANES.index(plane))
+    return np.asarray(direction, dtype=float) @ slip_map(params, plane)
 
 
 def slip_velocity(params, plane: str, y) -> np.ndarray:
-    return _core.slip_map(params, PLANES.index(plane)) @ y
+    return slip_map(params, plane) @ y
 
 
 def settle(scene, params, latch, base_flags: int, plane: str, y):
