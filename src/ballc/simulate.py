@@ -263,8 +263,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     # Per stored sample: the flags and latched values of the segment that computed it,
     # so outputs that need the right-hand side (the observer's acceleration, contact
     # forces) can re-evaluate it exactly as integrated.  One column per sample.
-    flag_columns = [np.full(ts[0].size, run.flags(), dtype=np.int32)]
-    latch_columns = [np.repeat(run.latch[:, None], ts[0].size, axis=1)]
+    segment_flags, segment_latches, samples_per_segment = [run.flags()], [run.latch.copy()], [
+        ts[0].size]
     user = options.events
     user_t = [[] for _ in user]
     user_y = [[] for _ in user]
@@ -284,8 +284,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
         remaining = None if options.max_nfev is None else max(options.max_nfev - nfev, 1)
-        sol = integrate_segment(system, run.t, t_end, run.y,
-                                [e[2] for e in driver_events] + list(user),
+        segment_events = [e[2] for e in driver_events] + list(user)
+        sol = integrate_segment(system, run.t, t_end, run.y, segment_events,
                                 method=options.method, rtol=options.rtol, atol=options.atol,
                                 t_eval=segment_eval, max_step=options.max_step,
                                 max_nfev=remaining, first_step=first,
@@ -300,8 +300,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         later = sol.t[start:] > run.t
         ts.append(sol.t[start:][later])
         ys.append(sol.y[:, start:][:, later])
-        flag_columns.append(np.full(ts[-1].size, system.flags, dtype=np.int32))
-        latch_columns.append(np.repeat(run.latch[:, None], ts[-1].size, axis=1))
+        segment_flags.append(system.flags)
+        segment_latches.append(run.latch.copy())
+        samples_per_segment.append(ts[-1].size)
         n_driver = len(driver_events)
         for (kind, plane, _), t_hits, y_hits in zip(driver_events, sol.t_events, sol.y_events):
             if kind == "deepest" and len(t_hits):
@@ -329,10 +330,14 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                 pieces.append((run.t, t_end, sol.interpolant))
             run.t = t_end
             break
-        fired = [(i, e) for i, e in enumerate([e[2] for e in driver_events] + list(user))
-                 if getattr(e, "terminal", False) and len(sol.t_events[i])]
-        index = min(fired, key=lambda item: sol.t_events[item[0]][-1])[0]
-        t_hit = float(sol.t_events[index][-1])
+        index, t_hit = -1, np.inf   # the earliest terminal event that fired
+        for i, e in enumerate(segment_events):
+            hits = sol.t_events[i]
+            if len(hits) and getattr(e, "terminal", False) and hits[-1] < t_hit:
+                index, t_hit = i, float(hits[-1])
+        if index < 0:
+            raise RuntimeError("the integrator stopped on a terminal event (status 1) but "
+                               "reported no terminal event hit")
         if options.dense_output:
             pieces.append((run.t, t_hit, sol.interpolant))
         run.t = t_hit
@@ -357,8 +362,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             record_depth(contact, ev.penetration(plane, scene)(0, last), last)
     result = Result(t=np.concatenate(ts), y=np.concatenate(ys, axis=1), scene=scene,
                     status=run.status, message=run.message, nfev=nfev, njev=njev, nlu=nlu,
-                    contacts=run.contacts, flags=np.concatenate(flag_columns),
-                    latch=np.concatenate(latch_columns, axis=1),
+                    contacts=run.contacts,
+                    flags=np.repeat(np.array(segment_flags, dtype=np.int32), samples_per_segment),
+                    latch=np.repeat(np.array(segment_latches).T, samples_per_segment, axis=1),
                     t_events=[np.concatenate(k) if k else np.empty(0) for k in user_t],
                     y_events=[np.concatenate(k) if k else np.empty((0, _core.N_STATES))
                               for k in user_y],
