@@ -22,15 +22,22 @@ solver's private ``controller`` option (``_radau5_solver.h``, RADAU5_CTRL_*):
 * ``scale``  the error scale from |y| at the step start (scipy max(|y|, |y_new|))
 
 Scenes: those of benchmarks/work_precision.py (seed, conservative oblique, friction
-only), 5 s.  Tolerances rtol = atol = 10^(-3 - k/2), k = 0..18 (1e-3 .. 1e-12).  For
-each scene, variant and tolerance: RHS calls, steps, LU factorisations, CPU
-(time.process_time around ``ballc.simulate``, best of ``--repeat``, all variants
-interleaved in one process) and the final error (max |final centre position (m),
-velocity (m/s) - reference|), the reference being radau5 with scipy's control at
-1e-13 (as work_precision and seed_tolerance).  Equal error: each variant's cost
-(calls, CPU) is interpolated log-log on its work-precision front (the runs no cheaper
-run beats in error) at the errors scipy's control reaches at 1e-3, 1e-4, ..., 1e-12;
-the tables give variant / scipy.  Writes docs/controllers.md.
+only), 5 s.  The final error of one run jumps by up to a decade from one tolerance to
+the next (nine contacts amplify it erratically), which would drown differences of
+10-30 % at equal error; so each scene is an ensemble of ``--members`` throws (its
+velocity scaled by 1, 1.01, 0.99, 1.02, 0.98, ...), each with its own reference, and a
+run of the ensemble costs the sum and errs the geometric mean over its throws.
+Tolerances rtol = atol = 10^(-3 - k/2), k = 0..18 (1e-3 .. 1e-12).  For each scene,
+variant and tolerance: RHS calls, steps, rejected steps, LU factorisations, Jacobians,
+CPU (time.process_time around each ``ballc.simulate``, best of ``--repeat``, all
+variants interleaved in one process so that the machine's load falls on all of them)
+and the final error (max |final centre position (m), velocity (m/s) - reference|), the
+reference being radau5 with scipy's control at 1e-13 (as work_precision and
+seed_tolerance).  Equal error: each variant's cost (calls, CPU) is interpolated
+log-log on its work-precision front (the runs no cheaper run beats in error) at the
+errors scipy's control reaches at 1e-3, 1e-4, ..., 1e-12; the tables give variant /
+scipy, and their geometric mean over the columns both reach.  Writes
+docs/controllers.md.
 """
 from __future__ import annotations
 
@@ -63,32 +70,24 @@ def variants(which):
     out = {"scipy": ()}
     if which in ("elements", "all"):
         out.update({e: (e,) for e in ELEMENTS})
+        out["hold+jac"] = ("hold", "jac")
         out["hairer (all)"] = ELEMENTS
         out["hairer - tol"] = HAIRER_NO_TOL
+        out["hairer - tol - pred"] = tuple(x for x in HAIRER_NO_TOL if x != "pred")
     if which == "all":
         out.update({f"hairer - tol - {e}": tuple(x for x in HAIRER_NO_TOL if x != e)
-                    for e in HAIRER_NO_TOL})
+                    for e in HAIRER_NO_TOL if e != "pred"})
     if which not in ("elements", "all"):
         for name in which.split(","):
-            out[name] = tuple(x for x in name.split("+") if x)
+            if name != "scipy":
+                out[name] = tuple(x for x in name.split("+") if x)
     return out
 
 
-def run(scene, tol, elements, counter=None):
-    previous = _radau5._set_controller(list(elements))
-    try:
-        started = time.process_time()
-        result = ballc.simulate(scene, T_END, rtol=tol, atol=tol)
-        cpu = time.process_time() - started
-    finally:
-        _radau5._set_controller(previous)
-    return cpu, result
-
-
-def counts(scene, tol, elements):
-    """steps, LU factorisations and Jacobians of a run: summed over its segments (the
-    driver does not keep them, so the solver is wrapped for this one run)."""
-    totals = {"nstep": 0, "nlu": 0, "njev": 0, "nreject": 0}
+def run(scene, tol, elements):
+    """CPU, result and the solver's counts summed over the run's segments (steps,
+    rejections, LU factorisations, Jacobians: the driver does not keep them)."""
+    totals = {"nstep": 0, "nreject": 0, "nlu": 0, "njev": 0}
     original = _radau5.solve_system
 
     def counting(*args, **kwargs):
@@ -96,13 +95,22 @@ def counts(scene, tol, elements):
         for key in totals:
             totals[key] += int(sol[key])
         return sol
-    from ballc import integrate
-    integrate._radau5.solve_system = counting
+    previous = _radau5._set_controller(list(elements))
+    _radau5.solve_system = counting
     try:
-        run(scene, tol, elements)
+        started = time.process_time()
+        result = ballc.simulate(scene, T_END, rtol=tol, atol=tol)
+        cpu = time.process_time() - started
     finally:
-        integrate._radau5.solve_system = original
-    return totals
+        _radau5.solve_system = original
+        _radau5._set_controller(previous)
+    return cpu, result, totals
+
+
+def members(scene, k):
+    factors = [1.0] + [1 + s * 0.01 * (i // 2 + 1) for i, s in
+                       zip(range(k - 1), [1, -1] * k)]
+    return [scene.replace(velocity=tuple(f * v for v in scene.velocity)) for f in factors]
 
 
 def front(points):
@@ -139,6 +147,7 @@ def main(argv=None):
                              "without each element), or names joined by , (elements "
                              "joined by +)")
     parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("--members", type=int, default=4)
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
     chosen = variants(args.variants)
@@ -147,33 +156,42 @@ def main(argv=None):
     table = {}       # (scene, variant) -> list of rows
     notes = {}
     for scene_name in scenes:
-        scene = SCENES[scene_name]
-        _, ref = run(scene, 1e-13, ())
-        ref_final = ref.y[_IDX, -1]
-        ref_contacts = len(ref.contacts)
-        _, check = run(scene, 1e-12, ())
-        _, check_h = run(scene, 1e-13, HAIRER_NO_TOL)
-        notes[scene_name] = (float(np.abs(check.y[_IDX, -1] - ref_final).max()),
-                             float(np.abs(check_h.y[_IDX, -1] - ref_final).max()),
-                             ref_contacts)
+        throws = members(SCENES[scene_name], args.members)
+        refs = [run(m, 1e-13, ())[1] for m in throws]
+        ref_finals = [r.y[_IDX, -1] for r in refs]
+        checks = [run(m, 1e-12, ())[1] for m in throws]
+        checks_h = [run(m, 1e-13, HAIRER_NO_TOL)[1] for m in throws]
+        notes[scene_name] = (
+            max(float(np.abs(c.y[_IDX, -1] - f).max()) for c, f in zip(checks, ref_finals)),
+            max(float(np.abs(c.y[_IDX, -1] - f).max()) for c, f in zip(checks_h, ref_finals)),
+            [len(r.contacts) for r in refs])
         print(f"{scene_name}: reference (scipy control, 1e-13) vs scipy 1e-12 "
               f"{notes[scene_name][0]:.1e}, vs hairer - tol 1e-13 {notes[scene_name][1]:.1e}",
               flush=True)
         for tol in TOLERANCES:
-            best = {v: np.inf for v in chosen}
+            best = {(v, i): np.inf for v in chosen for i in range(len(throws))}
             results = {}
             for _ in range(args.repeat):   # interleaved: the load falls on every variant
-                for v, elements in chosen.items():
-                    cpu, result = run(scene, tol, elements)
-                    best[v] = min(best[v], cpu)
-                    results[v] = result
-            for v, elements in chosen.items():
-                result = results[v]
-                c = counts(scene, tol, elements)
-                error = (float(np.abs(result.y[_IDX, -1] - ref_final).max())
-                         if result.status == 0 else np.nan)
-                row = dict(tol=tol, nfev=result.nfev, cpu=best[v], error=error,
-                           status=result.status, contacts=len(result.contacts), **c)
+                for i, throw in enumerate(throws):
+                    for v, elements in chosen.items():
+                        cpu, result, c = run(throw, tol, elements)
+                        best[(v, i)] = min(best[(v, i)], cpu)
+                        results[(v, i)] = (result, c)
+            for v in chosen:
+                errors, row = [], dict(tol=tol, nfev=0, cpu=0.0, status=0, nstep=0,
+                                       nreject=0, nlu=0, njev=0, contacts=[])
+                for i in range(len(throws)):
+                    result, c = results[(v, i)]
+                    errors.append(float(np.abs(result.y[_IDX, -1] - ref_finals[i]).max())
+                                  if result.status == 0 else np.nan)
+                    row["nfev"] += result.nfev
+                    row["cpu"] += best[(v, i)]
+                    row["status"] = min(row["status"], result.status)
+                    row["contacts"].append(len(result.contacts))
+                    for key in c:
+                        row[key] += c[key]
+                row["error"] = float(np.exp(np.mean(np.log(errors))))
+                row["error0"] = errors[0]
                 table.setdefault((scene_name, v), []).append(row)
             print(f"  {tol:.1e}: " + "  ".join(
                 f"{v} {table[(scene_name, v)][-1]['nfev']}/{table[(scene_name, v)][-1]['error']:.1e}"
@@ -203,48 +221,64 @@ def _f(x, fmt):
     return "–" if x is None or not np.isfinite(x) else format(x, fmt)
 
 
+def geomean(ratios):
+    r = [x for x in ratios if np.isfinite(x)]
+    return float(np.exp(np.mean(np.log(r)))) if r else np.nan
+
+
 def markdown(table, notes, chosen, scenes, args, elapsed):
     lines = [
         "# Step control: scipy's Radau against Hairer's RADAU5", "",
         "Generated by `python -m benchmarks.controllers` on a 2-core machine shared with "
         f"other work ({elapsed:.0f} s; CPU best of {args.repeat}, variants interleaved).  "
-        "See the script's docstring for what each element is; `hairer - tol` is every "
-        "element except the tolerance relabelling.", "",
-        "Reference: radau5 with scipy's control at rtol = atol = 1e-13.  Error: max "
-        "|final centre position (m), velocity (m/s) - reference| at 5 s.  **Equal error**: "
-        "a variant's cost interpolated (log-log, on its work-precision front) at the error "
-        "scipy's control reaches at the column's tolerance, divided by scipy's cost there; "
-        "below 1 is better; – where the variant's runs do not reach that error (or the "
-        "error is below the reference's own uncertainty).", ""]
+        "The script's docstring says what each element is; `hairer (all)` is every "
+        "element of RADAU5's control, `hairer - tol` all but the tolerance relabelling, "
+        "`hairer - tol - pred` also without the predictive controller.", "",
+        f"Each scene is an ensemble of {args.members} throws (its velocity scaled by "
+        "1, 1.01, 0.99, 1.02, ...): a single run's final error jumps by up to a decade "
+        "between neighbouring tolerances, the ensemble's geometric mean much less.  "
+        "Reference: each throw with scipy's control at rtol = atol = 1e-13.  Error: "
+        "geometric mean over the throws of max |final centre position (m), velocity "
+        "(m/s) - reference| at 5 s; cost: sum over the throws.  **Equal error**: a "
+        "variant's cost interpolated (log-log, on its work-precision front) at the error "
+        "scipy's control reaches at the column's tolerance, divided by scipy's cost "
+        "there; below 1 is better; – where the variant's runs do not reach that error; "
+        "gmean: the geometric mean of the row.  Errors near the reference's own "
+        "uncertainty (given per scene) are not resolved.", ""]
     for scene_name in scenes:
         unc, unc_h, ncontacts = notes[scene_name]
         lines += [f"## {scene_name}", "",
-                  f"Reference uncertainty: scipy control at 1e-12 is {unc:.1e} from it, "
-                  f"`hairer - tol` at 1e-13 {unc_h:.1e}; {ncontacts} contacts.", ""]
+                  f"Reference uncertainty (max over the throws): scipy's control at 1e-12 "
+                  f"is {unc:.1e} from it, `hairer - tol` at 1e-13 {unc_h:.1e}; contacts of "
+                  f"the throws: {ncontacts}.", ""]
         for key, label in (("nfev", "RHS calls"), ("cpu", "CPU")):
-            lines += [f"Equal-error {label}, variant / scipy (scipy's error at that "
-                      "tolerance in the second row):", "",
-                      "| variant | " + " | ".join(f"{t:.0e}" for t in TARGETS) + " |",
-                      "|---|" + "---|" * len(TARGETS)]
+            lines += [f"Equal-error {label}, variant / scipy (first row: scipy's error at "
+                      "that tolerance):", "",
+                      "| variant | " + " | ".join(f"{t:.0e}" for t in TARGETS) + " | gmean |",
+                      "|---|" + "---|" * (len(TARGETS) + 1)]
             errors = [e for e, _ in equal_error(table, scene_name, "scipy", key)]
             lines.append("| (scipy error) | " + " | ".join(_f(e, ".1e") for e in errors)
-                         + " |")
+                         + " | |")
             for v in chosen:
                 if v == "scipy":
                     continue
                 ratios = [r for _, r in equal_error(table, scene_name, v, key)]
-                lines.append(f"| {v} | " + " | ".join(_f(r, ".2f") for r in ratios) + " |")
+                lines.append(f"| {v} | " + " | ".join(_f(r, ".2f") for r in ratios)
+                             + f" | {_f(geomean(ratios), '.2f')} |")
             lines.append("")
-        lines += ["Runs (every other tolerance):", "",
+        lines += ["Runs at every other tolerance (sums over the throws; error: their "
+                  "geometric mean, and the unperturbed throw's alone):", "",
                   "| variant | rtol = atol | RHS calls | steps | rejected | LU | Jacobians "
-                  "| CPU ms | final error | contacts |", "|---|---|---|---|---|---|---|---|---|---|"]
+                  "| CPU ms | error | error (throw 1) | contacts |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|"]
         for v in chosen:
             for r in table[(scene_name, v)][::2]:
                 status = "" if r["status"] == 0 else f" (status {r['status']})"
+                same = "same" if r["contacts"] == ncontacts else str(r["contacts"])
                 lines.append(f"| {v} | {r['tol']:.0e} | {r['nfev']} | {r['nstep']} | "
                              f"{r['nreject']} | {r['nlu']} | {r['njev']} | "
                              f"{1e3 * r['cpu']:.1f} | {_f(r['error'], '.1e')}{status} | "
-                             f"{r['contacts']} |")
+                             f"{_f(r['error0'], '.1e')} | {same} |")
         lines.append("")
     return lines
 
