@@ -245,6 +245,24 @@ def markdown(table, notes, chosen, scenes, args, elapsed):
         "there; below 1 is better; – where the variant's runs do not reach that error; "
         "gmean: the geometric mean of the row.  Errors near the reference's own "
         "uncertainty (given per scene) are not resolved.", ""]
+    lines += ["## Summary", "",
+              "A variant would replace scipy's control as the default only if it were "
+              "ahead at equal error across the range on every scene.  Per scene: the "
+              "geometric mean of the equal-error ratios (variant / scipy) over the "
+              "columns of the tables below, and in brackets their smallest and largest.",
+              "",
+              "| variant | " + " | ".join(f"{n}: calls | {n}: CPU" for n in scenes) + " |",
+              "|---|" + "---|---|" * len(scenes)]
+    for v in chosen:
+        if v == "scipy":
+            continue
+        cells = []
+        for scene_name in scenes:
+            for key in ("nfev", "cpu"):
+                r = [x for _, x in equal_error(table, scene_name, v, key) if np.isfinite(x)]
+                cells.append(f"{geomean(r):.2f} ({min(r):.2f}–{max(r):.2f})" if r else "–")
+        lines.append(f"| {v} | " + " | ".join(cells) + " |")
+    lines.append("")
     for scene_name in scenes:
         unc, unc_h, ncontacts = notes[scene_name]
         lines += [f"## {scene_name}", "",
