@@ -80,7 +80,9 @@ def test_trajectories_agree_at_common_times(pair):
 
 
 def test_work_is_that_of_scipy_radau(pair):
-    """Same algorithm: the RHS-call counts of a whole run differ by rounding-level step
+    """Same algorithm (scipy's step control, radau5's default; the other controllers are
+    held to the reference by test_every_controller_reaches_the_reference, not to scipy's
+    counts): the RHS-call counts of a whole run differ by rounding-level step
     changes and by the step radau5's driver carries across stick/slip transitions
     (measured: 0.05 .. 0.6 %); 1 % bounds them (the README says so)."""
     name, ours, ref = pair
