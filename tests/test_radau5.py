@@ -80,7 +80,9 @@ def test_trajectories_agree_at_common_times(pair):
 
 
 def test_work_is_that_of_scipy_radau(pair):
-    """Same algorithm: the RHS-call counts of a whole run differ by rounding-level step
+    """Same algorithm (scipy's step control, radau5's default; the other controllers are
+    held to the reference by test_every_controller_reaches_the_reference, not to scipy's
+    counts): the RHS-call counts of a whole run differ by rounding-level step
     changes and by the step radau5's driver carries across stick/slip transitions
     (measured: 0.05 .. 0.6 %); 1 % bounds them (the README says so)."""
     name, ours, ref = pair
@@ -176,3 +178,67 @@ def test_bad_options_are_named():
     with pytest.raises(TypeError, match="linear event"):
         _radau5.solve_linear(A, (0, 1), [1.0, 1.0], rtol=1e-6, atol=1e-6,
                              events=[lambda t, y: y[0]])
+
+
+# ---- step control (radau5_problem.controller; benchmarks/controllers.py) ----
+
+#: RADAU5's control without its tolerance relabelling (the candidate of
+#: benchmarks/controllers.py), and each of its elements alone.
+_HAIRER = ("nit7", "limits", "pred", "hold", "jac", "scale")
+
+
+@pytest.fixture(scope="module", params=["seed", "conservative", "friction"])
+def reference(request):
+    """scipy's Radau at 1e-12 (the oracle of the pair fixture)."""
+    t_eval = np.linspace(0.0, 5.0, 501)
+    ref = ballc.simulate(SCENES[request.param], 5.0, method="Radau", rtol=TOL, atol=TOL,
+                         t_eval=t_eval)
+    return request.param, t_eval, ref
+
+
+@pytest.mark.parametrize("controller", ["scipy", "hairer-tol", "jac", "hold+jac"])
+def test_every_controller_reaches_the_reference(reference, controller):
+    """Whatever the step control, radau5 at 1e-12 is the same trajectory as scipy's
+    Radau at 1e-12 (bounds as in test_trajectories_agree_at_common_times) with the same
+    contacts: the controllers choose different steps, not different solutions."""
+    name, t_eval, ref = reference
+    elements = {"scipy": (), "hairer-tol": _HAIRER}.get(controller,
+                                                        tuple(controller.split("+")))
+    previous = _radau5._set_controller(list(elements))
+    try:
+        ours = ballc.simulate(SCENES[name], 5.0, method="radau5", rtol=TOL, atol=TOL,
+                              t_eval=t_eval)
+    finally:
+        _radau5._set_controller(previous)
+    assert ours.status == ref.status == 0
+    assert [c.plane for c in ours.contacts] == [c.plane for c in ref.contacts]
+    np.testing.assert_allclose(_contact_times(ours), _contact_times(ref), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(ours.position, ref.position, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(ours.velocity, ref.velocity, rtol=0, atol=1e-7)
+    np.testing.assert_allclose(ours.angular_velocity, ref.angular_velocity, rtol=0, atol=1e-7)
+
+
+def test_tolerance_transformation_only_relabels():
+    """RADAU5's rtol' = 0.1 rtol^(2/3) (the ``tol`` element): the solver then runs
+    exactly as scipy's control at rtol' (its Newton tolerance is the same function of
+    the tolerance in use), step for step."""
+    A = np.array([[-1.0, 20.0, 0.0], [-20.0, -1.0, 0.0], [0.0, 1.0, -1e4]])
+    y0 = np.array([1.0, 0.0, 1.0])
+    for tol in (1e-4, 1e-9):
+        relabelled = _radau5.solve_linear(A, (0, 2), y0, rtol=tol, atol=tol, controller="tol")
+        inner = 0.1 * tol ** (2 / 3)
+        plain = _radau5.solve_linear(A, (0, 2), y0, rtol=inner, atol=inner, controller=0)
+        assert (relabelled.nfev, relabelled.nstep, relabelled.nlu) == (
+            plain.nfev, plain.nstep, plain.nlu)
+        np.testing.assert_array_equal(relabelled.y, plain.y)
+
+
+def test_controller_elements_are_named():
+    assert _radau5._controller_bits("scipy") == 0
+    assert _radau5._controller_bits(["jac", "hold"]) == (
+        _radau5.CONTROLLER_ELEMENTS["jac"] | _radau5.CONTROLLER_ELEMENTS["hold"])
+    with pytest.raises(ValueError, match="controller element"):
+        _radau5._controller_bits(["gustafsson"])
+    with pytest.raises(ValueError, match="controller element"):
+        _radau5.solve_linear(np.eye(1), (0, 1), [1.0], rtol=1e-6, atol=1e-6,
+                             controller="nope")

@@ -9,6 +9,7 @@ one copy of the kernels in the process, never two that could disagree.
 (used to test the integrator against the matrix exponential); ``_lu_solve`` exposes
 ballc's LU and ``_constants`` radau5's method constants for tests.
 """
-from ._core import EPS, _constants, _lu_solve, solve_linear, solve_system
+from ._core import (CONTROLLER_ELEMENTS, EPS, _constants, _controller_bits, _lu_solve,
+                    _set_controller, solve_linear, solve_system)
 
 __all__ = ["solve_system", "solve_linear"]

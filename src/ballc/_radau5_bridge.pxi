@@ -53,6 +53,7 @@ cdef extern from "_radau5_solver.h":
         const int *ev_terminal
         const int *ev_direction
         int dense_output
+        int controller
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -254,6 +255,54 @@ def _event_arrays(events, n):
     return m, coef, reals, ints[0], ints[1], ints[2], users
 
 
+cdef extern from "_radau5_solver.h":
+    enum:
+        RADAU5_CTRL_NIT7, RADAU5_CTRL_LIMITS, RADAU5_CTRL_PRED, RADAU5_CTRL_HOLD
+        RADAU5_CTRL_JAC, RADAU5_CTRL_TOL, RADAU5_CTRL_SCALE, RADAU5_CTRL_HAIRER
+
+#: radau5's step-control elements (internal; see _radau5_solver.h and
+#: benchmarks/controllers.py): name -> bit of radau5_problem.controller.
+CONTROLLER_ELEMENTS = {
+    "nit7": RADAU5_CTRL_NIT7, "limits": RADAU5_CTRL_LIMITS, "pred": RADAU5_CTRL_PRED,
+    "hold": RADAU5_CTRL_HOLD, "jac": RADAU5_CTRL_JAC, "tol": RADAU5_CTRL_TOL,
+    "scale": RADAU5_CTRL_SCALE,
+}
+#: The step control every solve uses unless told otherwise (``_set_controller``).
+DEFAULT_CONTROLLER = 0
+_controller = [DEFAULT_CONTROLLER]
+
+
+def _controller_bits(controller):
+    """``controller``: None (the current one), an int of RADAU5_CTRL_* bits, "scipy",
+    "hairer" (every element), or an iterable of element names."""
+    if controller is None:
+        return _controller[0]
+    if controller == "scipy":
+        return 0
+    if controller == "hairer":
+        return RADAU5_CTRL_HAIRER
+    if isinstance(controller, (int, np.integer)) and 0 <= controller <= RADAU5_CTRL_HAIRER:
+        return int(controller)
+    if isinstance(controller, str):
+        controller = [controller]
+    bits = 0
+    for name in controller:
+        if name not in CONTROLLER_ELEMENTS:
+            raise ValueError(f"controller element {name!r} is not one of "
+                             f"{sorted(CONTROLLER_ELEMENTS)}")
+        bits |= CONTROLLER_ELEMENTS[name]
+    return bits
+
+
+def _set_controller(controller):
+    """Make ``controller`` (see ``_controller_bits``) the step control of every later
+    radau5 solve in this process (private: benchmarks and tests); returns the previous
+    bits."""
+    previous = _controller[0]
+    _controller[0] = _controller_bits(controller)
+    return previous
+
+
 cdef object _run(radau5_problem *p, int n, int m):
     cdef radau5_result r
     cdef int rc
@@ -338,8 +387,9 @@ cdef tuple _group_hits(const int[::1] event, const double[::1] t, const double[:
 cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    rtol, atol, max_step, t_eval, events, first_step, max_nfev,
                    radau5_event_fun event_fun=NULL, int[::1] event_plane=None,
-                   list users=None, bint dense_output=False):
+                   list users=None, bint dense_output=False, controller=None):
     cdef radau5_problem p
+    cdef int ctrl = _controller_bits(controller)
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
         raise ValueError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
                          "integer > 0")
@@ -389,12 +439,13 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.ev_nonlinear = &nlv[0]
     p.ev_fun = event_fun
     p.dense_output = dense_output
+    p.controller = ctrl
     return _run(&p, n, m)
 
 
 def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  max_step=np.inf, t_eval=None, events=(), first_step=None, max_nfev=None,
-                 dense_output=False):
+                 dense_output=False, controller=None):
     """Integrate ballc's equations (N_STATES states) over ``t_span`` with radau5.
 
     ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
@@ -409,7 +460,8 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ``dense_output``, (dense_t (steps x 2: t_old, t), dense_c (steps x 4 N_STATES:
     y_old then 3 coefficients per state, y = y_old + sum_j c_j x^(j+1))), else None.
     ``max_nfev``: give up (status -1, with what was computed) after that many
-    right-hand-side calls.
+    right-hand-side calls.  ``controller``: the step control (private; None: the
+    process's current one, see ``_set_controller``).
     """
     cdef ball_ctx ctx
     params = _vector("params", params, BALLC_N_PARAMETERS)
@@ -427,14 +479,14 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ctx.errors = <void *>errors
     sol = _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes,
-                 users, bool(dense_output))
+                 users, bool(dense_output), controller)
     if errors:
         raise errors[0]
     return sol
 
 
 def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),
-                 first_step=None, max_nfev=None):
+                 first_step=None, max_nfev=None, controller=None):
     """Integrate y' = A y (A: n x n) with radau5; same result as ``solve_system``."""
     cdef linear_ctx ctx
     A = np.ascontiguousarray(A, dtype=float)
@@ -446,7 +498,8 @@ def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, eve
     ctx.n = A.shape[0]
     ctx.A = &av[0, 0]
     return _solve(_linear_fun, _linear_jac, &ctx, ctx.n, t_span, y0, rtol, atol,
-                  max_step, t_eval, events, first_step, max_nfev)
+                  max_step, t_eval, events, first_step, max_nfev, NULL, None, None, False,
+                  controller)
 
 
 def _lu_solve(A, b):

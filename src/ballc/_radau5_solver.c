@@ -75,6 +75,13 @@ typedef struct {
     constants_t k;
     int n;
     double direction, newton_tol;
+    /* step control (radau5_problem.controller): the tolerances in use (transformed with
+     * RADAU5_CTRL_TOL), the Newton iteration cap, and Hairer's predictive-controller
+     * memory (h and error of the last accepted step) */
+    int ctrl, newton_maxiter;
+    double rtol, *atol;
+    double h_acc, err_acc;
+    int have_acc;
     /* solver state (Radau attributes) */
     double t, t_old, h_abs, h_abs_old, error_norm_old;
     int have_h_abs_old, have_error_norm_old, have_sol, current_jac, lu_valid;
@@ -229,8 +236,10 @@ static void solve_complex(solver_t *s, cplx *b)
 
 /* radau.solve_collocation_system: Z (3 x n) starts as Z0 and ends as the solution. */
 static int solve_collocation(solver_t *s, double t, double h, double *Z,
-                             int *n_iter, double *rate_out, int *have_rate_out)
+                             int *n_iter, double *rate_out, int *have_rate_out,
+                             double *theta_out)
 {
+    const int maxiter = s->newton_maxiter;
     const constants_t *k = &s->k;
     const int n = s->n;
     double M_real = k->mu_real / h;
@@ -240,9 +249,9 @@ static int solve_collocation(solver_t *s, double t, double h, double *Z,
     for (int i = 0; i < 3; i++)
         for (int c = 0; c < n; c++)
             W[i * n + c] = k->TI[i][0] * Z[c] + k->TI[i][1] * Z[n + c] + k->TI[i][2] * Z[2 * n + c];
-    double dW_norm_old = 0, rate = 0;
+    double dW_norm_old = 0, rate = 0, theta = 0, rate_prev = 0;
     int have_old = 0, have_rate = 0, converged = 0, it;
-    for (it = 0; it < NEWTON_MAXITER; it++) {
+    for (it = 0; it < maxiter; it++) {
         int finite = 1;
         for (int i = 0; i < 3 && finite; i++) {
             for (int c = 0; c < n; c++) yi[c] = s->y[c] + Z[i * n + c];
@@ -270,10 +279,13 @@ static int solve_collocation(solver_t *s, double t, double h, double *Z,
         if (!isfinite(dW_norm)) break;
         if (have_old) {
             rate = dW_norm / dW_norm_old;
+            /* RADAU5's theta: the first ratio, then the geometric mean of the last two */
+            theta = have_rate ? sqrt(rate * rate_prev) : rate;
+            rate_prev = rate;
             have_rate = 1;
         }
         if (have_rate && (rate >= 1 ||
-                          pow(rate, NEWTON_MAXITER - it) / (1 - rate) * dW_norm > s->newton_tol))
+                          pow(rate, maxiter - it) / (1 - rate) * dW_norm > s->newton_tol))
             break;
         for (int i = 0; i < 3 * n; i++) W[i] += dW[i];
         for (int i = 0; i < 3; i++)
@@ -286,9 +298,10 @@ static int solve_collocation(solver_t *s, double t, double h, double *Z,
         dW_norm_old = dW_norm;
         have_old = 1;
     }
-    *n_iter = (it < NEWTON_MAXITER ? it : NEWTON_MAXITER - 1) + 1;
+    *n_iter = (it < maxiter ? it : maxiter - 1) + 1;
     *rate_out = rate;
     *have_rate_out = have_rate;
+    *theta_out = theta;
     return converged;
 }
 
@@ -336,8 +349,9 @@ static int step(solver_t *s)
         error_norm_old = s->error_norm_old; have_error_norm_old = s->have_error_norm_old;
     }
 
+    const int ctrl = s->ctrl;
     int rejected = 0, converged = 0, n_iter = 0, have_rate = 0;
-    double rate = 0, h = 0, t_new = t, error_norm = 0, safety = 0;
+    double rate = 0, theta = 0, h = 0, t_new = t, error_norm = 0, safety = 0;
     double *Z = s->Znew, *y_new = s->y_new, *err = s->err, *ZE = s->ZE;
     for (;;) {   /* while not step_accepted */
         if (h_abs < min_step) {
@@ -359,14 +373,15 @@ static int step(solver_t *s)
                 for (int c = 0; c < n; c++) s->Z0[i * n + c] -= y[c];
             }
         }
-        for (int c = 0; c < n; c++) s->scale[c] = p->atol[c] + fabs(y[c]) * p->rtol;
+        for (int c = 0; c < n; c++) s->scale[c] = s->atol[c] + fabs(y[c]) * s->rtol;
 
         converged = 0;
         while (!converged) {
             int lu_ok = 1;
             if (!s->lu_valid) lu_ok = factor(s, h) == 0;
             memcpy(Z, s->Z0, 3 * n * sizeof(double));
-            converged = lu_ok && solve_collocation(s, t, h, Z, &n_iter, &rate, &have_rate);
+            converged = lu_ok && solve_collocation(s, t, h, Z, &n_iter, &rate, &have_rate,
+                                                  &theta);
             if (!lu_ok) n_iter = 0;
             if (!converged) {
                 if (s->current_jac) break;
@@ -392,11 +407,12 @@ static int step(solver_t *s)
         }
         solve_real(s, err);
         for (int c = 0; c < n; c++) {
-            s->scale[c] = p->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * p->rtol;
+            if (!(ctrl & RADAU5_CTRL_SCALE))
+                s->scale[c] = s->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * s->rtol;
             s->tmp[c] = err[c] / s->scale[c];
         }
         error_norm = rms(s->tmp, n);
-        safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter);
+        safety = 0.9 * (2 * s->newton_maxiter + 1) / (2 * s->newton_maxiter + n_iter);
 
         if (rejected && error_norm > 1) {
             for (int c = 0; c < n; c++) s->tmp[c] = y[c] + err[c];
@@ -410,8 +426,10 @@ static int step(solver_t *s)
             }
         }
         if (!(error_norm <= 1)) {
-            double fac = predict_factor(h_abs, h_abs_old, have_h_abs_old, error_norm,
-                                        error_norm_old, have_error_norm_old);
+            double fac = (ctrl & RADAU5_CTRL_PRED)   /* RADAU5: the standard factor alone */
+                         ? pow(error_norm, -0.25)
+                         : predict_factor(h_abs, h_abs_old, have_h_abs_old, error_norm,
+                                          error_norm_old, have_error_norm_old);
             h_abs *= fmax(MIN_FACTOR, safety * fac);
             s->lu_valid = 0;
             rejected = 1;
@@ -429,11 +447,31 @@ static int step(solver_t *s)
         break;   /* step_accepted */
     }
 
-    int recompute_jac = n_iter > 2 && have_rate && rate > 1e-3;
-    double fac = predict_factor(h_abs, h_abs_old, have_h_abs_old, error_norm,
-                                error_norm_old, have_error_norm_old);
-    fac = fmin(MAX_FACTOR, safety * fac);
-    if (!recompute_jac && fac < 1.2)
+    int recompute_jac = (ctrl & RADAU5_CTRL_JAC) ? (have_rate && theta > 1e-3)
+                                                 : (n_iter > 2 && have_rate && rate > 1e-3);
+    const double max_factor = (ctrl & RADAU5_CTRL_LIMITS) ? 8.0 : MAX_FACTOR;
+    double fac;
+    if (ctrl & RADAU5_CTRL_PRED) {
+        /* RADCOR: standard factor, and Gustafsson's from the last accepted step (plain
+         * safety), each within the limits; the smaller one */
+        double e = fmax(error_norm, 1e-10);
+        fac = fmin(max_factor, fmax(MIN_FACTOR, safety * pow(e, -0.25)));
+        if (s->have_acc) {
+            double gus = 0.9 * h_abs / s->h_acc * pow(s->err_acc / (e * e), 0.25);
+            fac = fmin(fac, fmin(max_factor, fmax(MIN_FACTOR, gus)));
+        }
+        s->h_acc = h_abs;
+        s->err_acc = fmax(0.01, e);
+        s->have_acc = 1;
+    } else {
+        fac = predict_factor(h_abs, h_abs_old, have_h_abs_old, error_norm,
+                             error_norm_old, have_error_norm_old);
+        fac = fmin(max_factor, safety * fac);
+    }
+    if ((ctrl & RADAU5_CTRL_LIMITS) && rejected && fac > 1)
+        fac = 1;   /* RADCOR: no growth right after a rejection */
+    int hold = (ctrl & RADAU5_CTRL_HOLD) ? (fac >= 1 && fac <= 1.2) : (fac < 1.2);
+    if (!recompute_jac && hold)
         fac = 1;
     else
         s->lu_valid = 0;
@@ -478,7 +516,7 @@ static double initial_step(solver_t *s)
     if (interval == 0) return 0;
     double d0 = 0, d1 = 0, d2 = 0;
     for (int c = 0; c < n; c++) {
-        s->scale[c] = p->atol[c] + fabs(s->y[c]) * p->rtol;
+        s->scale[c] = s->atol[c] + fabs(s->y[c]) * s->rtol;
         d0 += (s->y[c] / s->scale[c]) * (s->y[c] / s->scale[c]);
         d1 += (s->f[c] / s->scale[c]) * (s->f[c] / s->scale[c]);
     }
@@ -767,14 +805,18 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.n = n;
     init_constants(&s.k);
     s.direction = p->t_bound >= p->t0 ? 1.0 : -1.0;
-    s.newton_tol = fmax(10 * EPS / p->rtol, fmin(0.03, sqrt(p->rtol)));
+    s.ctrl = p->controller;
+    s.newton_maxiter = (s.ctrl & RADAU5_CTRL_NIT7) ? 7 : NEWTON_MAXITER;
+    s.rtol = (s.ctrl & RADAU5_CTRL_TOL) ? 0.1 * pow(p->rtol, 2.0 / 3) : p->rtol;
+    s.newton_tol = fmax(10 * EPS / s.rtol, fmin(0.03, sqrt(s.rtol)));
 
     /* one block of doubles, one of complex, one of ints */
     size_t nd = (size_t)n * (1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1) /* y f y_old y_new f_new scale tmp err ZE */
          + (size_t)n * n * 2                                /* J, LU_real */
          + (size_t)n * 3 * 7                                /* Z Q Z0 Znew W F dW */
          + (size_t)m * 3 + (size_t)n                        /* g g_new roots, ev_y */
-         + (size_t)n * n + (size_t)n;                       /* Joc, xc */
+         + (size_t)n * n + (size_t)n                        /* Joc, xc */
+         + (size_t)n;                                       /* atol */
     double *dblock = calloc(nd, sizeof(double));
     cplx *cblock = calloc((size_t)n * n + 2 * (size_t)n, sizeof(cplx));
     int *iblock = calloc(5 * (size_t)n + 2 * (size_t)m + 3 + (size_t)n * n, sizeof(int));
@@ -789,6 +831,9 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.W = d; d += 3 * n; s.F = d; d += 3 * n; s.dW = d; d += 3 * n;
     s.g = d; d += m; s.g_new = d; d += m; s.roots = d; d += m; s.ev_y = d; d += n;
     s.Joc = d; d += n * n; s.xc = d; d += n;
+    s.atol = d; d += n;
+    for (int c = 0; c < n; c++) s.atol[c] = s.rtol * (p->atol[c] / p->rtol);
+    if (!(s.ctrl & RADAU5_CTRL_TOL)) memcpy(s.atol, p->atol, n * sizeof(double));
     s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n; s.xcc = s.ctmp + n;
     s.piv_real = iblock; s.piv_complex = iblock + n;
     s.active = iblock + 2 * n;

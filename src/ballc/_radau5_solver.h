@@ -57,7 +57,28 @@ typedef struct {
     const int *ev_terminal;   /* nonzero: stop at the first occurrence */
     const int *ev_direction;  /* +1 rising only, -1 falling only, 0 both */
     int dense_output;         /* nonzero: keep every step's interpolant (dense_t, dense_c) */
+    int controller;           /* RADAU5_CTRL_* bits (internal; 0: scipy's step control) */
 } radau5_problem;
+
+/* Step control: scipy's Radau (0) or elements of Hairer & Wanner's RADAU5 (radau5.f,
+ * RADCOR/ESTRAD), each a bit, for benchmarks/controllers.py.
+ *   NIT7    at most 7 Newton iterations (scipy: 6), safety 0.9 (1 + 2 nit)/(newt + 2 nit)
+ *   LIMITS  h_new/h in [0.2, 8] (scipy: [0.2, 10]); no growth right after a rejection
+ *   PRED    Gustafsson's predictive factor after accepted steps only, min with the
+ *           standard one, plain safety 0.9, previous error floored at 0.01; a rejected
+ *           step uses the standard factor alone (scipy: the predictive one on both)
+ *   HOLD    keep h (and the LU) when h_new/h is in [1, 1.2] (scipy: whenever < 1.2)
+ *   JAC     a new Jacobian after an accepted step only when the Newton contraction
+ *           theta > 0.001 (scipy: also more than 2 iterations); theta = 0 after 1
+ *   TOL     the tolerances transformed, rtol' = 0.1 rtol^(2/3), atol' = rtol' atol/rtol
+ *           (error norm, Newton scale and stopping tolerance all use them)
+ *   SCALE   the error scale from |y| at the step's start (scipy: max(|y|, |y_new|)) */
+enum {
+    RADAU5_CTRL_NIT7 = 1, RADAU5_CTRL_LIMITS = 2, RADAU5_CTRL_PRED = 4,
+    RADAU5_CTRL_HOLD = 8, RADAU5_CTRL_JAC = 16, RADAU5_CTRL_TOL = 32,
+    RADAU5_CTRL_SCALE = 64,
+    RADAU5_CTRL_SCIPY = 0, RADAU5_CTRL_HAIRER = 127
+};
 
 enum { RADAU5_REACHED = 0, RADAU5_EVENT = 1, RADAU5_FAILED = -1 };
 /* What radau5_solve returns (result->status says how the integration ended). */
