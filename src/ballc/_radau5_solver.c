@@ -97,6 +97,7 @@ typedef struct {
     int *joc_col, *joc_start;             /* their coupled column; row o: [start[o], start[o+1]) */
     double lu_mr; cplx lu_mc;             /* mu_real / h, mu_complex / h of the factors */
     double *xc; cplx *xcc;                /* nc: gathered right-hand sides */
+    double *inv_scale;                    /* 1 / scale of the step start (Newton norm) */
     /* scratch */
     double *y_new, *f_new, *scale, *Z0, *Znew, *W, *F, *dW, *tmp, *err, *ZE;
     cplx *ctmp;
@@ -235,7 +236,7 @@ static void solve_complex(solver_t *s, cplx *b)
 }
 
 /* radau.solve_collocation_system: Z (3 x n) starts as Z0 and ends as the solution. */
-static int solve_collocation(solver_t *s, double t, double h, double *Z,
+static int solve_collocation(solver_t *s, double t, double h, double *restrict Z,
                              int *n_iter, double *rate_out, int *have_rate_out,
                              double *theta_out)
 {
@@ -244,8 +245,10 @@ static int solve_collocation(solver_t *s, double t, double h, double *Z,
     const int n = s->n;
     double M_real = k->mu_real / h;
     cplx M_complex = k->mu_complex / h;
-    double *W = s->W, *F = s->F, *dW = s->dW, *yi = s->tmp;
-    cplx *fc = s->ctmp;
+    /* distinct buffers: restrict lets the compiler vectorise the stage loops */
+    double *restrict W = s->W, *restrict F = s->F, *restrict dW = s->dW, *restrict yi = s->tmp;
+    const double *restrict inv_scale = s->inv_scale;
+    cplx *restrict fc = s->ctmp;
     for (int i = 0; i < 3; i++)
         for (int c = 0; c < n; c++)
             W[i * n + c] = k->TI[i][0] * Z[c] + k->TI[i][1] * Z[n + c] + k->TI[i][2] * Z[2 * n + c];
@@ -271,7 +274,7 @@ static int solve_collocation(solver_t *s, double t, double h, double *Z,
             dW[n + c] = creal(fc[c]);
             dW[2 * n + c] = cimag(fc[c]);
             for (int i = 0; i < 3; i++) {
-                double v = dW[i * n + c] / s->scale[c];
+                double v = dW[i * n + c] * inv_scale[c];
                 sum += v * v;
             }
         }
@@ -373,7 +376,10 @@ static int step(solver_t *s)
                 for (int c = 0; c < n; c++) s->Z0[i * n + c] -= y[c];
             }
         }
-        for (int c = 0; c < n; c++) s->scale[c] = s->atol[c] + fabs(y[c]) * s->rtol;
+        for (int c = 0; c < n; c++) {
+            s->scale[c] = s->atol[c] + fabs(y[c]) * s->rtol;
+            s->inv_scale[c] = 1.0 / s->scale[c];
+        }
 
         converged = 0;
         while (!converged) {
@@ -816,7 +822,8 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
          + (size_t)n * 3 * 7                                /* Z Q Z0 Znew W F dW */
          + (size_t)m * 3 + (size_t)n                        /* g g_new roots, ev_y */
          + (size_t)n * n + (size_t)n                        /* Joc, xc */
-         + (size_t)n;                                       /* atol */
+         + (size_t)n                                        /* atol */
+         + (size_t)n;                                       /* inv_scale */
     double *dblock = calloc(nd, sizeof(double));
     cplx *cblock = calloc((size_t)n * n + 2 * (size_t)n, sizeof(cplx));
     int *iblock = calloc(5 * (size_t)n + 2 * (size_t)m + 3 + (size_t)n * n, sizeof(int));
@@ -832,6 +839,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.g = d; d += m; s.g_new = d; d += m; s.roots = d; d += m; s.ev_y = d; d += n;
     s.Joc = d; d += n * n; s.xc = d; d += n;
     s.atol = d; d += n;
+    s.inv_scale = d; d += n;
     for (int c = 0; c < n; c++) s.atol[c] = s.rtol * (p->atol[c] / p->rtol);
     if (!(s.ctrl & RADAU5_CTRL_TOL)) memcpy(s.atol, p->atol, n * sizeof(double));
     s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n; s.xcc = s.ctmp + n;
