@@ -41,6 +41,7 @@ nreject = 0, h_next = 0`` and ``exact_flight = True``.
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -55,6 +56,9 @@ _POSITION = layout.POSITION
 _OMEGA = layout.ANGULAR_VELOCITY
 _VELOCITY = layout.VELOCITY
 _Z, _VZ = layout.INDEX["z"], layout.INDEX["vz"]
+_TO_VELOCITY = _VELOCITY.start - _POSITION.start
+_OBSERVER_MASS, _IXX, _IYY, _IZZ, _GRAVITY = (_PARAMETER[name] for name in (
+    "observer_mass", "inertia_xx", "inertia_yy", "inertia_zz", "gravity"))
 
 #: Fewest sample intervals of an exact flight segment without t_eval.
 MIN_INTERVALS = 32
@@ -67,10 +71,8 @@ TERMINATED = "A termination event occurred."
 
 def scene_allows(params) -> bool:
     """Whether the parameters admit exact flight: massless observer, isotropic inertia."""
-    p = np.asarray(params, dtype=float)
-    ixx, iyy, izz = (p[_PARAMETER[name]] for name in ("inertia_xx", "inertia_yy",
-                                                       "inertia_zz"))
-    return bool(p[_PARAMETER["observer_mass"]] == 0 and ixx == iyy == izz)
+    p = params
+    return bool(p[_OBSERVER_MASS] == 0 and p[_IXX] == p[_IYY] == p[_IZZ])
 
 
 def applies(system, events) -> bool:
@@ -80,7 +82,8 @@ def applies(system, events) -> bool:
     whose flight is polynomial (not the quaternion)."""
     if system.flags != 0 or not scene_allows(system.params):
         return False
-    return all(type(e) is LinearEvent and not np.any(e.coefficients[_QUATERNION])
+    return all(type(e) is LinearEvent and (e._index is not None and e._index >= _QUATERNION.stop
+                                           or not np.any(e.coefficients[_QUATERNION]))
                for e in events)
 
 
@@ -95,29 +98,54 @@ class FreeFlight:
         self.gravity = float(gravity)
         self.t_min = self.t0
         self.t_max = self.t0 if t_max is None else float(t_max)
-        omega = self.y0[_OMEGA]
-        self.rate = float(np.linalg.norm(omega))
-        axis = omega / self.rate if self.rate > 0 else np.zeros(3)
+        wx, wy, wz = (float(v) for v in self.y0[_OMEGA])
+        self.rate = math.sqrt(wx * wx + wy * wy + wz * wz)
+        nx, ny, nz = (wx / self.rate, wy / self.rate, wz / self.rate) if self.rate > 0 else (
+            0.0, 0.0, 0.0)
         # [0, n] (x) q0: the quaternion's direction of motion on the unit 3-sphere
-        qw, qv = self.y0[_QUATERNION][0], self.y0[_QUATERNION][1:]
-        self._turned = np.concatenate([[-axis @ qv], qw * axis + np.cross(axis, qv)])
+        qw, qx, qy, qz = (float(v) for v in self.y0[_QUATERNION])
+        turned = (-(nx * qx + ny * qy + nz * qz), nx * qw + ny * qz - nz * qy,
+                  ny * qw + nz * qx - nx * qz, nz * qw + nx * qy - ny * qx)
+        # y(s) = c0 + c1 s + c2 s^2 + c3 cos(|omega| s / 2) + c4 sin(|omega| s / 2)
+        n = self.y0.size
+        c = np.zeros((5, n))
+        c[0] = self.y0
+        c[0, _QUATERNION] = 0.0
+        c[1, _POSITION] = self.y0[_VELOCITY]
+        c[1, _VZ] = -self.gravity
+        c[2, _Z] = -0.5 * self.gravity
+        c[3, _QUATERNION] = self.y0[_QUATERNION]
+        c[4, _QUATERNION] = turned
+        self._c = c
 
     def __call__(self, t):
-        t = np.asarray(t, dtype=float)
-        scalar = t.ndim == 0
-        s = np.atleast_1d(t) - self.t0
-        y = np.repeat(self.y0[:, None], s.size, axis=1)
-        y[_POSITION] += self.y0[_VELOCITY, None] * s
-        y[_Z] -= 0.5 * self.gravity * s * s
-        y[_VZ] -= self.gravity * s
+        if np.ndim(t) == 0:
+            s = float(t) - self.t0
+            half = 0.5 * self.rate * s
+            c = self._c
+            return c[0] + c[1] * s + c[2] * (s * s) + c[3] * math.cos(half) + c[4] * math.sin(
+                half)
+        s = np.asarray(t, dtype=float).ravel() - self.t0
         half = 0.5 * self.rate * s
-        y[_QUATERNION] = (np.cos(half) * self.y0[_QUATERNION, None]
-                          + np.sin(half) * self._turned[:, None])
-        return y[:, 0] if scalar else y
+        basis = np.empty((5, s.size))
+        basis[0] = 1.0
+        basis[1] = s
+        np.multiply(s, s, out=basis[2])
+        np.cos(half, out=basis[3])
+        np.sin(half, out=basis[4])
+        # einsum's own loops (no BLAS): the same bits on every machine
+        return np.einsum("kn,km->nm", self._c, basis)
 
     def event_polynomial(self, event):
         """(c0, c1, c2): ``event`` (a LinearEvent without quaternion terms) on this
         solution, g(t0 + s) = c0 + c1 s + c2 s^2."""
+        if event._index is not None:     # one state (all of the driver's events)
+            k, scale, y0 = event._index, event._scale, self.y0
+            c0 = scale * y0[k] + event.offset
+            c1 = scale * (y0[k + _TO_VELOCITY] if _POSITION.start <= k < _POSITION.stop else
+                          -self.gravity if k == _VZ else 0.0)
+            c2 = -0.5 * scale * self.gravity if k == _Z else 0.0
+            return float(c0), float(c1), float(c2)
         c = event.coefficients
         c0 = float(c @ self.y0) + event.offset
         c1 = float(c[_POSITION] @ self.y0[_VELOCITY]) - c[_VZ] * self.gravity
@@ -144,17 +172,25 @@ def crossings(c0, c1, c2, direction, s_max):
             and (direction == 0 or (direction > 0) == rising)]
 
 
+@functools.lru_cache(maxsize=16)
+def _fractions(n):
+    """0, 1/n, ..., 1: the sample grid of n intervals (read only)."""
+    grid = np.arange(n + 1) / n
+    grid.flags.writeable = False
+    return grid
+
+
 def propagate(system, t0, t1, y0, events, *, t_eval=None, max_step=np.inf,
               dense_output=False):
     """The exact free-flight segment from (t0, y0) to t1 or its first terminal event
     (see the module's docstring); ``system``, ``events``, ``t_eval``, ``max_step`` and
     ``dense_output`` as for :func:`ballc.integrate.integrate_segment`."""
-    gravity = float(np.asarray(system.params)[_PARAMETER["gravity"]])
+    gravity = float(system.params[_GRAVITY])
     flight = FreeFlight(t0, y0, gravity)
     span = t1 - t0
     hits = []                     # (s, event index)
     for k, event in enumerate(events):
-        roots = crossings(*flight.event_polynomial(event), np.sign(event.direction), span)
+        roots = crossings(*flight.event_polynomial(event), event.direction, span)
         if event.terminal:
             roots = roots[:1]
         hits += [(s, k) for s in roots]
@@ -175,14 +211,16 @@ def propagate(system, t0, t1, y0, events, *, t_eval=None, max_step=np.inf,
         turn = flight.rate * (t_stop - t0) / MAX_TURN
         longest = (t_stop - t0) / max_step if max_step < np.inf else 0.0
         n = max(MIN_INTERVALS, math.ceil(turn), math.ceil(longest))
-        t = t0 + (t_stop - t0) * (np.arange(n + 1) / n)
+        t = t0 + (t_stop - t0) * _fractions(n)
         t[-1] = t_stop
     y = flight(t) if t.size else np.empty((len(y0), 0))
 
     t_events = [[] for _ in events]
     for s, k in hits:
         t_events[k].append(t_stop if (s, k) == stop else min(t0 + s, t1))
-    y_events = [flight(np.array(te)).T if te else np.empty((0, len(y0))) for te in t_events]
+    empty = np.empty((0, len(y0)))
+    y_events = [empty if not te else y[:, -1:].T.copy() if te == [t_stop] and t_eval is None
+                else flight(te).T for te in t_events]
     return OptimizeResult(t=t, y=y, t_events=[np.array(te, dtype=float) for te in t_events],
                           y_events=y_events, status=status, message=message, success=True,
                           nfev=0, njev=0, nlu=0, nstep=0, nreject=0, h_next=0.0, sol=None,
