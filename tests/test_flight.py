@@ -210,6 +210,8 @@ def test_whole_run_agrees_with_the_integrated_flight(changes, rtol):
         assert a.plane == b.plane
         assert a.t_start == pytest.approx(b.t_start, abs=1e-6)
         np.testing.assert_allclose(a.velocity_after, b.velocity_after, rtol=0, atol=1e-5)
+    # the mixture scene's own error at rtol 1e-10 is ~3e-5 in state (against rtol 1e-12,
+    # exact flight on or off alike: contact and stick-slip dominate), hence 1e-4 here
     times = np.linspace(0, 3.0, 50)
     np.testing.assert_allclose(on.sol(times)[:13], off.sol(times)[:13], rtol=0, atol=1e-4)
     balance = on.energy["balance"]
