@@ -3,19 +3,23 @@
 ``method`` "radau5" runs ballc's compiled Radau IIA (scipy's Radau, step by step in
 C) on the system's C right-hand side and Jacobian; any other is handed to scipy's
 ``solve_ivp`` (with the analytic Jacobian when implicit).  scipy has no call budget
-of its own: :func:`_call_budget` gives it one as a terminal event.
+of its own: :func:`_call_budget` gives it one as a terminal event.  With
+``exact_flight``, a free-flight segment that has an exact solution (massless observer,
+isotropic inertia, only linear events: :func:`ballc.flight.applies`) is not integrated
+at all but propagated in closed form by :func:`ballc.flight.propagate`, whatever the
+method.
 """
 from __future__ import annotations
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import _radau5, dense
+from . import _radau5, dense, flight
 from .options import IMPLICIT_METHODS
 
 
 def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval, max_step,
-                      max_nfev=None, first_step=None, dense_output=False):
+                      max_nfev=None, first_step=None, dense_output=False, exact_flight=False):
     """Integrate one smooth segment; returns a solve_ivp-style solution.
 
     This is the one seam between the driver and an integrator.  The solution has
@@ -25,8 +29,15 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
     ``terminal`` and ``direction``: :class:`ballc.events.LinearEvent` and
     :class:`ballc.events.StickRelease`, which radau5 evaluates in C, or any other
     (a user's), which it calls back.  ``max_nfev``: give up (status -1, keeping what
-    was computed) after that many right-hand-side calls.
+    was computed) after that many right-hand-side calls.  ``exact_flight``: propagate
+    the segment in closed form when :func:`ballc.flight.applies` (then ``nfev`` is 0,
+    ``first_step`` and ``max_nfev`` play no part, ``max_step`` only bounds the spacing
+    of the samples, and the solution has ``exact_flight = True``).
     """
+    events = list(events)
+    if exact_flight and flight.applies(system, events):
+        return flight.propagate(system, t0, t1, y0, events, t_eval=t_eval,
+                                max_step=max_step, dense_output=dense_output)
     if first_step is not None:   # a step carried over may be longer than what is left
         first_step = min(first_step, t1 - t0)
     if method == "radau5":

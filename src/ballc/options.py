@@ -41,6 +41,7 @@ class Options:
     max_nfev: int | None
     events: tuple
     dense_output: bool
+    exact_flight: bool = True
 
 
 def _is_number_like(value) -> bool:
@@ -132,7 +133,7 @@ def check_events(events) -> tuple:
 
 def check_options(scene, t_end, method="radau5", rtol=1e-10, atol=1e-10, max_step=np.inf,
                   first_step=None, t_eval=None, max_nfev=DEFAULT_MAX_NFEV, events=None,
-                  dense_output=False) -> Options:
+                  dense_output=False, exact_flight=True) -> Options:
     """Validate simulate's options (see :func:`ballc.simulate`); returns :class:`Options`."""
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a ballc.Scene, got {type(scene).__name__}")
@@ -154,7 +155,11 @@ def check_options(scene, t_end, method="radau5", rtol=1e-10, atol=1e-10, max_ste
     if not isinstance(dense_output, (bool, np.bool_)):
         raise SceneError(f"dense_output = {dense_output!r} is not allowed: must be True "
                          "or False")
+    if not isinstance(exact_flight, (bool, np.bool_)):
+        raise SceneError(f"exact_flight = {exact_flight!r} is not allowed: must be True "
+                         "or False")
     return Options(t_end=t_end, method=method, rtol=rtol, atol=atol, max_step=max_step,
                    first_step=first_step, t_eval=check_t_eval(t_eval, t_end),
                    max_nfev=None if max_nfev is None else int(max_nfev),
-                   events=check_events(events), dense_output=bool(dense_output))
+                   events=check_events(events), dense_output=bool(dense_output),
+                   exact_flight=bool(exact_flight))

@@ -199,7 +199,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
              atol: float = 1e-10, t_eval=None, max_step: float = np.inf,
              first_step: float | None = None, events=None, dense_output: bool = False,
              y0=None, progress: bool | None = None,
-             max_nfev: int | None = DEFAULT_MAX_NFEV) -> Result:
+             max_nfev: int | None = DEFAULT_MAX_NFEV, exact_flight: bool = True) -> Result:
     """Simulate ``scene`` from t = 0 to ``t_end`` (s), like ``scipy.integrate.solve_ivp``.
 
     Parameters
@@ -241,6 +241,17 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     progress : bool, optional
         Show a tqdm progress bar in simulated time (advanced once per segment).
         None (default): only when stderr is a terminal.
+    exact_flight : bool
+        True (default): a free-flight segment is propagated in closed form, not
+        integrated, when that is exact -- massless observer (``observer_mass = 0``) and
+        isotropic inertia (all three moments equal) -- whatever ``method``: constant
+        angular velocity, a parabola for the centre, the contact start at the root of
+        its event in closed form (ballc.flight).  Its samples are ``t_eval``'s, or
+        else the segment's start, end and evenly spaced times between (at least 32
+        intervals, at most pi/16 rad of rotation and ``max_step`` apart); it costs no
+        right-hand-side call.  A segment with a user event that is not a
+        ``ballc.events.LinearEvent`` is integrated as before.  False: every segment is
+        integrated by ``method``.
 
     Returns
     -------
@@ -250,7 +261,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         integrator failed; the arrays always hold what was computed up to there.
     """
     options = check_options(scene, t_end, method, rtol, atol, max_step, first_step, t_eval,
-                            max_nfev, events, dense_output)
+                            max_nfev, events, dense_output, exact_flight)
     run = _Run(scene, options, check_initial_state(scene, y0))
     t_end, t_eval = options.t_end, options.t_eval
     for plane in PLANES:   # a scene may start in contact: latch as documented in modes
@@ -289,7 +300,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                                 method=options.method, rtol=options.rtol, atol=options.atol,
                                 t_eval=segment_eval, max_step=options.max_step,
                                 max_nfev=remaining, first_step=first,
-                                dense_output=options.dense_output)
+                                dense_output=options.dense_output,
+                                exact_flight=options.exact_flight)
         first = None
         nfev += sol.nfev
         njev += sol.njev
