@@ -48,6 +48,17 @@ class LinearEvent:
         self._scale = float(self.coefficients[nonzero[0]]) if nonzero.size == 1 else 0.0
 
     @classmethod
+    def over(cls, coefficients, offset, terminal, direction):
+        """The same event over ``coefficients`` that the caller has just computed (a
+        float64 array of N_STATES values, owned by the event from now on): no copy, no
+        shape check -- for the driver, which makes several per segment."""
+        event = cls.__new__(cls)
+        event.coefficients, event.offset = coefficients, float(offset)
+        event.terminal, event.direction = bool(terminal), direction
+        event._index, event._scale = None, 0.0   # several states: the dot product
+        return event
+
+    @classmethod
     def of_state(cls, name, scale=1.0, offset=0.0, terminal=False, direction=0):
         """g(y) = scale * y[name] + offset."""
         coefficients = np.zeros(_core.N_STATES)
@@ -142,11 +153,11 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
             along = stickslip.slip_stop_coefficients(params, plane,
                                                      stickslip.slip_direction(latch, plane))
             if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
-                events.append(("approach", plane, LinearEvent(along, -clear, True, -1)))
+                events.append(("approach", plane, LinearEvent.over(along, -clear, True, -1)))
             else:                # fixed direction: stop at u . d = 0, or go free at 2 clear
                 margin = 4 * math.ulp(stickslip.speed_scale(scene, y0))
-                events.append(("stop", plane, LinearEvent(along, margin, True, -1)))
-                events.append(("clear", plane, LinearEvent(along, -2 * clear, True, 1)))
+                events.append(("stop", plane, LinearEvent.over(along, margin, True, -1)))
+                events.append(("clear", plane, LinearEvent.over(along, -2 * clear, True, 1)))
         elif mode == "stick":
             load = _core.stick_state(y0, params, latch, flags, PLANES.index(plane))[2]
             events.append(("release", plane, StickRelease(

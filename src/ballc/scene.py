@@ -7,6 +7,7 @@ in :class:`Scene`'s docstring (its Parameters and the table in its Notes).
 from __future__ import annotations
 
 import difflib
+import functools
 import json
 import math
 from dataclasses import asdict, dataclass, fields
@@ -244,14 +245,19 @@ class Scene:
         return {"friction": 0.0, "dig-in": 1.0, "compliant": 0.0}.get(
             self.tangential_model, self.mixture)
 
-    @property
+    @functools.cached_property
     def hertz_stiffness(self) -> float:
         """k0 = 4 / (3 (sigma_b + sigma_p)) sqrt(r), sigma = (1 - nu^2) / E, N/m^(3/2):
         evaluated by the generated kernel, so the formula exists once (codegen/contact.py)."""
         return float(_core.hertz_stiffness(self.parameter_vector()))
 
     def parameter_vector(self) -> np.ndarray:
-        """Parameters in the generated layout order (``ballc._core.PARAMETER_NAMES``)."""
+        """Parameters in the generated layout order (``ballc._core.PARAMETER_NAMES``);
+        a fresh copy each call (the scene is frozen: built once)."""
+        return self._parameters.copy()
+
+    @functools.cached_property
+    def _parameters(self) -> np.ndarray:
         ix, iy, iz = self.inertia
         a, b, c = self.observer_position
         values = {

@@ -72,9 +72,16 @@ class _Run:
         self.contacts: list[Contact] = []
         self.status, self.message = 0, SUCCESS
         self.last_transition, self.stalled = None, 0   # mode changes that left t unchanged
+        self._flags: dict[tuple, int] = {}
 
     def flags(self, with_coulomb=True):
-        return modes.flags(self.scene, self.in_contact, self.coulomb if with_coulomb else None)
+        key = (self.in_contact["floor"], self.in_contact["ceiling"],
+               self.coulomb["floor"], self.coulomb["ceiling"], with_coulomb)
+        found = self._flags.get(key)
+        if found is None:   # a run visits a handful of modes: compute each once
+            found = self._flags[key] = modes.flags(
+                self.scene, self.in_contact, self.coulomb if with_coulomb else None)
+        return found
 
     # ---- contacts ----
 

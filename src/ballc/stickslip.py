@@ -84,11 +84,14 @@ def set_slip_direction(latch: np.ndarray, plane: str, direction) -> None:
     latch[_slip_direction_slice(plane)] = direction
 
 
+_VELOCITY, _ANGULAR = layout.VELOCITY, layout.ANGULAR_VELOCITY
+
+
 def speed_scale(scene, y) -> float:
     """|v| + r |omega| (m/s): the scale slip speeds are compared with."""
-    vx, vy, vz = y[layout.VELOCITY]
-    wx, wy, wz = y[layout.ANGULAR_VELOCITY]
-    return math.hypot(vx, vy, vz) + scene.radius * math.hypot(wx, wy, wz) + 1e-300
+    values = y.tolist() if isinstance(y, np.ndarray) else list(y)   # Python floats: cheap
+    return (math.hypot(*values[_VELOCITY]) + scene.radius * math.hypot(*values[_ANGULAR])
+            + 1e-300)
 
 
 def clear_speed(scene, y, rtol, atol) -> float:
