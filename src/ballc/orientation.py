@@ -23,7 +23,10 @@ def quaternion_multiply(a, b):
     aw, av = a[..., 0], a[..., 1:]
     bw, bv = b[..., 0], b[..., 1:]
     w = aw * bw - np.sum(av * bv, axis=-1)
-    v = aw[..., None] * bv + bw[..., None] * av + np.cross(av, bv)
+    ax, ay, az = av[..., 0], av[..., 1], av[..., 2]   # av x bv, as np.cross computes it
+    bx, by, bz = bv[..., 0], bv[..., 1], bv[..., 2]     # (without its axis handling)
+    cross = np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=-1)
+    v = aw[..., None] * bv + bw[..., None] * av + cross
     return np.concatenate([w[..., None], v], axis=-1)
 
 
