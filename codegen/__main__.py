@@ -10,7 +10,8 @@ import sys
 import time
 from pathlib import Path
 
-from .emit import GENERATOR_VERSION, SIGNATURE, BallcPrinter, c_string_array, header_comment, kernel_c
+from .emit import (CONSTANTS_SIGNATURE, GENERATOR_VERSION, SIGNATURE, BallcPrinter,
+                   ParameterConstants, c_string_array, constants_c, header_comment, kernel_c)
 from .contact import TANGENTIAL_LAWS
 from .kernels import MASS_LAYOUT, build_kernels, contact_law_offsets, describe_contact_law_layout
 from .model import (LATCH_FIELDS, LATCH_NAMES, MECHANICAL_STATE_NAMES, PARAMETER_NAMES,
@@ -28,8 +29,9 @@ def render(verbose=False) -> dict[str, str]:
     printer = BallcPrinter()
     bodies, prototypes, sizes = [], [], []
     total_ops = 0
+    constants = ParameterConstants(model.parameters)
     for kernel in kernels:
-        source, ops = kernel_c(kernel, model.states, model.parameters, printer)
+        source, ops = kernel_c(kernel, model.states, model.parameters, printer, constants)
         total_ops += ops
         bodies.append(source)
         prototypes.append(SIGNATURE.format(name=kernel.name) + ";")
@@ -37,6 +39,14 @@ def render(verbose=False) -> dict[str, str]:
         if verbose:
             print(f"  {kernel.name:28s} {len(kernel.outputs):4d} outputs {ops:6d} ops",
                   file=sys.stderr)
+
+    source, ops = constants_c(constants, model.parameters, printer)
+    total_ops += ops
+    bodies.insert(0, source)
+    prototypes.insert(0, CONSTANTS_SIGNATURE + ";")
+    if verbose:
+        print(f"  {'parameter_constants':28s} {len(constants):4d} outputs {ops:6d} ops",
+              file=sys.stderr)
 
     law_names = {f"{plane}_{law}" for plane in PLANES for law in TANGENTIAL_LAWS}
     (contact_law_nout,) = {len(k.outputs) for k in kernels if k.name in law_names}
@@ -47,6 +57,8 @@ def render(verbose=False) -> dict[str, str]:
          f"#define BALLC_N_STATES {len(STATE_NAMES)}",
          f"#define BALLC_N_PARAMETERS {len(PARAMETER_NAMES)}",
          f"#define BALLC_N_LATCH {len(LATCH_NAMES)}",
+         "/* parameter constants: ballc_parameter_constants(params, constants) */",
+         f"#define BALLC_N_PARAMETER_CONSTANTS {len(constants)}",
          f"#define BALLC_N_LATCH_PER_PLANE {len(LATCH_FIELDS)}",
          f"#define BALLC_N_PLANES {len(PLANES)}",
          f"#define BALLC_MASS_SIZE {len(MASS_LAYOUT)}",
@@ -63,6 +75,7 @@ def render(verbose=False) -> dict[str, str]:
          c_string_array("BALLC_PARAMETER_NAMES", PARAMETER_NAMES).rstrip(),
          c_string_array("BALLC_PARAMETER_UNITS", units).rstrip(),
          c_string_array("BALLC_LATCH_NAMES", LATCH_NAMES).rstrip(),
+         c_string_array("BALLC_PARAMETER_CONSTANT_NAMES", map(str, constants.values)).rstrip(),
          c_string_array("BALLC_MASS_LAYOUT", MASS_LAYOUT).rstrip(),
          "", *prototypes, "", "#endif", ""]
     c = [header, "#include <math.h>", "#include \"ballc_kernels.h\"", "", *bodies]

@@ -3,11 +3,19 @@
 Every kernel has the same signature::
 
     void ballc_<name>(const double *restrict state, const double *restrict params,
-                      const double *restrict extra, double *restrict out);
+                      const double *restrict constants, const double *restrict extra,
+                      double *restrict out);
 
 ``state`` is the state (STATE_NAMES order), ``params`` the parameters (PARAMETER_NAMES order),
+``constants`` the parameter constants (``ballc_parameter_constants(params, constants)``),
 ``extra`` a kernel-specific input vector (latched contact values, or a vector to
 multiply with), ``out`` the kernel's outputs, written (never accumulated).
+
+Parameter constants: after each kernel's CSE, every subexpression whose free symbols
+are parameters only (a CSE temporary, a subtree, or the parameter factors and terms of
+a product or sum) is replaced by a constant ``pc<i>``, shared by all kernels; one more
+function, ``ballc_parameter_constants``, computes them from the parameter vector, so a
+caller computes them once per parameter vector instead of once per kernel call.
 """
 from __future__ import annotations
 
@@ -21,7 +29,10 @@ from sympy.printing.c import C99CodePrinter
 
 GENERATOR_VERSION = "1"
 SIGNATURE = ("void ballc_{name}(const double *restrict state, const double *restrict params,\n"
-             "        const double *restrict extra, double *restrict out)")
+             "        const double *restrict constants, const double *restrict extra,\n"
+             "        double *restrict out)")
+CONSTANTS_SIGNATURE = ("void ballc_parameter_constants(const double *restrict params, "
+                       "double *restrict constants)")
 CODEGEN_DIR = Path(__file__).resolve().parent
 
 
@@ -101,6 +112,66 @@ class BallcPrinter(C99CodePrinter):
         return super()._print_Pow(expr)
 
 
+class ParameterConstants:
+    """The parameter-only subexpressions of all kernels, numbered in order of first use.
+
+    ``hoist`` rewrites an expression with every maximal parameter-only part replaced by
+    a constant symbol ``pc<i>``; the same value (after expanding nested constants) gets
+    the same symbol in every kernel.
+    """
+
+    def __init__(self, param_syms):
+        self.params = frozenset(param_syms)
+        self.symbols, self.values = [], []   # pc<i> and its expression of parameters
+        self._by_value, self._value = {}, {}
+
+    def __len__(self):
+        return len(self.symbols)
+
+    def parameter_only(self, expr) -> bool:
+        symbols = expr.free_symbols
+        return bool(symbols) and all(s in self.params or s in self._value for s in symbols)
+
+    def constant(self, expr):
+        """The constant symbol of a parameter-only ``expr`` (a new one if needed)."""
+        if expr.is_Symbol:
+            return expr
+        value = expr.xreplace(self._value)
+        symbol = self._by_value.get(value)
+        if symbol is None:
+            symbol = sm.Symbol(f"pc{len(self.symbols)}")
+            self.symbols.append(symbol)
+            self.values.append(value)
+            self._by_value[value] = symbol
+            self._value[symbol] = value
+        return symbol
+
+    def hoist(self, expr):
+        if expr.is_Atom:
+            return expr
+        if self.parameter_only(expr):
+            return self.constant(expr)
+        if isinstance(expr, (sm.Add, sm.Mul)):
+            fixed = [a for a in expr.args if self.parameter_only(a) or a.is_Number]
+            nontrivial = [a for a in fixed if not a.is_Number]
+            if len(nontrivial) >= 2 or any(not a.is_Atom for a in nontrivial):
+                rest = [self.hoist(a) for a in expr.args if a not in fixed]
+                return expr.func(self.constant(expr.func(*fixed)), *rest)
+        return expr.func(*[self.hoist(a) for a in expr.args])
+
+    def hoist_all(self, definitions, outputs):
+        """(definitions, outputs) with parameter-only parts replaced by constants; a
+        definition that is parameter-only as a whole is dropped and its symbol replaced."""
+        alias, kept = {}, []
+        for symbol, expr in definitions:
+            expr = expr.xreplace(alias)
+            if self.parameter_only(expr):
+                alias[symbol] = self.constant(expr)
+            else:
+                kept.append((symbol, self.hoist(expr)))
+        return kept, [self.hoist(e.xreplace(alias)) for e in outputs]
+
+
 def plain_symbols(states):
     """Plain symbols named like the state dynamicsymbols (qw(t) -> qw)."""
     return [sm.Symbol(s.func.__name__) for s in states]
@@ -111,8 +182,11 @@ def _plain(expr, replacements):
     return sm.sympify(expr).xreplace(replacements)
 
 
-def kernel_c(kernel: Kernel, state_syms, param_syms, printer=None) -> tuple[str, int]:
-    """C source of one kernel and its operation count after CSE."""
+def kernel_c(kernel: Kernel, state_syms, param_syms, printer=None,
+             constants: ParameterConstants | None = None) -> tuple[str, int]:
+    """C source of one kernel and its operation count after CSE; with ``constants``, the
+    parameter-only subexpressions are read from the ``constants`` argument (and added to
+    ``constants``)."""
     printer = printer or BallcPrinter()
     plain_states = plain_symbols(state_syms)
     replacements = dict(zip(state_syms, plain_states))
@@ -133,6 +207,11 @@ def kernel_c(kernel: Kernel, state_syms, param_syms, printer=None) -> tuple[str,
 
     temps = sm.numbered_symbols("t", start=0)
     subexpressions, reduced = sm.cse(outputs, symbols=temps, order="canonical")
+    if constants is not None:
+        definitions, reduced = constants.hoist_all(definitions + subexpressions, reduced)
+        subexpressions = []
+        for i, s in enumerate(constants.symbols):
+            inputs[s] = ("constants", i)
     used = set().union(*(e.free_symbols for _, e in definitions + subexpressions),
                        *(e.free_symbols for e in reduced)) & set(inputs)
     ops = sum(sm.count_ops(e) for _, e in definitions + subexpressions)
@@ -144,14 +223,41 @@ def kernel_c(kernel: Kernel, state_syms, param_syms, printer=None) -> tuple[str,
     lines.append(f"   {len(outputs)} outputs, {ops} operations after CSE. */")
     lines.append(SIGNATURE.format(name=kernel.name))
     lines.append("{")
-    lines.append("    (void)state; (void)params; (void)extra;")
-    for sym in sorted(used, key=lambda s: (("state", "params", "extra").index(inputs[s][0]), inputs[s][1])):
+    lines.append("    (void)state; (void)params; (void)constants; (void)extra;")
+    arrays = ("state", "params", "constants", "extra")
+    for sym in sorted(used, key=lambda s: (arrays.index(inputs[s][0]), inputs[s][1])):
         array, i = inputs[sym]
         lines.append(f"    const double {sym} = {array}[{i}];")
     for sym, expr in definitions + subexpressions:
         lines.append(f"    const double {sym} = {printer.doprint(expr)};")
     for i, expr in enumerate(reduced):
         lines.append(f"    out[{i}] = {printer.doprint(expr)};")
+    lines.append("}")
+    return "\n".join(lines) + "\n", ops
+
+
+def constants_c(constants: ParameterConstants, param_syms, printer=None) -> tuple[str, int]:
+    """C source of ballc_parameter_constants (one joint CSE over all constants)."""
+    printer = printer or BallcPrinter()
+    index = {s: i for i, s in enumerate(param_syms)}
+    missing = set().union(set(), *(v.free_symbols for v in constants.values)) - set(index)
+    if missing:
+        raise ValueError(f"parameter constants: unknown symbols {sorted(map(str, missing))}")
+    subexpressions, reduced = sm.cse(constants.values, symbols=sm.numbered_symbols("t"),
+                                     order="canonical")
+    used = set().union(set(), *(e.free_symbols for _, e in subexpressions),
+                       *(e.free_symbols for e in reduced)) & set(index)
+    ops = sum(sm.count_ops(e) for _, e in subexpressions) + sum(map(sm.count_ops, reduced))
+    lines = ["/* The parameter constants (BALLC_PARAMETER_CONSTANT_NAMES): the parameter-only",
+             "   subexpressions of the kernels, computed once per parameter vector.",
+             f"   {len(reduced)} outputs, {ops} operations after CSE. */",
+             CONSTANTS_SIGNATURE, "{", "    (void)params;"]
+    for sym in sorted(used, key=index.get):
+        lines.append(f"    const double {sym} = params[{index[sym]}];")
+    for sym, expr in subexpressions:
+        lines.append(f"    const double {sym} = {printer.doprint(expr)};")
+    for i, expr in enumerate(reduced):
+        lines.append(f"    constants[{i}] = {printer.doprint(expr)};")
     lines.append("}")
     return "\n".join(lines) + "\n", ops
 

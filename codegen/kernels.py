@@ -6,7 +6,9 @@ pays only for what acts on it:
 * ``ball``      M and F of the ball alone (gravity, gyroscopic terms),
 * ``observer``  the observer particle's additive share of M and F (zero when m_o = 0),
 * ``<plane>_<law>`` generalized forces of one contact law on one plane
-  (only called while that plane is in contact and the law has weight).
+  (only called while that plane is in contact and the law has weight),
+* ``<plane>_friction_normal`` the friction law with mu = 0: its normal share, which is
+  all exact (event-driven) Coulomb friction takes from it.
 
 ``M`` is stored as 16 numbers: the symmetric 3x3 block ``J`` (J00 J01 J02 J11 J12 J22),
 the 3x3 coupling block ``B`` row-major, and the scalar ``D`` of the block ``D I3``:
@@ -150,6 +152,17 @@ def build_kernels():
             kernels.append(jacobian_kernel(model, f"{plane}_{law}_jac", f"{doc} d(outputs)/dx "
                                            f"({len(outputs)}x{n} row-major).", list(outputs),
                                            latch, extra_doc))
+        # Exact (event-driven) Coulomb friction applies the tangential force itself and
+        # takes only the friction law's normal share: the law with mu = 0, whose
+        # regularised Coulomb part (two square roots and a division) then drops out.
+        outputs = pieces[f"{plane}_friction"].xreplace({model.p["friction_coefficient"]: 0})
+        doc = f"{plane} contact, friction law with mu = 0 (its normal share, weighted):"
+        kernels.append(Kernel(f"{plane}_friction_normal",
+                              f"{doc} {describe_contact_law_layout()}.",
+                              list(outputs), list(latch), extra_doc))
+        kernels.append(jacobian_kernel(model, f"{plane}_friction_normal_jac", f"{doc} "
+                                       f"d(outputs)/dx ({len(outputs)}x{n} row-major).",
+                                       list(outputs), latch, extra_doc))
     for plane in PLANES:
         kernels.append(slip_kernel(model, plane, pieces[f"{plane}_force_map"]))
     kernels += output_kernels(model)

@@ -32,6 +32,25 @@ def test_layout_comes_from_generated_code():
     assert len(_core.PARAMETER_NAMES) == _core.N_PARAMETERS == P.size
 
 
+def test_parameter_constants_match_their_names():
+    """Each parameter constant the kernels read is the value of its name (a sympy
+    expression of the parameters), for a scene whose parameters are all distinct."""
+    import sympy as sm
+
+    scene = ballc.Scene(mass=1.3, observer_mass=0.2, radius=0.7, c_tau=0.6, mixture=0.3,
+                        friction_coefficient=0.4, observer_position=(0.3, -0.2, 0.5))
+    params = scene.parameter_vector()
+    values = _core.parameter_constants(params)
+    assert len(values) == len(_core.PARAMETER_CONSTANT_NAMES) > 0
+    symbols = {name: sm.Symbol(name) for name in _core.PARAMETER_NAMES}
+    for name, value in zip(_core.PARAMETER_CONSTANT_NAMES, values):
+        expected = sm.lambdify(list(symbols.values()), sm.sympify(name, locals=symbols),
+                               "math")(*params)
+        assert value == pytest.approx(expected, rel=1e-13, abs=1e-15), name
+    with pytest.raises(ValueError, match="length"):
+        _core.parameter_constants(np.zeros(3))
+
+
 @pytest.mark.parametrize("bad", [np.zeros(12), np.zeros(14), np.zeros(0)])
 def test_wrong_state_length_raises(bad):
     with pytest.raises(ValueError, match="length"):

@@ -14,19 +14,28 @@ from libc.math cimport NAN
 
 cdef extern from "ballc_kernels.h":
     int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH, BALLC_N_LATCH_PER_PLANE
+    int BALLC_N_PARAMETER_CONSTANTS
+    const char *const BALLC_PARAMETER_CONSTANT_NAMES[]
+    void ballc_parameter_constants(const double *, double *) nogil
     const char *const BALLC_STATE_NAMES[]
     const char *const BALLC_PARAMETER_NAMES[]
     const char *const BALLC_PARAMETER_UNITS[]
     const char *const BALLC_LATCH_NAMES[]
     const char *BALLC_GENERATOR_VERSION
     int BALLC_ENERGY_NOUT, BALLC_CONTACT_KINEMATICS_NOUT, BALLC_OBSERVER_POSITION_NOUT
-    void ballc_energy(const double *, const double *, const double *, double *) nogil
-    void ballc_contact_kinematics(const double *, const double *, const double *, double *) nogil
-    void ballc_observer_position(const double *, const double *, const double *, double *) nogil
-    void ballc_hertz_stiffness(const double *, const double *, const double *, double *) nogil
+    void ballc_energy(const double *, const double *, const double *, const double *,
+        double *) nogil
+    void ballc_contact_kinematics(const double *, const double *, const double *, const double *,
+        double *) nogil
+    void ballc_observer_position(const double *, const double *, const double *, const double *,
+        double *) nogil
+    void ballc_hertz_stiffness(const double *, const double *, const double *, const double *,
+        double *) nogil
     int BALLC_FLOOR_SLIP_NOUT
-    void ballc_floor_slip(const double *, const double *, const double *, double *) nogil
-    void ballc_ceiling_slip(const double *, const double *, const double *, double *) nogil
+    void ballc_floor_slip(const double *, const double *, const double *, const double *,
+        double *) nogil
+    void ballc_ceiling_slip(const double *, const double *, const double *, const double *,
+        double *) nogil
 
 cdef extern from "_system.h":
     int BALLC_WITH_OBSERVER, BALLC_FLOOR_FRICTION, BALLC_FLOOR_DIGIN
@@ -35,10 +44,14 @@ cdef extern from "_system.h":
     int BALLC_OK
     int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
     int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
-    int ballc_rhs_checked_inputs(const double *, const double *, const double *, int,
-                                 double *) nogil
-    int ballc_jacobian_checked_inputs(const double *, const double *, const double *, int,
-                                      double *) nogil
+    ctypedef struct ballc_parameters_t:
+        const double *values
+        double *constants      # an array in C (BALLC_N_PARAMETER_CONSTANTS)
+    void ballc_parameters_init(ballc_parameters_t *, const double *) nogil
+    int ballc_rhs_checked_inputs(const double *, const ballc_parameters_t *, const double *,
+                                 int, double *) nogil
+    int ballc_jacobian_checked_inputs(const double *, const ballc_parameters_t *,
+                                      const double *, int, double *) nogil
     int ballc_contact_forces(const double *, const double *, const double *, int, double *) nogil
     int ballc_stick_state(const double *, const double *, const double *, int, int,
                           double *) nogil
@@ -56,6 +69,10 @@ STATE_INDEX = {name: i for i, name in enumerate(STATE_NAMES)}
 PARAMETER_NAMES = tuple(BALLC_PARAMETER_NAMES[i].decode() for i in range(BALLC_N_PARAMETERS))
 PARAMETER_UNITS = tuple(BALLC_PARAMETER_UNITS[i].decode() for i in range(BALLC_N_PARAMETERS))
 LATCH_NAMES = tuple(BALLC_LATCH_NAMES[i].decode() for i in range(BALLC_N_LATCH))
+#: The parameter constants (parameter-only subexpressions of the kernels), each named by
+#: its sympy expression of PARAMETER_NAMES; see codegen/emit.py.
+PARAMETER_CONSTANT_NAMES = tuple(BALLC_PARAMETER_CONSTANT_NAMES[i].decode()
+                                 for i in range(BALLC_N_PARAMETER_CONSTANTS))
 GENERATOR_VERSION = BALLC_GENERATOR_VERSION.decode()
 FLAGS = {
     "observer": BALLC_WITH_OBSERVER,
@@ -181,7 +198,8 @@ def jacobian(const double[::1] y, const double[::1] params, const double[::1] la
     return out
 
 
-ctypedef void (*kernel_fn)(const double *, const double *, const double *, double *) nogil
+ctypedef void (*kernel_fn)(const double *, const double *, const double *, const double *,
+                           double *) nogil
 
 
 cdef object _per_row(kernel_fn kernel, int nout, const double[:, ::1] states,
@@ -191,8 +209,10 @@ cdef object _per_row(kernel_fn kernel, int nout, const double[:, ::1] states,
     out = np.empty((states.shape[0], nout))
     cdef double[:, ::1] o = out
     cdef Py_ssize_t i
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
     for i in range(states.shape[0]):
-        kernel(&states[i, 0], &params[0], NULL, &o[i, 0])
+        kernel(&states[i, 0], &params[0], prepared.constants, NULL, &o[i, 0])
     return out
 
 
@@ -242,12 +262,14 @@ def slip_map(const double[::1] params, int plane):
     out = np.empty(BALLC_FLOOR_SLIP_NOUT)
     cdef double[::1] o = out
     cdef Py_ssize_t i
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
     for i in range(BALLC_N_STATES):
         ys[i] = 0.0
     if plane == 0:
-        ballc_floor_slip(ys, &params[0], NULL, &o[0])
+        ballc_floor_slip(ys, &params[0], prepared.constants, NULL, &o[0])
     else:
-        ballc_ceiling_slip(ys, &params[0], NULL, &o[0])
+        ballc_ceiling_slip(ys, &params[0], prepared.constants, NULL, &o[0])
     return out[2:2 + 2 * BALLC_N_STATES].reshape(2, BALLC_N_STATES)
 
 
@@ -307,10 +329,23 @@ def contact_forces_per_sample(const double[:, ::1] states, const double[::1] par
 include "_radau5_bridge.pxi"
 
 
+def parameter_constants(const double[::1] params):
+    """The parameter constants (PARAMETER_CONSTANT_NAMES) of a parameter vector, as the
+    kernels read them (computed in C, once per segment, by the integrator's adapter)."""
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    out = np.empty(BALLC_N_PARAMETER_CONSTANTS)
+    cdef double[::1] o = out
+    if BALLC_N_PARAMETER_CONSTANTS:
+        ballc_parameter_constants(&params[0], &o[0])
+    return out
+
+
 def hertz_stiffness(const double[::1] params):
     """k0 (N/m^(3/2)) of the generated contact law, from the parameter vector."""
     _check("params", params.shape[0], BALLC_N_PARAMETERS)
     cdef double state[BALLC_MAX_STATES]
     cdef double k0
-    ballc_hertz_stiffness(state, &params[0], NULL, &k0)
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
+    ballc_hertz_stiffness(state, &params[0], prepared.constants, NULL, &k0)
     return k0

@@ -82,6 +82,7 @@ EPS = np.finfo(float).eps
 
 ctypedef struct ball_ctx:
     const double *params
+    ballc_parameters_t prepared   # params and their constants, prepared once per segment
     const double *latch
     int flags
     const int *event_plane   # per event: 0/1 stick release of that plane, -1 linear,
@@ -91,11 +92,11 @@ ctypedef struct ball_ctx:
 
 cdef int _ball_fun(void *ctx, double t, const double *y, double *f) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
-    return ballc_rhs_checked_inputs(y, c.params, c.latch, c.flags, f)
+    return ballc_rhs_checked_inputs(y, &c.prepared, c.latch, c.flags, f)
 
 cdef int _ball_jac(void *ctx, double t, const double *y, double *jac) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
-    return ballc_jacobian_checked_inputs(y, c.params, c.latch, c.flags, jac)
+    return ballc_jacobian_checked_inputs(y, &c.prepared, c.latch, c.flags, jac)
 
 cdef int _ball_event(void *ctx, int e, double t, const double *y, double *g) noexcept nogil:
     """The stick-to-slip margin mu N - |lambda| of the event's plane, or a user event."""
@@ -471,6 +472,7 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     planes_array.fill(-1)
     cdef int[::1] planes = planes_array
     ctx.params = &pv[0]
+    ballc_parameters_init(&ctx.prepared, &pv[0])
     ctx.latch = &lv[0]
     ctx.flags = flags
     ctx.event_plane = &planes[0]

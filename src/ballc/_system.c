@@ -9,16 +9,30 @@
 #define NU 6  /* speeds: angular velocity (3) and centre velocity (3) */
 
 typedef void (*kernel_fn)(const double *restrict, const double *restrict,
-                          const double *restrict, double *restrict);
+                          const double *restrict, const double *restrict, double *restrict);
 
-/* Contact laws: which flag switches them on, their kernels, their plane. */
-static const struct { int flag; kernel_fn value, jac; int plane; } CONTACT_LAWS[] = {
-    {BALLC_FLOOR_FRICTION, ballc_floor_friction, ballc_floor_friction_jac, 0},
-    {BALLC_FLOOR_DIGIN, ballc_floor_digin, ballc_floor_digin_jac, 0},
-    {BALLC_FLOOR_COMPLIANT, ballc_floor_compliant, ballc_floor_compliant_jac, 0},
-    {BALLC_CEILING_FRICTION, ballc_ceiling_friction, ballc_ceiling_friction_jac, 1},
-    {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac, 1},
-    {BALLC_CEILING_COMPLIANT, ballc_ceiling_compliant, ballc_ceiling_compliant_jac, 1},
+/* A kernel's parameter arguments: the parameters and their constants. */
+#define PARAMS(p) (p)->values, (p)->constants
+
+void ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
+{
+    prepared->values = params;
+    ballc_parameter_constants(params, prepared->constants);
+}
+
+/* Contact laws: which flag switches them on, their kernels, their plane, and (friction
+ * only) the kernels of the law's normal share (mu = 0), used under exact Coulomb friction. */
+static const struct { int flag; kernel_fn value, jac; int plane; kernel_fn normal, normal_jac; }
+CONTACT_LAWS[] = {
+    {BALLC_FLOOR_FRICTION, ballc_floor_friction, ballc_floor_friction_jac, 0,
+     ballc_floor_friction_normal, ballc_floor_friction_normal_jac},
+    {BALLC_FLOOR_DIGIN, ballc_floor_digin, ballc_floor_digin_jac, 0, NULL, NULL},
+    {BALLC_FLOOR_COMPLIANT, ballc_floor_compliant, ballc_floor_compliant_jac, 0, NULL, NULL},
+    {BALLC_CEILING_FRICTION, ballc_ceiling_friction, ballc_ceiling_friction_jac, 1,
+     ballc_ceiling_friction_normal, ballc_ceiling_friction_normal_jac},
+    {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac, 1, NULL, NULL},
+    {BALLC_CEILING_COMPLIANT, ballc_ceiling_compliant, ballc_ceiling_compliant_jac, 1,
+     NULL, NULL},
 };
 #define N_CONTACT_LAWS (sizeof CONTACT_LAWS / sizeof CONTACT_LAWS[0])
 #define LAW_NOUT BALLC_CONTACT_LAW_NOUT
@@ -99,22 +113,19 @@ typedef struct {
 
 /* Mass blocks and forcing of everything that acts under ``flags``; the rates of the
  * auxiliary states go to ``xdot`` (indexed by state, may be NULL).  A plane in exact
- * Coulomb mode gets its friction kernel's normal share (mu = 0) and, when sliding,
+ * Coulomb mode gets its friction law's normal share (the mu = 0 kernel) and, when sliding,
  * the Coulomb force -mu N e; a sticking plane's constraint force is added later
  * (it needs M). */
-static void assemble(const double *state, const double *params, const double *latch,
+static void assemble(const double *state, const ballc_parameters_t *params, const double *latch,
                      int flags, evaluation_t *ev, double *force, double *xdot)
 {
     double buf[BALLC_BALL_NOUT];
     double out[LAW_NOUT];
-    double normal_params[BALLC_N_PARAMETERS];
-    memcpy(normal_params, params, sizeof normal_params);
-    normal_params[BALLC_PARAMETER_FRICTION_COEFFICIENT] = 0.0;
-    ballc_ball(state, params, NULL, buf);
+    ballc_ball(state, PARAMS(params), NULL, buf);
     memcpy(ev->mass, buf, BALLC_MASS_SIZE * sizeof(double));
     memcpy(force, buf + BALLC_MASS_SIZE, NU * sizeof(double));
     if (flags & BALLC_WITH_OBSERVER) {
-        ballc_observer(state, params, NULL, buf);
+        ballc_observer(state, PARAMS(params), NULL, buf);
         for (int i = 0; i < BALLC_MASS_SIZE; i++) ev->mass[i] += buf[i];
         for (int i = 0; i < NU; i++) force[i] += buf[BALLC_MASS_SIZE + i];
     }
@@ -128,10 +139,9 @@ static void assemble(const double *state, const double *params, const double *la
     for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
         if (!(flags & CONTACT_LAWS[k].flag)) continue;
         int plane = CONTACT_LAWS[k].plane, target[4];
-        int exact = ev->mode[plane] != MODE_NONE && (CONTACT_LAWS[k].flag &
-                    (BALLC_FLOOR_FRICTION | BALLC_CEILING_FRICTION));
-        CONTACT_LAWS[k].value(state, exact ? normal_params : params,
-                              law_latch(latch, plane), out);
+        int exact = ev->mode[plane] != MODE_NONE && CONTACT_LAWS[k].normal;
+        (exact ? CONTACT_LAWS[k].normal : CONTACT_LAWS[k].value)(state, PARAMS(params),
+                                                                 law_latch(latch, plane), out);
         for (int i = 0; i < NU; i++) force[i] += out[BALLC_LAW_GENERALIZED_FORCE + i];
         for (int i = 0; i < 3; i++) ev->contact_force[3 * plane + i] += out[BALLC_LAW_FORCE + i];
         if (exact) ev->load[plane] = (plane == 0 ? 1.0 : -1.0) * out[BALLC_LAW_FORCE + 2];
@@ -139,11 +149,11 @@ static void assemble(const double *state, const double *params, const double *la
         auxiliary_targets(plane, target);
         for (int i = 0; i < 4; i++) xdot[target[i]] += out[BALLC_LAW_DISSIPATION + i];
     }
-    const double mu = params[BALLC_PARAMETER_FRICTION_COEFFICIENT];
+    const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
     for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
         if (ev->mode[plane] == MODE_NONE) continue;
         double *slip = ev->slip[plane];
-        SLIP_KERNELS[plane](state, params, NULL, slip);
+        SLIP_KERNELS[plane](state, PARAMS(params), NULL, slip);
         if (!is_sliding(ev->mode[plane])) continue;
         const double *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
         double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = hypot(ux, uy);
@@ -244,7 +254,7 @@ static int stick_response(const schur_t *factor, const double *slip, double z[2]
  * du/dt = 0: lambda = -W^-1 (du/d speeds) udot_0, udot = udot_0 + z lambda.  (The
  * planes are handled one after the other: both can only touch the ball at once when
  * H < 2 r, which Scene rejects.) */
-static int accelerations(const double *state, const double *params, const double *latch,
+static int accelerations(const double *state, const ballc_parameters_t *params, const double *latch,
                          int flags, schur_t *factor, evaluation_t *ev, double *udot,
                          double *xdot)
 {
@@ -287,11 +297,13 @@ int ballc_rhs(const double *state, const double *params, const double *latch,
         for (int i = 0; i < NS; i++) xdot[i] = NAN;
         return BALLC_NOT_FINITE;
     }
-    return ballc_rhs_checked_inputs(state, params, latch, flags, xdot);
+    ballc_parameters_t prepared;
+    ballc_parameters_init(&prepared, params);
+    return ballc_rhs_checked_inputs(state, &prepared, latch, flags, xdot);
 }
 
-int ballc_rhs_checked_inputs(const double *state, const double *params, const double *latch,
-                             int flags, double *xdot)
+int ballc_rhs_checked_inputs(const double *state, const ballc_parameters_t *params,
+                             const double *latch, int flags, double *xdot)
 {
     schur_t factor;
     evaluation_t ev;
@@ -299,7 +311,7 @@ int ballc_rhs_checked_inputs(const double *state, const double *params, const do
         for (int i = 0; i < NS; i++) xdot[i] = NAN;
         return BALLC_NOT_FINITE;
     }
-    ballc_kinematics(state, params, NULL, xdot);
+    ballc_kinematics(state, PARAMS(params), NULL, xdot);
     int status = accelerations(state, params, latch, flags, &factor, &ev, xdot + NQ, xdot);
     if (status == BALLC_OK && !all_finite(xdot, NS)) status = BALLC_NOT_FINITE;
     return status;
@@ -311,9 +323,11 @@ int ballc_contact_forces(const double *state, const double *params, const double
     schur_t factor;
     evaluation_t ev;
     double udot[NU];
+    ballc_parameters_t prepared;
     for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
     if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
-    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+    ballc_parameters_init(&prepared, params);
+    int status = accelerations(state, &prepared, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
     memcpy(forces, ev.contact_force, sizeof ev.contact_force);
     return all_finite(forces, 3 * BALLC_N_PLANES) ? BALLC_OK : BALLC_NOT_FINITE;
@@ -329,7 +343,9 @@ int ballc_stick_state(const double *state, const double *params, const double *l
     if (plane < 0 || plane >= BALLC_N_PLANES || exact_mode(flags, plane) != MODE_STICK)
         return BALLC_SINGULAR;
     if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
-    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+    ballc_parameters_t prepared;
+    ballc_parameters_init(&prepared, params);
+    int status = accelerations(state, &prepared, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
     out[0] = ev.lambda[plane][0];
     out[1] = ev.lambda[plane][1];
@@ -349,15 +365,17 @@ int ballc_remove_slip(const double *state, const double *params, int flags, int 
     if (plane < 0 || plane >= BALLC_N_PLANES) return BALLC_SINGULAR;
     if (!all_finite(state, NS) || !all_finite(params, BALLC_N_PARAMETERS))
         return BALLC_NOT_FINITE;
-    ballc_ball(state, params, NULL, buf);
+    ballc_parameters_t prepared;
+    ballc_parameters_init(&prepared, params);
+    ballc_ball(state, PARAMS(&prepared), NULL, buf);
     memcpy(mass, buf, sizeof mass);
     if (flags & BALLC_WITH_OBSERVER) {
-        ballc_observer(state, params, NULL, buf);
+        ballc_observer(state, PARAMS(&prepared), NULL, buf);
         for (int i = 0; i < BALLC_MASS_SIZE; i++) mass[i] += buf[i];
     }
     int status = schur_factor(mass, &factor);
     if (status != BALLC_OK) return status;
-    SLIP_KERNELS[plane](state, params, NULL, slip);
+    SLIP_KERNELS[plane](state, PARAMS(&prepared), NULL, slip);
     status = stick_response(&factor, slip, z, Winv);
     if (status != BALLC_OK) return status;
     const double *u = slip + SLIP_U;
@@ -369,11 +387,12 @@ int ballc_remove_slip(const double *state, const double *params, int flags, int 
 }
 
 /* Add dF/dx (6 x 13) and d(M a)/dq (6 x 4) of one dynamics kernel family. */
-static void add_dynamics_jac(kernel_fn kernel, const double *state, const double *params, const double *udot,
+static void add_dynamics_jac(kernel_fn kernel, const double *state,
+                             const ballc_parameters_t *params, const double *udot,
                              double *dF, double *dMa)
 {
     double buf[BALLC_BALL_JAC_NOUT];   /* ball and observer kernels have equal sizes */
-    kernel(state, params, udot, buf);
+    kernel(state, PARAMS(params), udot, buf);
     for (int i = 0; i < NU * NS; i++) dF[i] += buf[i];
     for (int i = 0; i < NU * 4; i++) dMa[i] += buf[NU * NS + i];
 }
@@ -381,7 +400,7 @@ static void add_dynamics_jac(kernel_fn kernel, const double *state, const double
 /* Forward-difference Jacobian of the whole right-hand side, for sticking planes
  * (lambda depends on the state through M, the forcing and the Delassus matrix).
  * Jacobians are rare (the integrator reuses them), so this costs little. */
-static int difference_jacobian(const double *state, const double *params, const double *latch,
+static int difference_jacobian(const double *state, const ballc_parameters_t *params, const double *latch,
                                int flags, double *jac)
 {
     double f0[NS], f1[NS], y[NS];
@@ -434,10 +453,12 @@ int ballc_jacobian(const double *state, const double *params, const double *latc
 {
     if (!all_finite(params, BALLC_N_PARAMETERS) || !all_finite(latch, BALLC_N_LATCH))
         return BALLC_NOT_FINITE;
-    return ballc_jacobian_checked_inputs(state, params, latch, flags, jac);
+    ballc_parameters_t prepared;
+    ballc_parameters_init(&prepared, params);
+    return ballc_jacobian_checked_inputs(state, &prepared, latch, flags, jac);
 }
 
-int ballc_jacobian_checked_inputs(const double *state, const double *params,
+int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t *params,
                                   const double *latch, int flags, double *jac)
 {
     schur_t factor;
@@ -449,12 +470,9 @@ int ballc_jacobian_checked_inputs(const double *state, const double *params,
     if (status != BALLC_OK) return status;
 
     for (int i = 0; i < NS * NS; i++) jac[i] = 0.0;
-    ballc_kinematics_jac(state, params, NULL, jac);   /* rows 0..6 */
+    ballc_kinematics_jac(state, PARAMS(params), NULL, jac);   /* rows 0..6 */
 
-    double normal_params[BALLC_N_PARAMETERS];
-    memcpy(normal_params, params, sizeof normal_params);
-    normal_params[BALLC_PARAMETER_FRICTION_COEFFICIENT] = 0.0;
-    const double mu = params[BALLC_PARAMETER_FRICTION_COEFFICIENT];
+    const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
     double dF[NU * NS] = {0}, dMa[NU * 4] = {0}, buf[LAW_NOUT * NS];
     add_dynamics_jac(ballc_ball_jac, state, params, udot, dF, dMa);
     if (flags & BALLC_WITH_OBSERVER)
@@ -462,9 +480,9 @@ int ballc_jacobian_checked_inputs(const double *state, const double *params,
     for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
         if (!(flags & CONTACT_LAWS[k].flag)) continue;
         int plane = CONTACT_LAWS[k].plane, target[4];
-        int exact = is_sliding(ev.mode[plane]) && (CONTACT_LAWS[k].flag &
-                    (BALLC_FLOOR_FRICTION | BALLC_CEILING_FRICTION));
-        CONTACT_LAWS[k].jac(state, exact ? normal_params : params, law_latch(latch, plane), buf);
+        int exact = is_sliding(ev.mode[plane]) && CONTACT_LAWS[k].normal_jac;
+        (exact ? CONTACT_LAWS[k].normal_jac : CONTACT_LAWS[k].jac)(state, PARAMS(params),
+                                                                   law_latch(latch, plane), buf);
         for (int i = 0; i < NU * NS; i++) dF[i] += buf[BALLC_LAW_GENERALIZED_FORCE * NS + i];
         auxiliary_targets(plane, target);
         for (int i = 0; i < 4; i++)

@@ -55,11 +55,24 @@ int ballc_rhs(const double *state, const double *params, const double *latch,
 int ballc_jacobian(const double *state, const double *params, const double *latch,
                    int flags, double *jac);
 
-/* The same, for callers that have checked once that params and latch are finite
- * (the integrator's adapters, per segment): only the state is checked, per call. */
-int ballc_rhs_checked_inputs(const double *state, const double *params, const double *latch,
-                             int flags, double *xdot);
-int ballc_jacobian_checked_inputs(const double *state, const double *params,
+/* A parameter vector and its parameter constants (the parameter-only subexpressions of
+ * the kernels, see codegen/emit.py), computed from it by ballc_parameters_init: once per
+ * segment by the integrator's adapter, once per call by the entry points that take a
+ * plain parameter vector.  The constants are never taken from a caller, so they cannot
+ * belong to other parameters. */
+typedef struct {
+    const double *values;                               /* BALLC_N_PARAMETERS, borrowed */
+    double constants[BALLC_N_PARAMETER_CONSTANTS];
+} ballc_parameters_t;
+
+void ballc_parameters_init(ballc_parameters_t *prepared, const double *params);
+
+/* ballc_rhs and ballc_jacobian for callers that have checked once that params and latch
+ * are finite and prepared the parameters (the integrator's adapters, per segment): only
+ * the state is checked, per call. */
+int ballc_rhs_checked_inputs(const double *state, const ballc_parameters_t *params,
+                             const double *latch, int flags, double *xdot);
+int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t *params,
                                   const double *latch, int flags, double *jac);
 
 /* Stick state of ``plane`` (0 floor, 1 ceiling) under ``flags`` (which must hold that
