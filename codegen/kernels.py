@@ -17,12 +17,15 @@ derivatives needed by the analytic Jacobian.
 """
 from __future__ import annotations
 
+import random
+
 import sympy as sm
 import sympy.physics.mechanics as me
 
 from . import contact
 from .emit import Kernel, forward_jacobian, plain_symbols
-from .model import PLANES, STATE_NAMES, Model, bodies, build_model, gravity_loads, kanes_equations
+from .model import (PLANES, STATE_NAMES, Model, bodies, build_model, gravity_loads,
+                    kanes_equations, quaternion_dcm)
 
 MASS_LAYOUT = ("J00", "J01", "J02", "J11", "J12", "J22",
                "B00", "B01", "B02", "B10", "B11", "B12", "B20", "B21", "B22", "D")
@@ -138,8 +141,9 @@ def build_kernels():
                         list(model.kinematics)),
     ]
     kernels += _dynamics_kernels(model, "ball", pieces["M_ball"], pieces["F_ball"], "Ball")
-    kernels += _dynamics_kernels(model, "observer", pieces["M_observer"],
-                                 pieces["F_observer"], "Observer particle")
+    value, jac = _dynamics_kernels(model, "observer", pieces["M_observer"],
+                                   pieces["F_observer"], "Observer particle")
+    kernels += [observer_value_kernel(model, pieces, value.doc), jac]
     n = len(x)
     for plane in PLANES:
         latch = contact.latch_symbols(model, plane)
@@ -167,6 +171,75 @@ def build_kernels():
         kernels.append(slip_kernel(model, plane, pieces[f"{plane}_force_map"]))
     kernels += output_kernels(model)
     return model, kernels
+
+
+def observer_by_offset(model: Model):
+    """The observer's share of M and F in terms of its offset from the centre.
+
+    The same particle, derived again by KanesMethod, but placed at C + p with p =
+    (p_x, p_y, p_z) in N given as symbols: fixed in the ball, its velocity is
+    v_C + w x p and its acceleration a_C + dw/dt x p + w x (w x p).  The quaternion
+    then enters only through p = r R(q) (alpha, beta, gamma), which the kernel
+    computes first, instead of through every entry of M and F.
+    Returns (offset symbols, their expressions in the state, M (6x6), F (6)).
+    """
+    N, A = model.frame, model.ball_frame
+    offset_symbols = sm.symbols("observer_offset_x observer_offset_y observer_offset_z")
+    offset = sum((s * v for s, v in zip(offset_symbols, (N.x, N.y, N.z))), me.Vector(0))
+    w = A.ang_vel_in(N)
+    point = me.Point("P_o_offset")
+    point.set_vel(N, model.centre.vel(N) + me.cross(w, offset))
+    point.set_acc(N, model.centre.acc(N) + me.cross(A.ang_acc_in(N), offset)
+                  + me.cross(w, me.cross(w, offset)))
+    particle = me.Particle("observer_at_offset", point, model.p["observer_mass"])
+    M, F = kanes_equations(model, [particle], gravity_loads(model, particle))
+    relative = model.observer.pos_from(model.centre)
+    expressions = [me.dot(relative, v) for v in (N.x, N.y, N.z)]
+    return offset_symbols, expressions, M, F
+
+
+def observer_value_kernel(model: Model, pieces: dict, doc: str) -> Kernel:
+    """The observer's value kernel in the offset form (observer_by_offset), checked
+    against the pieces of the whole system's KanesMethod at random points."""
+    offset_symbols, expressions, M, F = observer_by_offset(model)
+    outputs = pack_mass(M) + list(F)
+    # p = R(q) c with R of a quaternion of any norm: (unnormalised R) c / |q|^2, one
+    # division (c = r (alpha, beta, gamma) is parameter-only: hoisted by emit)
+    qw, qx, qy, qz = model.coordinates[:4]
+    inverse_norm2 = sm.Symbol("observer_inverse_norm2")
+    unnormalised = quaternion_dcm(qw, qx, qy, qz) * (qw**2 + qx**2 + qy**2 + qz**2)
+    p = model.p
+    c = sm.Matrix([p["radius"] * p[f"observer_{k}"] for k in ("alpha", "beta", "gamma")])
+    definitions = [(inverse_norm2, 1 / (qw**2 + qx**2 + qy**2 + qz**2))]
+    definitions += [(s, inverse_norm2 * sm.expand(e))
+                    for s, e in zip(offset_symbols, unnormalised * c)]
+    for (s, e), relative in zip(definitions[1:], expressions):   # the same offset
+        _check_same(model, [e.xreplace({inverse_norm2: definitions[0][1]})], [relative],
+                    "observer offset")
+    substitute = {s: e.xreplace({inverse_norm2: definitions[0][1]}) for s, e in definitions[1:]}
+    whole = pack_mass(pieces["M_observer"]) + list(pieces["F_observer"])
+    _check_same(model, [o.xreplace(substitute) for o in outputs], whole,
+                "observer kernel (offset form)")
+    states = plain_symbols(model.states)
+    replacements = dict(zip(model.states, states))
+    definitions = [(s, sm.sympify(e).xreplace(replacements)) for s, e in definitions]
+    return Kernel("observer", doc.replace("Observer particle:", "Observer particle (from its "
+                  "offset p = r R(q) (alpha, beta, gamma), computed first):"),
+                  [sm.sympify(o).xreplace(replacements) for o in outputs], [],
+                  definitions=definitions)
+
+
+def _check_same(model: Model, ours, theirs, what, samples=5, seed=20261123):
+    """Raise unless two lists of expressions agree at random states and parameters."""
+    rng = random.Random(seed)
+    for _ in range(samples):
+        values = {s: sm.Float(rng.uniform(0.2, 1.5), 30) for s in model.parameters}
+        values.update({s: sm.Float(rng.uniform(-1.5, 1.5), 30) for s in model.states})
+        for a, b in zip(ours, theirs):
+            va = sm.sympify(a).xreplace(values).evalf(30)
+            vb = sm.sympify(b).xreplace(values).evalf(30)
+            if abs(va - vb) > 1e-20 * (1 + abs(vb)):
+                raise ValueError(f"{what}: {va} != {vb} at a random point")
 
 
 def slip_kernel(model: Model, plane: str, force_map: sm.Matrix):
