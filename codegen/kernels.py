@@ -141,9 +141,9 @@ def build_kernels():
                         list(model.kinematics)),
     ]
     kernels += _dynamics_kernels(model, "ball", pieces["M_ball"], pieces["F_ball"], "Ball")
-    value, jac = _dynamics_kernels(model, "observer", pieces["M_observer"],
-                                   pieces["F_observer"], "Observer particle")
-    kernels += [observer_value_kernel(model, pieces, value.doc), jac]
+    value, M_offset, F_offset = observer_value_kernel(model, pieces)
+    jac = _dynamics_kernels(model, "observer", M_offset, F_offset, "Observer particle")[1]
+    kernels += [value, jac]
     n = len(x)
     for plane in PLANES:
         latch = contact.latch_symbols(model, plane)
@@ -198,9 +198,11 @@ def observer_by_offset(model: Model):
     return offset_symbols, expressions, M, F
 
 
-def observer_value_kernel(model: Model, pieces: dict, doc: str) -> Kernel:
+def observer_value_kernel(model: Model, pieces: dict):
     """The observer's value kernel in the offset form (observer_by_offset), checked
-    against the pieces of the whole system's KanesMethod at random points."""
+    against the pieces of the whole system's KanesMethod at random points; also M and F
+    of that form with p written out in the state (for the Jacobian kernel, whose
+    forward-mode differentiation then goes through p)."""
     offset_symbols, expressions, M, F = observer_by_offset(model)
     outputs = pack_mass(M) + list(F)
     # p = R(q) c with R of a quaternion of any norm: (unnormalised R) c / |q|^2, one
@@ -223,10 +225,11 @@ def observer_value_kernel(model: Model, pieces: dict, doc: str) -> Kernel:
     states = plain_symbols(model.states)
     replacements = dict(zip(model.states, states))
     definitions = [(s, sm.sympify(e).xreplace(replacements)) for s, e in definitions]
-    return Kernel("observer", doc.replace("Observer particle:", "Observer particle (from its "
-                  "offset p = r R(q) (alpha, beta, gamma), computed first):"),
-                  [sm.sympify(o).xreplace(replacements) for o in outputs], [],
-                  definitions=definitions)
+    kernel = Kernel("observer", "Observer particle (from its offset p = r R(q) (alpha, "
+                    "beta, gamma), computed first): mass blocks (16, MASS_LAYOUT) then "
+                    "forcing (6).", [sm.sympify(o).xreplace(replacements) for o in outputs],
+                    [], definitions=definitions)
+    return kernel, M.xreplace(substitute), F.xreplace(substitute)
 
 
 def _check_same(model: Model, ours, theirs, what, samples=5, seed=20261123):
