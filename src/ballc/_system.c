@@ -55,7 +55,7 @@ static const double *law_latch(const double *latch, int plane)
 typedef struct {
     double L[6];   /* Cholesky factor of S, packed lower: L00 L10 L11 L20 L21 L22 */
     double B[9];
-    double D;
+    double D, inverse_D;
 } schur_t;
 
 /* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one. */
@@ -156,7 +156,7 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
         SLIP_KERNELS[plane](state, PARAMS(params), NULL, slip);
         if (!is_sliding(ev->mode[plane])) continue;
         const double *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
-        double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = hypot(ux, uy);
+        double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = sqrt(ux * ux + uy * uy);
         double *e = ev->e[plane];
         if (speed > 0 && ev->mode[plane] == MODE_SLIP) {
             double sign = ux * d[0] + uy * d[1] < 0 ? -1.0 : 1.0;
@@ -182,13 +182,14 @@ static int schur_factor(const double *mass, schur_t *f)
     memcpy(f->B, mass + 6, 9 * sizeof(double));
     f->D = mass[15];
     if (!(f->D > 0)) return BALLC_NOT_POSITIVE_DEFINITE;
+    f->inverse_D = 1.0 / f->D;
     const double *B = f->B;
     double S[3][3];
     const int jrow[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
             S[i][j] = J[jrow[i][j]] - (B[3*i]*B[3*j] + B[3*i+1]*B[3*j+1]
-                                       + B[3*i+2]*B[3*j+2]) / f->D;
+                                       + B[3*i+2]*B[3*j+2]) * f->inverse_D;
     double l00 = S[0][0];
     if (!(l00 > 0)) return BALLC_NOT_POSITIVE_DEFINITE;
     l00 = sqrt(l00);
@@ -212,7 +213,7 @@ static void schur_solve(const schur_t *f, double *b)
     double *bw = b, *bv = b + 3;
     double r[3];
     for (int i = 0; i < 3; i++)
-        r[i] = bw[i] - (B[3*i]*bv[0] + B[3*i+1]*bv[1] + B[3*i+2]*bv[2]) / f->D;
+        r[i] = bw[i] - (B[3*i]*bv[0] + B[3*i+1]*bv[1] + B[3*i+2]*bv[2]) * f->inverse_D;
     /* forward: L y = r */
     double y0 = r[0] / L[0];
     double y1 = (r[1] - L[1]*y0) / L[2];
@@ -223,7 +224,7 @@ static void schur_solve(const schur_t *f, double *b)
     double w0 = (y0 - L[1]*w1 - L[3]*w2) / L[0];
     bw[0] = w0; bw[1] = w1; bw[2] = w2;
     for (int j = 0; j < 3; j++)
-        bv[j] = (bv[j] - (B[j]*w0 + B[3+j]*w1 + B[6+j]*w2)) / f->D;
+        bv[j] = (bv[j] - (B[j]*w0 + B[3+j]*w1 + B[6+j]*w2)) * f->inverse_D;
 }
 
 /* Responses of a sticking plane: z_k = M^-1 G_t e_k (6 x 2, column k at z[k]) and the
