@@ -50,13 +50,8 @@ import numpy as np
 import ballc
 from ballc import _core, _radau5
 
-T_END = 5.0
-SCENES = {
-    "seed": ballc.Scene(),
-    "conservative oblique": ballc.Scene(c_tau=1.0, friction_coefficient=0.0, mixture=0.0,
-                                        velocity=(3.0, 1.0, -20.0)),
-    "friction only": ballc.Scene(tangential_model="friction"),
-}
+from .work_precision import SCENES, T_END   # the work-precision scenes, not a copy
+
 TOLERANCES = tuple(10.0 ** (-3 - k / 2) for k in range(19))
 TARGETS = tuple(10.0 ** -k for k in range(3, 13))   # scipy's tolerances giving the errors
 ELEMENTS = ("nit7", "limits", "pred", "hold", "jac", "scale", "tol")
