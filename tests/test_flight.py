@@ -209,10 +209,19 @@ def test_whole_run_agrees_with_the_integrated_flight(changes, rtol):
     for a, b in zip(on.contacts, off.contacts):
         assert a.plane == b.plane
         assert a.t_start == pytest.approx(b.t_start, abs=1e-6)
-        np.testing.assert_allclose(a.velocity_after, b.velocity_after, rtol=0, atol=1e-5)
-    # the mixture scene's own error at rtol 1e-10 is ~3e-5 in state (against rtol 1e-12,
-    # exact flight on or off alike: contact and stick-slip dominate), hence 1e-4 here
+    # These runs' own error is dominated by the contacts, not the flight: the mixture
+    # scene's stick-slip and the compliant law's kink where the tangential spring meets
+    # its Coulomb cap while unloading give 1e-6 .. 3e-5 in state at rtol 1e-10, exact
+    # flight on or off alike, and which of the two is closer to the truth moves with
+    # rounding (a different start state by 1e-10 takes different steps through the kink).
+    # So both runs must be accurate against a tight reference, at a bound 10x above that
+    # (a defect of the closed form -- a sign, the spin, the root -- gives O(1) errors).
+    reference = ballc.simulate(scene, 3.0, rtol=1e-12, atol=1e-12, progress=False,
+                               exact_flight=False, dense_output=True)
     times = np.linspace(0, 3.0, 50)
-    np.testing.assert_allclose(on.sol(times)[:13], off.sol(times)[:13], rtol=0, atol=1e-4)
+    for quantity in (lambda r: np.array([c.velocity_after for c in r.contacts]),
+                     lambda r: r.sol(times)[:13]):
+        for run in (on, off):
+            assert np.max(np.abs(quantity(run) - quantity(reference))) <= 3e-4
     balance = on.energy["balance"]
     assert abs(balance[-1] - balance[0]) <= 1e-6 * abs(balance[0])
