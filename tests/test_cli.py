@@ -161,6 +161,7 @@ def test_run_on_invalid_toml_is_one_line(tmp_path):
     ("[simulate]\nrtol = 0.0\n", ["[simulate]", "rtol = 0.0"]),
     ("[simulate]\natol = -1e-9\n", ["[simulate]", "atol = -1e-09"]),
     ('[simulate]\nmethod = "Euler"\n', ["[simulate]", "method = 'Euler'", "radau5"]),
+    ('[simulate]\nexact_flight = "yes"\n', ["[simulate]", "exact_flight = 'yes'"]),
 ])
 def test_invalid_simulate_table_is_named(table, names, scene_file, tmp_path):
     scene_file(table)
@@ -191,6 +192,21 @@ def test_invalid_run_options_fail_before_any_work(args, names, scene_file, tmp_p
     done = run_ballc("run", "scene.toml", *args, "--out", "out", cwd=tmp_path)
     assert_one_line_error(done, *names)
     assert not (tmp_path / "out").exists()
+
+
+def test_run_can_integrate_the_flight_it_would_solve_in_closed_form(tmp_path):
+    """--no-exact-flight (or [simulate] exact_flight = false) integrates every flight
+    segment: more right-hand-side calls for the same observer-free scene."""
+    ballc.Scene(observer_mass=0.0).to_toml(tmp_path / "scene.toml")
+    calls = {}
+    for flag in ((), ("--no-exact-flight",)):
+        out = "off" if flag else "on"
+        done = run_ballc("run", "scene.toml", "--t-end", "0.5", *flag, "--out", out,
+                         cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        calls[out] = ballc.load(tmp_path / out / "result.npz").nfev
+    assert "exact_flight False" in done.stdout
+    assert calls["off"] > calls["on"] > 0
 
 
 def test_demo_with_an_invalid_end_time_fails_before_any_work(tmp_path):

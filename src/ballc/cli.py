@@ -27,7 +27,7 @@ DEFAULT_T_END = 5.0
 #: Default parent of ``ballc run`` / ``ballc sweep`` outputs: <this>/<file stem>/.
 OUTPUT_ROOT = "ballc-output"
 #: Keys of a scene file's [simulate] table; all but t_end are passed to ballc.simulate.
-SIMULATE_KEYS = ("t_end", "rtol", "atol", "method")
+SIMULATE_KEYS = ("t_end", "rtol", "atol", "method", "exact_flight")
 
 
 class CommandError(Exception):
@@ -160,16 +160,16 @@ def _simulate_options(scene, t_end, options: dict):
     from .simulate import simulate
     defaults = {name: parameter.default
                 for name, parameter in inspect.signature(simulate).parameters.items()
-                if name in ("method", "rtol", "atol")}
+                if name in ("method", "rtol", "atol", "exact_flight")}
     given = {name: value for name, value in options.items() if value is not None}
     merged = {**defaults, **given}
     t_end = check_options(scene, t_end, method=merged["method"], rtol=merged["rtol"],
-                          atol=merged["atol"]).t_end
+                          atol=merged["atol"], exact_flight=merged["exact_flight"]).t_end
     return t_end, given
 
 
 def simulate_table(path, scene=None) -> dict:
-    """A scene file's ``[simulate]`` table (t_end, rtol, atol, method), validated: unknown
+    """A scene file's ``[simulate]`` table (t_end, rtol, atol, method, exact_flight), validated: unknown
     keys fail with a "did you mean", values by ``ballc.simulate``'s own checks."""
     data = read_toml(path)
     settings = data.get("simulate", {})
@@ -229,8 +229,9 @@ def _run(args) -> int:
     scene = Scene.from_toml(path)
     settings = simulate_table(path, scene)
     t_end = args.t_end if args.t_end is not None else settings.get("t_end", DEFAULT_T_END)
-    overrides = {"rtol": args.rtol, "atol": args.atol, "method": args.method}
-    options = {name: settings.get(name) for name in ("rtol", "atol", "method")}
+    overrides = {"rtol": args.rtol, "atol": args.atol, "method": args.method,
+                 "exact_flight": False if args.no_exact_flight else None}
+    options = {name: settings.get(name) for name in ("rtol", "atol", "method", "exact_flight")}
     options.update({k: v for k, v in overrides.items() if v is not None})
     t_end, options = _simulate_options(scene, t_end, options)
     _check_html(args.html)
@@ -286,6 +287,9 @@ def main(argv=None) -> int:
     run.add_argument("--method", default=None,
                      help="integrator: radau5 or a solve_ivp method (default: [simulate] "
                           "method, else radau5)")
+    run.add_argument("--no-exact-flight", action="store_true",
+                     help="integrate free flight even where it has a closed form (default: "
+                          "[simulate] exact_flight, else closed form where exact)")
     run.add_argument("--out", default=None,
                      help=f"output folder (default: {OUTPUT_ROOT}/<the file's stem>)")
     run.add_argument("--animate", action="store_true", help="also write the 3D animation")
