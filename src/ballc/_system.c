@@ -291,15 +291,24 @@ static int any_stick(int flags)
     return exact_mode(flags, 0) == MODE_STICK || exact_mode(flags, 1) == MODE_STICK;
 }
 
+/* The public entry points' part of the checks: finite parameters and latch, and the
+ * parameter constants computed from them; 0 when they are not finite. */
+static int prepare(const double *params, const double *latch, ballc_parameters_t *prepared)
+{
+    if (!all_finite(params, BALLC_N_PARAMETERS) || !all_finite(latch, BALLC_N_LATCH))
+        return 0;
+    ballc_parameters_init(prepared, params);
+    return 1;
+}
+
 int ballc_rhs(const double *state, const double *params, const double *latch,
               int flags, double *xdot)
 {
-    if (!all_finite(params, BALLC_N_PARAMETERS) || !all_finite(latch, BALLC_N_LATCH)) {
+    ballc_parameters_t prepared;
+    if (!prepare(params, latch, &prepared)) {
         for (int i = 0; i < NS; i++) xdot[i] = NAN;
         return BALLC_NOT_FINITE;
     }
-    ballc_parameters_t prepared;
-    ballc_parameters_init(&prepared, params);
     return ballc_rhs_checked_inputs(state, &prepared, latch, flags, xdot);
 }
 
@@ -452,10 +461,8 @@ static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const dou
 int ballc_jacobian(const double *state, const double *params, const double *latch,
                    int flags, double *jac)
 {
-    if (!all_finite(params, BALLC_N_PARAMETERS) || !all_finite(latch, BALLC_N_LATCH))
-        return BALLC_NOT_FINITE;
     ballc_parameters_t prepared;
-    ballc_parameters_init(&prepared, params);
+    if (!prepare(params, latch, &prepared)) return BALLC_NOT_FINITE;
     return ballc_jacobian_checked_inputs(state, &prepared, latch, flags, jac);
 }
 
