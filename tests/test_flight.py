@@ -210,10 +210,11 @@ def test_whole_run_agrees_with_the_integrated_flight(changes, rtol):
         assert a.plane == b.plane
         assert a.t_start == pytest.approx(b.t_start, abs=1e-6)
     # These runs' own error is dominated by the contacts, not the flight: the mixture
-    # scene's stick-slip and the compliant law's kink where the tangential spring meets
-    # its Coulomb cap while unloading give 1e-6 .. 3e-5 in state at rtol 1e-10, exact
-    # flight on or off alike, and which of the two is closer to the truth moves with
-    # rounding (a different start state by 1e-10 takes different steps through the kink).
+    # scene's stick-slip, and in the compliant scene a jump while unloading (most likely
+    # where the tangential spring reaches its Coulomb cap, a kink that is integrated
+    # through), give 1e-6 .. 3e-5 in state at rtol 1e-10, exact flight on or off alike;
+    # which of the two is closer to the truth moves with rounding (a start state 1e-10
+    # apart takes different steps through the kink).
     # So both runs must be accurate against a tight reference, at a bound 10x above that
     # (a defect of the closed form -- a sign, the spin, the root -- gives O(1) errors).
     reference = ballc.simulate(scene, 3.0, rtol=1e-12, atol=1e-12, progress=False,
