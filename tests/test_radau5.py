@@ -242,3 +242,17 @@ def test_controller_elements_are_named():
     with pytest.raises(ValueError, match="controller element"):
         _radau5.solve_linear(np.eye(1), (0, 1), [1.0], rtol=1e-6, atol=1e-6,
                              controller="nope")
+
+
+def test_a_non_finite_right_hand_side_of_ballc_is_reported_not_integrated():
+    """radau5 leaves the finiteness check of ballc's own right-hand side to ballc_rhs
+    (radau5_problem.outputs_checked): a state whose derivative overflows must still end
+    the integration with status -1 and the reason, not run on NaNs."""
+    scene = ballc.Scene()
+    y0 = scene.initial_state()
+    y0[_core.STATE_INDEX["omega_x"]] = 1e300        # omega^2 overflows
+    latch = np.zeros(_core.N_LATCH)
+    sol = _radau5.solve_system(scene.parameter_vector(), latch, _core.FLAGS["observer"],
+                               (0.0, 1.0), y0, rtol=1e-6, atol=1e-6)
+    assert sol.status == -1 and not sol.success
+    assert "cannot be evaluated at the initial state" in sol.message

@@ -54,6 +54,7 @@ cdef extern from "_radau5_solver.h":
         const int *ev_direction
         int dense_output
         int controller
+        int outputs_checked
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -388,7 +389,8 @@ cdef tuple _group_hits(const int[::1] event, const double[::1] t, const double[:
 cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    rtol, atol, max_step, t_eval, events, first_step, max_nfev,
                    radau5_event_fun event_fun=NULL, int[::1] event_plane=None,
-                   list users=None, bint dense_output=False, controller=None):
+                   list users=None, bint dense_output=False, controller=None,
+                   bint outputs_checked=False):
     cdef radau5_problem p
     cdef int ctrl = _controller_bits(controller)
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
@@ -441,6 +443,7 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.ev_fun = event_fun
     p.dense_output = dense_output
     p.controller = ctrl
+    p.outputs_checked = outputs_checked
     return _run(&p, n, m)
 
 
@@ -481,7 +484,8 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ctx.errors = <void *>errors
     sol = _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes,
-                 users, bool(dense_output), controller)
+                 users, bool(dense_output), controller,
+                 True)   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
     if errors:
         raise errors[0]
     return sol

@@ -58,6 +58,8 @@ typedef struct {
     const int *ev_direction;  /* +1 rising only, -1 falling only, 0 both */
     int dense_output;         /* nonzero: keep every step's interpolant (dense_t, dense_c) */
     int controller;           /* RADAU5_CTRL_* bits (internal; 0: scipy's step control) */
+    int outputs_checked;      /* nonzero: fun and jac return nonzero whenever an output is
+                               * not finite, so the solver does not check them again */
 } radau5_problem;
 
 /* Step control: scipy's Radau (0) or elements of Hairer & Wanner's RADAU5 (radau5.f,
