@@ -28,6 +28,8 @@ DEFAULT_T_END = 5.0
 OUTPUT_ROOT = "ballc-output"
 #: Keys of a scene file's [simulate] table; all but t_end are passed to ballc.simulate.
 SIMULATE_KEYS = ("t_end", "rtol", "atol", "method", "exact_flight")
+#: Those of them that are ballc.simulate options.
+SIMULATE_OPTIONS = SIMULATE_KEYS[1:]
 
 
 class CommandError(Exception):
@@ -160,17 +162,15 @@ def _simulate_options(scene, t_end, options: dict):
     from .simulate import simulate
     defaults = {name: parameter.default
                 for name, parameter in inspect.signature(simulate).parameters.items()
-                if name in ("method", "rtol", "atol", "exact_flight")}
+                if name in SIMULATE_OPTIONS}
     given = {name: value for name, value in options.items() if value is not None}
-    merged = {**defaults, **given}
-    t_end = check_options(scene, t_end, method=merged["method"], rtol=merged["rtol"],
-                          atol=merged["atol"], exact_flight=merged["exact_flight"]).t_end
+    t_end = check_options(scene, t_end, **{**defaults, **given}).t_end
     return t_end, given
 
 
 def simulate_table(path, scene=None) -> dict:
-    """A scene file's ``[simulate]`` table (t_end, rtol, atol, method, exact_flight), validated: unknown
-    keys fail with a "did you mean", values by ``ballc.simulate``'s own checks."""
+    """A scene file's ``[simulate]`` table (SIMULATE_KEYS), validated: unknown keys fail
+    with a "did you mean", values by ``ballc.simulate``'s own checks."""
     data = read_toml(path)
     settings = data.get("simulate", {})
     if not isinstance(settings, dict):
@@ -231,7 +231,7 @@ def _run(args) -> int:
     t_end = args.t_end if args.t_end is not None else settings.get("t_end", DEFAULT_T_END)
     overrides = {"rtol": args.rtol, "atol": args.atol, "method": args.method,
                  "exact_flight": False if args.no_exact_flight else None}
-    options = {name: settings.get(name) for name in ("rtol", "atol", "method", "exact_flight")}
+    options = {name: settings.get(name) for name in SIMULATE_OPTIONS}
     options.update({k: v for k, v in overrides.items() if v is not None})
     t_end, options = _simulate_options(scene, t_end, options)
     _check_html(args.html)

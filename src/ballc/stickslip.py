@@ -31,6 +31,7 @@ decisions at the mode boundaries; the driver (simulate.py) holds the segment loo
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -109,24 +110,17 @@ def force_scale(scene, load) -> float:
 
 
 def slip_map(params, plane: str) -> np.ndarray:
-    """du/dy (2 x N_STATES) of ``plane``'s slip velocity u (u is linear in the state);
-    the maps of the last parameter vector are kept (a run asks for them at every
-    event).  Read-only: shared between callers."""
-    global _slip_maps
-    key = params.tobytes()
-    cached = _slip_maps            # one read: a consistent (key, maps) pair across threads
-    if cached[0] != key:
-        cached = (key, {})
-        _slip_maps = cached
-    found = cached[1].get(plane)
-    if found is None:
-        found = _core.slip_map(params, PLANES.index(plane))
-        found.flags.writeable = False
-        cached[1][plane] = found
+    """du/dy (2 x N_STATES) of ``plane``'s slip velocity u (u is linear in the state),
+    kept per parameter vector (a run asks for it at every event).  Read-only: shared
+    between callers."""
+    return _slip_map(np.ascontiguousarray(params, dtype=float).tobytes(), plane)
+
+
+@functools.lru_cache(maxsize=16)
+def _slip_map(params_bytes: bytes, plane: str) -> np.ndarray:
+    found = _core.slip_map(np.frombuffer(params_bytes), PLANES.index(plane))
+    found.flags.writeable = False
     return found
-
-
-_slip_maps: tuple = (b"", {})
 
 
 def slip_stop_coefficients(params, plane: str, direction) -> np.ndarray:
