@@ -7,8 +7,8 @@ the CPU ratio; the seed's model build (sympy, lambdify) is not counted.
 
 Then the comparison at equal error: against a converged reference (radau5 at 1e-13),
 the seed's final-state error (centre position, m, and velocity, m/s) is measured, and
-radau5 runs at rtol = atol = 1e-6 ... 1e-12; the loosest tolerance whose final error is
-at most the seed's gives the CPU ratio at equal (or smaller) error.
+radau5 runs at rtol = atol = 1, 2 and 5 per decade from 1e-5 to 1e-12; the cheapest run
+whose final error is at most the seed's gives the CPU ratio at equal (or smaller) error.
 """
 from __future__ import annotations
 
@@ -55,7 +55,7 @@ def _final(y):
 
 
 def equal_error(seed, args):
-    """radau5's CPU at the loosest tolerance whose final error is <= the seed's."""
+    """radau5's CPU in the cheapest run whose final error is <= the seed's."""
     reference = ballc.simulate(ballc.Scene(), args.t_end, rtol=1e-13, atol=1e-13)
     ref = np.concatenate([reference.position[:, -1], reference.velocity[:, -1]])
     seed_error = np.abs(_final(seed["y"]) - ref).max()
@@ -63,8 +63,8 @@ def equal_error(seed, args):
           f"{seed_error:.2e} in {seed['cpu_seconds']:.3f} s")
     print(f"{'radau5 rtol = atol':>20s} {'CPU s':>9s} {'final error':>12s} {'seed / this':>11s}")
     chosen = None
-    for exponent in range(6, 13):
-        tol = 10.0 ** -exponent
+    tolerances = [m * 10.0 ** -e for e in range(6, 13) for m in (5, 2, 1)]
+    for tol in tolerances:
         cpu = []
         for _ in range(args.repeat):
             started = time.process_time()
@@ -73,7 +73,7 @@ def equal_error(seed, args):
         error = np.abs(np.concatenate([ours.position[:, -1], ours.velocity[:, -1]]) - ref).max()
         ratio = seed["cpu_seconds"] / min(cpu)
         print(f"{tol:20.0e} {min(cpu):9.4f} {error:12.2e} {ratio:10.0f}x")
-        if chosen is None and error <= seed_error:
+        if error <= seed_error and (chosen is None or ratio > chosen[1]):
             chosen = (tol, ratio)
     if chosen:
         print(f"equal or smaller error than the seed's: radau5 at {chosen[0]:.0e}, "

@@ -84,9 +84,13 @@ def test_work_is_that_of_scipy_radau(pair):
     held to the reference by test_every_controller_reaches_the_reference, not to scipy's
     counts): the RHS-call counts of a whole run differ by rounding-level step
     changes and by the step radau5's driver carries across stick/slip transitions
-    (measured: 0.05 .. 0.6 %); 1 % bounds them (the README says so)."""
+    (measured: 0.05 .. 0.6 %), and radau5 steps again to each terminal event where
+    scipy interpolates (measured: +1.2 % on the observer-free scene, whose slips swing
+    past zero: stepping there takes ~13 short steps, where scipy's state is the dense
+    output of a step across the slip law's jump); 2 % bounds them (the README says
+    so)."""
     name, ours, ref = pair
-    assert abs(ours.nfev - ref.nfev) <= 0.01 * ref.nfev
+    assert abs(ours.nfev - ref.nfev) <= 0.02 * ref.nfev
 
 
 def test_free_flight_is_exactly_ballistic():
@@ -137,6 +141,30 @@ def test_linear_events_are_located_on_the_dense_output():
     assert sol.t[-1] == sol.t_events[1][0]
     np.testing.assert_allclose(sol.y_events[1][0], [0.5, -3 * np.sin(3 * t_stop)],
                                rtol=0, atol=1e-9)
+
+
+def test_the_state_at_a_terminal_event_is_a_step_end_not_the_dense_output():
+    """The same oscillator, stopped where y0 = 0.5 first rises.  The state radau5
+    returns there is compared with the exact solution at the time it reports (so the
+    root's own error does not count).  Stepping to the event (the default) leaves the
+    global error of the step end points; the crossing step's dense output (solve_ivp's
+    state, refine_events=False) adds its own interpolation error, measured 10x (1e-6)
+    and 25x (1e-8) larger."""
+    A = np.array([[0.0, 1.0], [-9.0, 0.0]])
+    stop = [_Event([1.0, 0.0], -0.5, True, 1)]
+
+    def state_error(tol, refine):
+        sol = _radau5.solve_linear(A, (0, 3), np.array([1.0, 0.0]), rtol=tol, atol=tol,
+                                   events=stop, refine_events=refine)
+        assert sol.status == 1 and sol.t[-1] == sol.t_events[0][0]
+        np.testing.assert_array_equal(sol.y[:, -1], sol.y_events[0][0])
+        t = sol.t_events[0][0]
+        return np.abs(sol.y_events[0][0] - [np.cos(3 * t), -3 * np.sin(3 * t)]).max()
+
+    for tol in (1e-6, 1e-8):
+        stepped, interpolated = state_error(tol, True), state_error(tol, False)
+        assert stepped <= 0.3 * interpolated
+        assert stepped <= 0.1 * tol
 
 
 def test_linear_event_objects_serve_both_integrators():

@@ -200,6 +200,34 @@ def test_remove_slip_is_an_impulse_at_the_contact_point(rng):
         assert np.array_equal(out[:7], y[:7]) and np.array_equal(out[13:], y[13:])
 
 
+def test_a_slip_that_passes_by_zero_is_integrated_through():
+    """The seed scene's contacts slip past u = 0, missing it by ~1e-5 m/s (the direction
+    swings through 180 degrees in microseconds).  At rtol = 1e-8 the clear speed is
+    ~2e-5 m/s: freezing the direction there and removing the miss at the stop as if it
+    were integration error (the rule before PASS_FACTOR) left every post-contact
+    velocity 130-250 x rtol off the 1e-12 run; integrated through, they are within
+    0.5-7 x rtol (measured), bounded here by 20 x rtol.  The first 1.2 s (three
+    contacts) are well conditioned."""
+    tol = 1e-8
+    reference = ballc.simulate(ballc.Scene(), 1.2, rtol=1e-12, atol=1e-12)
+    result = ballc.simulate(ballc.Scene(), 1.2, rtol=tol, atol=tol)
+    assert len(result.contacts) == len(reference.contacts) == 3
+    for ours, ref in zip(result.contacts, reference.contacts):
+        np.testing.assert_allclose(ours.velocity_after, ref.velocity_after, rtol=0,
+                                   atol=20 * tol)
+        np.testing.assert_allclose(ours.angular_velocity_after, ref.angular_velocity_after,
+                                   rtol=0, atol=20 * tol / ballc.Scene().radius)
+
+
+def test_passes_by_zero_compares_the_miss_with_the_error():
+    """The miss is the part of u across the direction d it is approaching along."""
+    error = 1e-7
+    d = np.array([1.0, 0.0])
+    assert stickslip.passes_by_zero(np.array([3e-5, 2e-5]), d, error)       # misses by 2e-5
+    assert not stickslip.passes_by_zero(np.array([3e-5, 5e-7]), d, error)   # within 10 x
+    assert not stickslip.passes_by_zero(np.array([0.0, 0.0]), d, error)
+
+
 def test_loose_tolerances_finish_quickly_on_the_seed_scene():
     """No cliff: every tolerance from 1e-3 to 1e-8 finishes the 5-s seed throw with
     status 0 and fewer right-hand-side calls than the next tighter tolerance (the

@@ -55,6 +55,7 @@ cdef extern from "_radau5_solver.h":
         int dense_output
         int controller
         int outputs_checked
+        int refine_events
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -390,7 +391,7 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    rtol, atol, max_step, t_eval, events, first_step, max_nfev,
                    radau5_event_fun event_fun=NULL, int[::1] event_plane=None,
                    list users=None, bint dense_output=False, controller=None,
-                   bint outputs_checked=False):
+                   bint outputs_checked=False, bint refine_events=True):
     cdef radau5_problem p
     cdef int ctrl = _controller_bits(controller)
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
@@ -444,12 +445,13 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.dense_output = dense_output
     p.controller = ctrl
     p.outputs_checked = outputs_checked
+    p.refine_events = refine_events
     return _run(&p, n, m)
 
 
 def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  max_step=np.inf, t_eval=None, events=(), first_step=None, max_nfev=None,
-                 dense_output=False, controller=None):
+                 dense_output=False, controller=None, refine_events=True):
     """Integrate ballc's equations (N_STATES states) over ``t_span`` with radau5.
 
     ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
@@ -465,7 +467,10 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     y_old then 3 coefficients per state, y = y_old + sum_j c_j x^(j+1))), else None.
     ``max_nfev``: give up (status -1, with what was computed) after that many
     right-hand-side calls.  ``controller``: the step control (private; None: the
-    process's current one, see ``_set_controller``).
+    process's current one, see ``_set_controller``).  ``refine_events`` (default
+    True): the state at a terminal event is the end point of a step taken to the
+    event's time (order 5, error-controlled), not the crossing step's dense output
+    (a cubic, as in solve_ivp); False: solve_ivp's.
     """
     cdef ball_ctx ctx
     params = _vector("params", params, BALLC_N_PARAMETERS)
@@ -485,15 +490,17 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     sol = _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes,
                  users, bool(dense_output), controller,
-                 True)   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
+                 True,   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
+                 bool(refine_events))
     if errors:
         raise errors[0]
     return sol
 
 
 def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),
-                 first_step=None, max_nfev=None, controller=None):
-    """Integrate y' = A y (A: n x n) with radau5; same result as ``solve_system``."""
+                 first_step=None, max_nfev=None, controller=None, refine_events=True):
+    """Integrate y' = A y (A: n x n) with radau5; same result as ``solve_system``
+    (``refine_events``: see there)."""
     cdef linear_ctx ctx
     A = np.ascontiguousarray(A, dtype=float)
     if A.ndim != 2 or A.shape[0] != A.shape[1] or A.shape[0] == 0:
@@ -505,7 +512,7 @@ def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, eve
     ctx.A = &av[0, 0]
     return _solve(_linear_fun, _linear_jac, &ctx, ctx.n, t_span, y0, rtol, atol,
                   max_step, t_eval, events, first_step, max_nfev, NULL, None, None, False,
-                  controller)
+                  controller, False, bool(refine_events))
 
 
 def _lu_solve(A, b):

@@ -84,6 +84,11 @@ typedef struct {
     int have_acc;
     /* solver state (Radau attributes) */
     double t, t_old, h_abs, h_abs_old, error_norm_old;
+    double t_bound;                       /* where steps stop: p->t_bound, or an event's
+                                           * time while stepping to it (step_to_event) */
+    double dense_end;                     /* the end of the step the interpolant Q covers */
+    long i_eval;                          /* the next of p->t_eval to store */
+    double jac_t;                         /* where J was evaluated */
     int have_h_abs_old, have_error_norm_old, have_sol, current_jac, lu_valid;
     double *y, *f, *y_old, *J, *Z, *Q;      /* Z, Q: of the last accepted step */
     double *LU_real; int *piv_real;       /* nc x nc: the coupled block (see partition) */
@@ -160,6 +165,7 @@ static int call_jac(solver_t *s, double t, const double *y)
 {
     PROF_START;
     s->r->njev++;
+    s->jac_t = t;
     int rc = s->p->jac(s->p->ctx, t, y, s->J);
     for (int i = 0; i < s->n * s->n && rc == 0 && !s->p->outputs_checked; i++)
         if (!isfinite(s->J[i])) rc = -1;
@@ -326,7 +332,7 @@ static double predict_factor(double h_abs, double h_abs_old, int have_h_abs_old,
 static void dense(const solver_t *s, double tt, double *out)
 {
     const int n = s->n;
-    double x = (tt - s->t_old) / (s->t - s->t_old);
+    double x = (tt - s->t_old) / (s->dense_end - s->t_old);
     double p1 = x, p2 = x * x, p3 = x * x * x;
     for (int c = 0; c < n; c++)
         out[c] = s->y_old[c] + s->Q[3 * c] * p1 + s->Q[3 * c + 1] * p2 + s->Q[3 * c + 2] * p3;
@@ -366,7 +372,7 @@ static int step(solver_t *s)
         }
         h = h_abs * s->direction;
         t_new = t + h;
-        if (s->direction * (t_new - p->t_bound) > 0) t_new = p->t_bound;
+        if (s->direction * (t_new - s->t_bound) > 0) t_new = s->t_bound;
         h = t_new - t;
         h_abs = fabs(h);
 
@@ -484,6 +490,8 @@ static int step(solver_t *s)
     else
         s->lu_valid = 0;
 
+    if (recompute_jac && t_new == s->t_bound)
+        recompute_jac = 0;   /* the last step: nothing would use it (a new run starts anew) */
     if (recompute_jac) {
         if (call_jac(s, t_new, y_new) != 0) {
             snprintf(s->r->message, sizeof s->r->message,
@@ -506,6 +514,7 @@ static int step(solver_t *s)
     memcpy(s->Z, Z, 3 * n * sizeof(double));
     s->t_old = t;
     s->t = t_new;
+    s->dense_end = t_new;
     /* _compute_dense_output: Q = Z^T P (n x 3) */
     for (int c = 0; c < n; c++)
         for (int j = 0; j < 3; j++)
@@ -776,6 +785,79 @@ static int handle_events(solver_t *s, double *t_stop)
     return terminate;
 }
 
+/* Store the points of t_eval up to t_upto from the last step's dense output. */
+static int store_eval(solver_t *s, double t_upto)
+{
+    const radau5_problem *p = s->p;
+    while (s->i_eval < p->n_eval && s->direction * (p->t_eval[s->i_eval] - t_upto) <= 0) {
+        dense(s, p->t_eval[s->i_eval], s->err);
+        if (store_point(s, p->t_eval[s->i_eval], s->err) != 0) return -1;
+        s->i_eval++;
+    }
+    return 0;
+}
+
+/* Step to a terminal event's time: integrate again from the start of the step that
+ * crossed it, t_old, to exactly t_stop (usually one step, with the full error control).
+ * The state there is a step's end point, of the method's order 5 (with the error
+ * estimate's control), where the dense output it replaces is a cubic of order 3
+ * between the nodes and carries no error control at all: at loose tolerances across a
+ * contact's end (where the Hertz force's higher derivatives are singular) it was off
+ * by 100 times the tolerance.  On success y_stop (n) is overwritten with the new state
+ * and the interpolant of the crossing step is replaced by those of the new steps;
+ * when a step fails y_stop is kept (the dense value) and so is the old interpolant.
+ * The next step size (h_next) stays the one chosen before.  The crossing step is no
+ * predictor here: past the event the equations may jump (the slip law's orientation
+ * flips where u . d < 0, just past a slip's approach event), and a polynomial through
+ * the jump sent Newton astray (measured: 13-15 halvings instead of one step), so the
+ * first new step starts from zero stage increments, with a Jacobian taken at its start
+ * if the one in hand was taken past it.  Returns 1 when refined, 0 when kept, -1 when
+ * out of memory. */
+static int step_to_event(solver_t *s, double t_stop, double *y_stop)
+{
+    const int n = s->n;
+    if (!(s->direction * (t_stop - s->t_old) > 0 && s->direction * (s->t - t_stop) > 0))
+        return 0;   /* at a step's end point already */
+    const double h_next = s->h_abs;
+    const long n_dense = s->r->n_dense;
+    s->t = s->t_old;
+    s->have_sol = 0;   /* zero predictor: see above */
+    memcpy(s->y, s->y_old, n * sizeof(double));
+    int ok = call_fun(s, s->t, s->y, s->f) == 0;
+    if (ok && s->direction * (s->jac_t - s->t) > 0) {
+        /* J was evaluated at the crossing step's end, past the event (the mode's
+         * equations may have turned sharply there, e.g. a slip direction swinging
+         * through zero): take it at the start again */
+        ok = call_jac(s, s->t, s->y) == 0;
+        s->current_jac = 1;
+    }
+    s->t_bound = t_stop;
+    s->h_abs = fabs(t_stop - s->t);
+    s->lu_valid = 0;
+    while (ok && s->direction * (t_stop - s->t) > 0) {
+        ok = step(s);
+        if (ok && s->p->dense_output && store_dense(s) != 0) return -1;
+        if (ok && s->p->t_eval != NULL && store_eval(s, s->t) != 0) return -1;
+    }
+    s->t_bound = s->p->t_bound;
+    s->h_abs = h_next;
+    radau5_result *r = s->r;
+    if (!ok) {   /* keep the dense value; drop the pieces of the new steps */
+        r->n_dense = n_dense;
+        return 0;
+    }
+    memcpy(y_stop, s->y, n * sizeof(double));
+    if (s->p->dense_output) {   /* the new steps' pieces replace the crossing step's */
+        const size_t width = 4 * (size_t)n;
+        memmove(r->dense_t + 2 * (n_dense - 1), r->dense_t + 2 * n_dense,
+                2 * (size_t)(r->n_dense - n_dense) * sizeof(double));
+        memmove(r->dense_c + (n_dense - 1) * width, r->dense_c + n_dense * width,
+                (size_t)(r->n_dense - n_dense) * width * sizeof(double));
+        r->n_dense--;
+    }
+    return 1;
+}
+
 /* ---- driver (solve_ivp's loop) ---- */
 
 void radau5_free(radau5_result *r)
@@ -851,8 +933,8 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.joc_start = s.oidx + n; s.joc_col = s.joc_start + n + 1;
 
     s.t = p->t0;
+    s.t_bound = p->t_bound;
     memcpy(s.y, p->y0, n * sizeof(double));
-    long i_eval = 0;
     if (p->t_eval == NULL) {
         if (store_point(&s, s.t, s.y) != 0) goto oom;
     }
@@ -901,20 +983,17 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
             terminate = handle_events(&s, &t_out);
             PROF_STOP(RADAU5_PROF_EVENTS);
             if (terminate < 0) goto oom;
-            if (terminate) {
-                dense(&s, t_out, s.tmp);
-                y_out = s.tmp;
+            if (terminate) {   /* handle_events stored the hit's state, from the dense output */
+                double *hit = r->hit_y + (size_t)(r->n_hits - 1) * n;
+                if (p->refine_events && step_to_event(&s, t_out, hit) < 0) goto oom;
+                y_out = hit;
             }
             memcpy(s.g, s.g_new, m * sizeof(double));
         }
         if (p->t_eval == NULL) {
             if (store_point(&s, t_out, y_out) != 0) goto oom;
-        } else {
-            while (i_eval < p->n_eval && s.direction * (p->t_eval[i_eval] - t_out) <= 0) {
-                dense(&s, p->t_eval[i_eval], s.err);
-                if (store_point(&s, p->t_eval[i_eval], s.err) != 0) goto oom;
-                i_eval++;
-            }
+        } else if (store_eval(&s, t_out) != 0) {
+            goto oom;
         }
         if (terminate) {
             r->status = RADAU5_EVENT;

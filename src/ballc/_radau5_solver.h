@@ -11,7 +11,10 @@
  * g(y) = c . y + d (on one step g(t) is then a cubic in t), and for events the
  * system evaluates itself (a callback, evaluated on the dense output).  Events are evaluated
  * exactly as solve_ivp evaluates them (the driver keeps segments from starting on
- * an event's zero; see simulate.py).
+ * an event's zero; see simulate.py).  One difference, on by default
+ * (radau5_problem.refine_events): the state at a terminal event is not the crossing
+ * step's dense output (a cubic, order 3, without error control) but the end point of
+ * the step taken again from that step's start to the event's time.
  *
  * Generic in the system: the right-hand side and Jacobian are C callbacks, the
  * dimension is a run-time value.  The Newton systems are solved by ballc's own
@@ -60,6 +63,9 @@ typedef struct {
     int controller;           /* RADAU5_CTRL_* bits (internal; 0: scipy's step control) */
     int outputs_checked;      /* nonzero: fun and jac return nonzero whenever an output is
                                * not finite, so the solver does not check them again */
+    int refine_events;        /* nonzero: the state at a terminal event is a step's end
+                               * point (the crossing step is taken again from its start
+                               * to the event's time), not the dense output's value */
 } radau5_problem;
 
 /* Step control: scipy's Radau (0) or elements of Hairer & Wanner's RADAU5 (radau5.f,

@@ -127,12 +127,13 @@ def contact_threshold(scene, plane, rho0, entering):
 
 
 def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
-                    clear=0.0):
+                    clear=0.0, approach=None):
     """Events of one segment starting at state y0: [(kind, plane, event)].
 
     ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
     see ballc.stickslip), ``clear`` the slip speed (m/s) below which the slip
-    direction is held fixed.  The stop and release events sit a rounding-level margin
+    direction is held fixed, ``approach`` (optional, per plane) the speed at which a
+    free slip's approach event fires when it is not ``clear``.  The stop and release events sit a rounding-level margin
     past their zero, so that a segment starting on it (slip from rest, a stick that
     starts at the cone) does not fire at once.
     """
@@ -153,7 +154,9 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
             along = stickslip.slip_stop_coefficients(params, plane,
                                                      stickslip.slip_direction(latch, plane))
             if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
-                events.append(("approach", plane, LinearEvent.over(along, -clear, True, -1)))
+                speed = approach.get(plane) if approach else None
+                speed = clear if speed is None else speed
+                events.append(("approach", plane, LinearEvent.over(along, -speed, True, -1)))
             else:                # fixed direction: stop at u . d = 0, or go free at 2 clear
                 margin = 4 * math.ulp(stickslip.speed_scale(scene, y0))
                 events.append(("stop", plane, LinearEvent.over(along, margin, True, -1)))

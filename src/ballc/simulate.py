@@ -65,6 +65,7 @@ class _Run:
         self.exact = stickslip.uses_exact_coulomb(scene)
         self.in_contact = {plane: False for plane in PLANES}
         self.coulomb: dict[str, str | None] = {plane: None for plane in PLANES}
+        self.approach: dict[str, float | None] = {plane: None for plane in PLANES}
         self.relatches = {plane: 0 for plane in PLANES}
         self.transitions = {plane: 0 for plane in PLANES}
         self.open: dict[str, Contact] = {}
@@ -109,7 +110,7 @@ class _Run:
     def end_contact(self, plane):
         y = self.y
         self.in_contact[plane] = False
-        self.coulomb[plane] = None
+        self.coulomb[plane] = self.approach[plane] = None
         contact = self.open.pop(plane)
         contact.t_end = self.t
         contact.velocity_after = y[layout.VELOCITY].copy()
@@ -122,11 +123,16 @@ class _Run:
     def clear_speed(self):
         return stickslip.clear_speed(self.scene, self.y, self.options.rtol, self.options.atol)
 
-    def set_mode(self, plane, mode, direction=None):
+    def error_speed(self):
+        return stickslip.error_speed(self.scene, self.y, self.options.rtol, self.options.atol)
+
+    def set_mode(self, plane, mode, direction=None, approach=None):
         """Enter ``mode`` on ``plane`` now; the contact records when each phase of slip
-        or stick begins."""
+        or stick begins.  ``approach``: the slip speed u . d (m/s) at which a free slip's
+        approach event fires, when it is not the clear speed (a slip passing by zero)."""
         phase = "stick" if mode == "stick" else "slip"
         self.coulomb[plane] = mode
+        self.approach[plane] = approach
         self.transitions[plane] += 1
         if direction is not None:
             stickslip.set_slip_direction(self.latch, plane, direction)
@@ -165,15 +171,21 @@ class _Run:
         u = stickslip.slip_velocity(self.params, plane, self.y)
         speed = float(np.hypot(*u))
         clear = self.clear_speed()
-        if kind == "approach":   # u . d fell to `clear`: near zero, or only turned away
-            self.relatches[plane] += 1
-            near = speed <= 2 * clear or self.relatches[plane] > stickslip.MAX_RELATCH
-            self.set_mode(plane, "slip_fixed" if near else "slip", u / speed)
-        elif kind == "stop":     # u . d = 0 with the direction held: what is left is error
-            if speed <= clear:
-                self.settle(plane)
+        if kind == "approach":   # u . d fell to its threshold: near zero, passing by, or
+            self.relatches[plane] += 1   # only turned away
+            direction = stickslip.slip_direction(self.latch, plane)
+            free = (self.relatches[plane] <= stickslip.MAX_RELATCH
+                    and (speed > 2 * clear
+                         or stickslip.passes_by_zero(u, direction, self.error_speed())))
+            if free:
+                self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))
             else:
-                self.set_mode(plane, "slip", u / speed)
+                self.set_mode(plane, "slip_fixed", u / speed)
+        elif kind == "stop":     # u . d = 0 with the direction held: a slip left within the
+            if speed <= stickslip.PASS_FACTOR * self.error_speed():   # error is error
+                self.settle(plane)
+            else:                # a slip left beyond it passes by zero: free again
+                self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))
         elif kind == "clear":    # clear of zero again: the direction goes free
             self.set_mode(plane, "slip", u / speed)
         else:                    # "release": |lambda| reached mu N; slip from rest along -lambda
@@ -297,7 +309,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         flags = run.flags()
         system = _core.System(run.params, run.latch, flags)
         driver_events = ev.segment_events(scene, run.in_contact, run.y, run.coulomb,
-                                          run.params, run.latch, flags, run.clear_speed())
+                                          run.params, run.latch, flags, run.clear_speed(),
+                                          run.approach)
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
