@@ -124,14 +124,19 @@ cdef class System:
     """
     cdef double[::1] _params
     cdef double[::1] _latch
+    cdef object _params_array, _latch_array   # the arrays _params and _latch view
     cdef readonly int flags
     cdef public long nfev, njev, failures
 
     def __init__(self, const double[::1] params, const double[::1] latch, int flags):
         _check("params", params.shape[0], BALLC_N_PARAMETERS)
         _check("latch", latch.shape[0], BALLC_N_LATCH)
-        self._params = np.array(params, dtype=np.float64)
-        self._latch = np.array(latch, dtype=np.float64)
+        self._params_array = np.empty(BALLC_N_PARAMETERS)
+        self._latch_array = np.empty(BALLC_N_LATCH)
+        self._params = self._params_array
+        self._latch = self._latch_array
+        self._params[:] = params
+        self._latch[:] = latch
         self.flags = flags
         self.nfev = 0
         self.njev = 0
@@ -140,12 +145,12 @@ cdef class System:
     @property
     def params(self):
         """The parameter vector (a copy)."""
-        return np.array(self._params)
+        return self._params_array.copy()
 
     @property
     def latch(self):
         """The latched values (a copy)."""
-        return np.array(self._latch)
+        return self._latch_array.copy()
 
     def __call__(self, double t, const double[:] y):
         cdef double ys[BALLC_MAX_STATES]
