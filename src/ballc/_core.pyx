@@ -10,7 +10,7 @@ solver and its LU are compiled and linked once, here.  The solver's bridge lives
 thin module that re-exports it.
 """
 import numpy as np
-from libc.math cimport NAN
+from libc.math cimport NAN, isfinite
 
 cdef extern from "ballc_kernels.h":
     int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH, BALLC_N_LATCH_PER_PLANE
@@ -53,6 +53,8 @@ cdef extern from "_system.h":
     int ballc_jacobian_checked_inputs(const double *, const ballc_parameters_t *,
                                       const double *, int, double *) nogil
     int ballc_contact_forces(const double *, const double *, const double *, int, double *) nogil
+    int ballc_contact_forces_prepared(const double *, const ballc_parameters_t *,
+                                      const double *, int, double *) nogil
     int ballc_stick_state(const double *, const double *, const double *, int, int,
                           double *) nogil
     int ballc_remove_slip(const double *, const double *, int, int, double *) nogil
@@ -322,10 +324,15 @@ def contact_forces_per_sample(const double[:, ::1] states, const double[::1] par
     out = np.empty((states.shape[0], 6))
     cdef double[:, ::1] o = out
     cdef Py_ssize_t i, j
+    cdef bint params_finite = True
+    cdef ballc_parameters_t prepared
+    for j in range(params.shape[0]):
+        params_finite = params_finite and isfinite(params[j])
+    ballc_parameters_init(&prepared, &params[0])   # once for all rows
     with nogil:
         for i in range(states.shape[0]):
-            if ballc_contact_forces(&states[i, 0], &params[0], &latches[i, 0], flags[i],
-                                    &o[i, 0]) != BALLC_OK:
+            if not params_finite or ballc_contact_forces_prepared(
+                    &states[i, 0], &prepared, &latches[i, 0], flags[i], &o[i, 0]) != BALLC_OK:
                 for j in range(6):
                     o[i, j] = NAN
     return out
