@@ -10,7 +10,7 @@ solver and its LU are compiled and linked once, here.  The solver's bridge lives
 thin module that re-exports it.
 """
 import numpy as np
-from libc.math cimport NAN
+from libc.math cimport NAN, isfinite
 
 cdef extern from "ballc_kernels.h":
     int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH, BALLC_N_LATCH_PER_PLANE
@@ -53,6 +53,8 @@ cdef extern from "_system.h":
     int ballc_jacobian_checked_inputs(const double *, const ballc_parameters_t *,
                                       const double *, int, double *) nogil
     int ballc_contact_forces(const double *, const double *, const double *, int, double *) nogil
+    int ballc_contact_forces_prepared(const double *, const ballc_parameters_t *,
+                                      const double *, int, double *) nogil
     int ballc_stick_state(const double *, const double *, const double *, int, int,
                           double *) nogil
     int ballc_remove_slip(const double *, const double *, int, int, double *) nogil
@@ -124,14 +126,19 @@ cdef class System:
     """
     cdef double[::1] _params
     cdef double[::1] _latch
+    cdef object _params_array, _latch_array   # the arrays _params and _latch view
     cdef readonly int flags
     cdef public long nfev, njev, failures
 
     def __init__(self, const double[::1] params, const double[::1] latch, int flags):
         _check("params", params.shape[0], BALLC_N_PARAMETERS)
         _check("latch", latch.shape[0], BALLC_N_LATCH)
-        self._params = np.array(params, dtype=np.float64)
-        self._latch = np.array(latch, dtype=np.float64)
+        self._params_array = np.empty(BALLC_N_PARAMETERS)
+        self._latch_array = np.empty(BALLC_N_LATCH)
+        self._params = self._params_array
+        self._latch = self._latch_array
+        self._params[:] = params
+        self._latch[:] = latch
         self.flags = flags
         self.nfev = 0
         self.njev = 0
@@ -140,12 +147,12 @@ cdef class System:
     @property
     def params(self):
         """The parameter vector (a copy)."""
-        return np.array(self._params)
+        return self._params_array.copy()
 
     @property
     def latch(self):
         """The latched values (a copy)."""
-        return np.array(self._latch)
+        return self._latch_array.copy()
 
     def __call__(self, double t, const double[:] y):
         cdef double ys[BALLC_MAX_STATES]
@@ -317,10 +324,15 @@ def contact_forces_per_sample(const double[:, ::1] states, const double[::1] par
     out = np.empty((states.shape[0], 6))
     cdef double[:, ::1] o = out
     cdef Py_ssize_t i, j
+    cdef bint params_finite = True
+    cdef ballc_parameters_t prepared
+    for j in range(params.shape[0]):
+        params_finite = params_finite and isfinite(params[j])
+    ballc_parameters_init(&prepared, &params[0])   # once for all rows
     with nogil:
         for i in range(states.shape[0]):
-            if ballc_contact_forces(&states[i, 0], &params[0], &latches[i, 0], flags[i],
-                                    &o[i, 0]) != BALLC_OK:
+            if not params_finite or ballc_contact_forces_prepared(
+                    &states[i, 0], &prepared, &latches[i, 0], flags[i], &o[i, 0]) != BALLC_OK:
                 for j in range(6):
                     o[i, j] = NAN
     return out

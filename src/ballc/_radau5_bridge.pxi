@@ -219,34 +219,43 @@ def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
     return t0, t1, rtol, atol_v, max_step, t_eval, first
 
 
-def _event_arrays(events, n):
+def _event_arrays(events, int n):
     """Linear events (``coefficients``, ``offset``), stick-release events
     (``stick_plane``, ``offset``: g = mu N - |lambda| + offset, evaluated in C) and, for
     ballc's system, any other callable g(t, y) (a user event, called from C).
-    Returns (m, coef, offset, terminal, direction, plane, user callables)."""
-    cdef Py_ssize_t m = len(events), k, size = max(len(events), 1)
+    Returns (m, coef, offset, ints, user callables); ``ints`` (4 rows): terminal,
+    direction, plane (-1 linear, 0/1 stick release, -2 - k the user's event k) and
+    nonlinear (not evaluated from ``coef``)."""
+    cdef Py_ssize_t m = len(events), k, i, size = max(len(events), 1)
     coef = np.zeros((size, n))
     reals = np.zeros(size)
-    ints = np.zeros((3, size), dtype=np.intc)
+    ints = np.zeros((4, size), dtype=np.intc)
+    cdef double[:, ::1] cv = coef
     cdef double[::1] offset = reals
-    cdef int[:, ::1] iv = ints   # terminal, direction, plane
+    cdef int[:, ::1] iv = ints   # terminal, direction, plane, nonlinear
+    cdef const double[::1] row
     iv[2, :] = -1
     users = []
     for k in range(m):
         e = events[k]
         c = getattr(e, "coefficients", None)   # the driver's events are LinearEvents
         if c is not None:
-            if not (isinstance(c, np.ndarray) and c.shape == (n,) and c.dtype == np.float64):
+            if not (isinstance(c, np.ndarray) and c.shape == (n,) and c.dtype == np.float64
+                    and c.flags.c_contiguous):
                 c = _vector(f"events[{k}].coefficients", c, n)
-            coef[k] = c
-            if not _finite(coef[k]):
-                _vector(f"events[{k}].coefficients", c, n)   # raises, naming it
+            row = c
+            for i in range(n):
+                if not isfinite(row[i]):
+                    _vector(f"events[{k}].coefficients", c, n)   # raises, naming it
+                cv[k, i] = row[i]
             offset[k] = float(getattr(e, "offset", 0.0))
         elif hasattr(e, "stick_plane"):
             iv[2, k] = int(e.stick_plane)
+            iv[3, k] = 1
             offset[k] = float(getattr(e, "offset", 0.0))
         elif callable(e):
             iv[2, k] = -2 - len(users)
+            iv[3, k] = 1
             users.append(e)
         else:
             raise TypeError(f"events[{k}] = {e!r} is neither a linear event (`coefficients` "
@@ -255,7 +264,7 @@ def _event_arrays(events, n):
         iv[0, k] = bool(getattr(e, "terminal", False))
         dirn = float(getattr(e, "direction", 0))
         iv[1, k] = (dirn > 0) - (dirn < 0)
-    return m, coef, reals, ints[0], ints[1], ints[2], users
+    return m, coef, reals, ints, users
 
 
 cdef extern from "_radau5_solver.h":
@@ -355,14 +364,15 @@ cdef object _run(radau5_problem *p, int n, int m):
     finally:
         radau5_free(&r)
     t_events, y_events = _group_hits(hit_event, hit_t, hit_y, m, n)
-    return OptimizeResult(t=t, y=np.ascontiguousarray(y.T), t_events=t_events,
+    return OptimizeResult(t=t, y=y.T, t_events=t_events,
                           y_events=y_events, status=status, message=message,
                           success=status >= 0, sol=None, dense=dense, **counts)
 
 
 cdef tuple _group_hits(const int[::1] event, const double[::1] t, const double[:, ::1] y,
                        int m, int n):
-    """Per event k, the times (hits,) and states (hits, n) of its hits, in order."""
+    """Per event k, the times (hits,) and states (hits, n) of its hits, in order.  The
+    events without a hit (most of them) share one pair of empty arrays."""
     cdef Py_ssize_t h, k, i
     cdef double[::1] tv
     cdef double[:, ::1] yv
@@ -370,18 +380,22 @@ cdef tuple _group_hits(const int[::1] event, const double[::1] t, const double[:
     counts = [0] * m
     for h in range(event.shape[0]):
         counts[event[h]] += 1
+    no_t, no_y = np.empty(0), np.empty((0, n))
     for k in range(m):
+        if not counts[k]:
+            t_events.append(no_t)
+            y_events.append(no_y)
+            continue
         te = np.empty(counts[k])
         ye = np.empty((counts[k], n))
-        if counts[k]:
-            tv = te
-            yv = ye
-            i = 0
-            for h in range(event.shape[0]):
-                if event[h] == k:
-                    tv[i] = t[h]
-                    yv[i, :] = y[h, :]
-                    i += 1
+        tv = te
+        yv = ye
+        i = 0
+        for h in range(event.shape[0]):
+            if event[h] == k:
+                tv[i] = t[h]
+                yv[i, :] = y[h, :]
+                i += 1
         t_events.append(te)
         y_events.append(ye)
     return t_events, y_events
@@ -401,18 +415,20 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     t0, t1, rtol, atol_v, max_step, t_eval, first = _options(
         n, t0, t1, rtol, atol, max_step, t_eval, first_step)
     y0 = _vector("y0", y0, n)
-    m, coef, offset, terminal, direction, plane, found = _event_arrays(list(events or ()), n)
-    if event_plane is not None:   # the system evaluates its own events: it reads the planes
-        np.asarray(event_plane)[:plane.size] = plane
+    m, coef, offset, ints, found = _event_arrays(list(events or ()), n)
+    cdef int[:, ::1] iv = ints   # terminal, direction, plane, nonlinear
+    cdef Py_ssize_t k
+    for k in range(m):
+        if event_plane is not None:   # the system evaluates its own events: it reads the planes
+            event_plane[k] = iv[2, k]
+        elif iv[3, k]:
+            raise TypeError("this system takes linear events only (`coefficients` and "
+                            "`offset`): stick-release and callable events need ballc's "
+                            "system (solve_system)")
+    if event_plane is not None:
         users.extend(found)
-    elif np.any(plane[:m] != -1):
-        raise TypeError("this system takes linear events only (`coefficients` and "
-                        "`offset`): stick-release and callable events need ballc's "
-                        "system (solve_system)")
-    nonlinear = np.ascontiguousarray(plane != -1, dtype=np.intc)
     cdef double[::1] y0v = y0, atolv = atol_v, offv = offset
     cdef double[:, ::1] coefv = coef
-    cdef int[::1] termv = terminal, dirv = direction, nlv = nonlinear
     cdef double[::1] tev
     p.n = n
     p.fun = fun
@@ -438,9 +454,9 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.n_events = m
     p.ev_coef = &coefv[0, 0]
     p.ev_offset = &offv[0]
-    p.ev_terminal = &termv[0]
-    p.ev_direction = &dirv[0]
-    p.ev_nonlinear = &nlv[0]
+    p.ev_terminal = &iv[0, 0]
+    p.ev_direction = &iv[1, 0]
+    p.ev_nonlinear = &iv[3, 0]
     p.ev_fun = event_fun
     p.dense_output = dense_output
     p.controller = ctrl
@@ -462,7 +478,8 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     any other callable g(t, y) with optional ``terminal``/``direction`` (called from C
     with the GIL; an exception it raises is re-raised after the integration).
     Returns a solve_ivp-shaped OptimizeResult (t, y, t_events, y_events, status,
-    message, success, nfev, njev, nlu) plus nstep and nreject, and ``dense``: with
+    message, success, nfev, njev, nlu) plus nstep and nreject (``y`` is the transpose of
+    the solver's rows: shape (N_STATES, samples), Fortran order), and ``dense``: with
     ``dense_output``, (dense_t (steps x 2: t_old, t), dense_c (steps x 4 N_STATES:
     y_old then 3 coefficients per state, y = y_old + sum_j c_j x^(j+1))), else None.
     ``max_nfev``: give up (status -1, with what was computed) after that many

@@ -330,14 +330,22 @@ int ballc_rhs_checked_inputs(const double *state, const ballc_parameters_t *para
 int ballc_contact_forces(const double *state, const double *params, const double *latch,
                          int flags, double *forces)
 {
-    schur_t factor;
-    evaluation_t ev;
-    double udot[NU];
     ballc_parameters_t prepared;
     for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
     if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
     ballc_parameters_init(&prepared, params);
-    int status = accelerations(state, &prepared, latch, flags, &factor, &ev, udot, NULL);
+    return ballc_contact_forces_prepared(state, &prepared, latch, flags, forces);
+}
+
+int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t *params,
+                                  const double *latch, int flags, double *forces)
+{
+    schur_t factor;
+    evaluation_t ev;
+    double udot[NU];
+    for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
+    if (!all_finite(state, NS) || !all_finite(latch, BALLC_N_LATCH)) return BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
     memcpy(forces, ev.contact_force, sizeof ev.contact_force);
     return all_finite(forces, 3 * BALLC_N_PLANES) ? BALLC_OK : BALLC_NOT_FINITE;

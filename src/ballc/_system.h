@@ -75,6 +75,11 @@ int ballc_rhs_checked_inputs(const double *state, const ballc_parameters_t *para
 int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t *params,
                                   const double *latch, int flags, double *jac);
 
+/* ballc_contact_forces for callers that have checked once that params are finite and
+ * prepared them (a run's samples, one call): the state and latch are checked per call. */
+int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t *params,
+                                  const double *latch, int flags, double *forces);
+
 /* Stick state of ``plane`` (0 floor, 1 ceiling) under ``flags`` (which must hold that
  * plane's FRICTION and STICK flags): out = [lambda_x, lambda_y, N, mu N - |lambda|],
  * the constraint force that keeps the slip velocity constant, the friction share's

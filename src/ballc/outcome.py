@@ -112,18 +112,23 @@ def summarize_contact_forces(result):
     scene = result.scene
     params = scene.parameter_vector()
     mu = scene.friction_coefficient
-    # one C call over every stored sample, each with its segment's latch and flags
-    all_forces = _core.contact_forces_per_sample(
-        np.ascontiguousarray(result.y.T), params, np.ascontiguousarray(result.latch.T),
-        np.ascontiguousarray(result.flags, dtype=np.int32))
+    # one row per sample (views: Result.y and latch are Fortran-ordered)
+    states = np.ascontiguousarray(result.y.T)
+    latches = np.ascontiguousarray(result.latch.T)
+    flags = np.ascontiguousarray(result.flags, dtype=np.int32)
     for contact in result.contacts:
         end = contact.t_end if np.isfinite(contact.t_end) else result.t[-1]
-        inside = np.flatnonzero((result.t >= contact.t_start) & (result.t <= end))
-        if inside.size == 0:
+        # the samples with t_start <= t <= end: one run of them, result.t is increasing
+        first = np.searchsorted(result.t, contact.t_start, side="left")
+        stop = np.searchsorted(result.t, end, side="right")
+        if stop <= first:
             continue
+        inside = slice(first, stop)
         k = PLANES.index(contact.plane)
         normal = 1.0 if contact.plane == "floor" else -1.0
-        forces = all_forces[inside, 3 * k:3 * k + 3]
+        # one C call over the contact's samples, each with its segment's latch and flags
+        forces = _core.contact_forces_per_sample(states[inside], params, latches[inside],
+                                                 flags[inside])[:, 3 * k:3 * k + 3]
         f_n = forces[:, 2] * normal
         f_t = np.hypot(forces[:, 0], forces[:, 1])
         contact.peak_normal_force = float(f_n.max())

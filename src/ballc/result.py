@@ -10,6 +10,8 @@ from . import _core, layout
 from .orientation import angles_123_from_quaternion
 
 _STATE = layout.INDEX
+#: The unset values of a Contact's vectors (each contact gets its own copy).
+_NAN_3, _NAN_2 = np.full(3, np.nan), np.full(2, np.nan)
 
 
 @dataclass
@@ -55,11 +57,11 @@ class Contact:
     penetration_rate_at_impact: float    # m/s, the latched rhodot^-
     digin_direction: np.ndarray      # unit contact-point velocity at t_start
     t_end: float = np.nan            # s
-    velocity_after: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
-    angular_velocity_after: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
+    velocity_after: np.ndarray = field(default_factory=_NAN_3.copy)
+    angular_velocity_after: np.ndarray = field(default_factory=_NAN_3.copy)
     max_penetration: float = 0.0     # m
     #: centre (x, y) when the penetration was largest: the contact point (m)
-    contact_point: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
+    contact_point: np.ndarray = field(default_factory=_NAN_2.copy)
     peak_normal_force: float = np.nan      # N, largest F . n over the stored samples
     energy_lost_normal: float = np.nan     # J, dissipated by the normal force
     energy_lost_tangential: float = np.nan  # J, dissipated by the tangential force

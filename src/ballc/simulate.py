@@ -21,11 +21,13 @@ from .integrate import failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
 from .result import Contact, Result
+from .samples import Samples
 from .scene import Scene, SceneError
 
 PLANES = layout.PLANES
 _STATE = layout.INDEX
 _QUATERNION, _DISSIPATED, _DEFLECTION = layout.QUATERNION, layout.DISSIPATED, layout.DEFLECTION
+_CENTRE_XY = layout.rows("x", 2)
 SUCCESS = "The solver successfully reached the end of the integration interval."
 #: Events after which the next segment starts with the last segment's next step size.
 CARRY_STEP = ("approach", "stop", "clear", "release")
@@ -286,16 +288,15 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     for plane in PLANES:   # a scene may start in contact: latch as documented in modes
         if ev.penetration(plane, scene)(0.0, run.y) > 0:
             run.begin_contact(plane)
-    ts, ys = [np.array([0.0])], [run.y[:, None]]
-    if t_eval is not None:
+    samples = Samples()
+    if t_eval is None:
+        samples.add(np.array([0.0]), run.y[:, None], run.flags(), run.latch)
+    else:
         keep = t_eval == 0.0
-        ts, ys = [t_eval[keep]], [np.repeat(run.y[:, None], keep.sum(), axis=1)]
-    # Per stored sample: the flags and latched values of the segment that computed it,
-    # so outputs that need the right-hand side (the observer's acceleration, contact
-    # forces) can re-evaluate it exactly as integrated.  One column per sample.
-    segment_flags, segment_latches, samples_per_segment = [run.flags()], [run.latch.copy()], [
-        ts[0].size]
-    user = options.events
+        samples.add(t_eval[keep], np.repeat(run.y[:, None], keep.sum(), axis=1), run.flags(),
+                    run.latch)
+    skip = 1 if t_eval is None else 0   # a segment's first sample is its start, already stored
+    user = list(options.events)
     user_t = [[] for _ in user]
     user_y = [[] for _ in user]
     pieces = []
@@ -315,8 +316,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
         remaining = None if options.max_nfev is None else max(options.max_nfev - nfev, 1)
-        segment_events = [e[2] for e in driver_events] + list(user)
-        sol = integrate_segment(system, run.t, t_end, run.y, segment_events,
+        events = [event for _, _, event in driver_events] + user
+        sol = integrate_segment(system, run.t, t_end, run.y, events,
                                 method=options.method, rtol=options.rtol, atol=options.atol,
                                 t_eval=segment_eval, max_step=options.max_step,
                                 max_nfev=remaining, first_step=first,
@@ -326,23 +327,24 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         nfev += sol.nfev
         njev += sol.njev
         nlu += sol.nlu
-        start = 1 if t_eval is None else 0   # the segment's start is already stored
+        t, t_events, y_events = sol.t, sol.t_events, sol.y_events
         # An event at the segment's very start ends a zero-length segment whose event
         # sample repeats t; keep only later samples so that result.t stays increasing.
-        later = sol.t[start:] > run.t
-        ts.append(sol.t[start:][later])
-        ys.append(sol.y[:, start:][:, later])
-        segment_flags.append(system.flags)
-        segment_latches.append(run.latch.copy())
-        samples_per_segment.append(ts[-1].size)
+        samples.add_later(t, sol.y, run.t, skip, flags, run.latch)
         n_driver = len(driver_events)
-        for (kind, plane, _), t_hits, y_hits in zip(driver_events, sol.t_events, sol.y_events):
-            if kind == "deepest" and len(t_hits):
-                for yy in y_hits:
+        fired, t_fired = -1, np.inf   # the earliest terminal event that fired
+        for i, hits in enumerate(t_events):
+            if not len(hits):
+                continue
+            if i < n_driver and driver_events[i][0] == "deepest":
+                plane = driver_events[i][1]
+                for yy in y_events[i]:
                     record_depth(run.open[plane], ev.penetration(plane, scene)(0, yy), yy)
+            elif getattr(events[i], "terminal", False) and hits[-1] < t_fired:
+                fired, t_fired = i, float(hits[-1])
         for k in range(len(user)):
-            user_t[k].append(np.asarray(sol.t_events[n_driver + k], dtype=float))
-            user_y[k].append(np.asarray(sol.y_events[n_driver + k], dtype=float).reshape(
+            user_t[k].append(np.asarray(t_events[n_driver + k], dtype=float))
+            user_y[k].append(np.asarray(y_events[n_driver + k], dtype=float).reshape(
                 -1, _core.N_STATES))
 
         if sol.status == -1:
@@ -351,34 +353,29 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             if "max_nfev" in reason:
                 reason = (f"gave up after {nfev} right-hand-side evaluations in all "
                           f"(max_nfev = {options.max_nfev})")
-            end = sol.t[-1] if sol.t.size else run.t
+            end = t[-1] if t.size else run.t
             run.message = (f"integrator failed at t = {end:.6g} s: {reason}"
                            + failure_hint(scene, run.in_contact))
-            if options.dense_output and sol.t.size:
-                pieces.append((run.t, float(sol.t[-1]), sol.interpolant))
+            if options.dense_output and t.size:
+                pieces.append((run.t, float(t[-1]), sol.interpolant))
             break
         if sol.status == 0:
             if options.dense_output:
                 pieces.append((run.t, t_end, sol.interpolant))
             run.t = t_end
             break
-        index, t_hit = -1, np.inf   # the earliest terminal event that fired
-        for i, e in enumerate(segment_events):
-            hits = sol.t_events[i]
-            if len(hits) and getattr(e, "terminal", False) and hits[-1] < t_hit:
-                index, t_hit = i, float(hits[-1])
-        if index < 0:
+        if fired < 0:
             raise RuntimeError("the integrator stopped on a terminal event (status 1) but "
                                "reported no terminal event hit")
         if options.dense_output:
-            pieces.append((run.t, t_hit, sol.interpolant))
-        run.t = t_hit
-        run.y = np.array(sol.y_events[index][-1])
-        run.y[_QUATERNION] /= math.hypot(*run.y[_QUATERNION])
-        if index >= n_driver:   # a terminal user event
+            pieces.append((run.t, t_fired, sol.interpolant))
+        run.t = t_fired
+        run.y = state = np.array(y_events[fired][-1])
+        state[_QUATERNION] /= math.hypot(*state[_QUATERNION].tolist())
+        if fired >= n_driver:   # a terminal user event
             run.status, run.message = 1, "A termination event occurred."
             break
-        kind, plane, _ = driver_events[index]
+        kind, plane, _ = driver_events[fired]
         run.handle(kind, plane)
         if kind in CARRY_STEP and getattr(sol, "h_next", 0) > 0:
             # within a contact the dynamics do not jump at a stick/slip transition: go on
@@ -388,15 +385,14 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     if bar is not None:
         bar.update((t_end if run.status == 0 else run.t) - bar.n)
         bar.close()
+    last = samples.last_state
     for plane, contact in run.open.items():   # still in contact at the end
-        if ys[-1].size:
-            last = ys[-1][:, -1]
+        if last is not None:
             record_depth(contact, ev.penetration(plane, scene)(0, last), last)
-    result = Result(t=np.concatenate(ts), y=np.concatenate(ys, axis=1), scene=scene,
-                    status=run.status, message=run.message, nfev=nfev, njev=njev, nlu=nlu,
-                    contacts=run.contacts,
-                    flags=np.repeat(np.array(segment_flags, dtype=np.int32), samples_per_segment),
-                    latch=np.repeat(np.array(segment_latches).T, samples_per_segment, axis=1),
+    t, y, flags, latch = samples.arrays()
+    result = Result(t=t, y=y, scene=scene, status=run.status, message=run.message,
+                    nfev=nfev, njev=njev, nlu=nlu, contacts=run.contacts, flags=flags,
+                    latch=latch,
                     t_events=[np.concatenate(k) if k else np.empty(0) for k in user_t],
                     y_events=[np.concatenate(k) if k else np.empty((0, _core.N_STATES))
                               for k in user_y],
@@ -410,4 +406,4 @@ def record_depth(contact, depth, y):
     """Keep the deepest penetration of a contact and where it happened."""
     if depth >= contact.max_penetration:
         contact.max_penetration = float(depth)
-        contact.contact_point = y[[_STATE["x"], _STATE["y"]]].copy()
+        contact.contact_point = y[_CENTRE_XY].copy()

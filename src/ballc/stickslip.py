@@ -83,18 +83,19 @@ def mode_flags(plane: str, mode: str | None) -> int:
     return _core.FLAGS[f"{plane}_{mode}"] if mode else 0
 
 
-def _slip_direction_slice(plane: str) -> slice:
-    k = PLANES.index(plane) * _core.N_LATCH_PER_PLANE + _SLIP_DIRECTION
-    return slice(k, k + 2)
+#: plane -> where its slip direction d (x, y) sits in the latch vector
+_SLIP_DIRECTION_SLICE = {
+    plane: slice(k, k + 2) for plane, k in (
+        (plane, i * _core.N_LATCH_PER_PLANE + _SLIP_DIRECTION) for i, plane in enumerate(PLANES))}
 
 
 def slip_direction(latch: np.ndarray, plane: str) -> np.ndarray:
     """The slip direction d latched for ``plane`` (a view into ``latch``)."""
-    return latch[_slip_direction_slice(plane)]
+    return latch[_SLIP_DIRECTION_SLICE[plane]]
 
 
 def set_slip_direction(latch: np.ndarray, plane: str, direction) -> None:
-    latch[_slip_direction_slice(plane)] = direction
+    latch[_SLIP_DIRECTION_SLICE[plane]] = direction
 
 
 _VELOCITY, _ANGULAR = layout.VELOCITY, layout.ANGULAR_VELOCITY
