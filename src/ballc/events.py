@@ -133,9 +133,10 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
     ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
     see ballc.stickslip), ``clear`` the slip speed (m/s) below which the slip
     direction is held fixed, ``approach`` (optional, per plane) the speed at which a
-    free slip's approach event fires when it is not ``clear``.  The stop and release events sit a rounding-level margin
-    past their zero, so that a segment starting on it (slip from rest, a stick that
-    starts at the cone) does not fire at once.
+    free slip's approach event fires when it is not ``clear`` (a slip passing by
+    zero).  The stop and release events sit a rounding-level margin past their zero,
+    so that a segment starting on it (slip from rest, a stick that starts at the cone)
+    does not fire at once.
     """
     events = []
     for plane in PLANES:
