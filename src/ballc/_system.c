@@ -331,9 +331,10 @@ int ballc_contact_forces(const double *state, const double *params, const double
                          int flags, double *forces)
 {
     ballc_parameters_t prepared;
-    for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
-    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
-    ballc_parameters_init(&prepared, params);
+    if (!prepare(params, latch, &prepared)) {
+        for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
+        return BALLC_NOT_FINITE;
+    }
     return ballc_contact_forces_prepared(state, &prepared, latch, flags, forces);
 }
 
