@@ -257,9 +257,21 @@ static int solve_collocation(solver_t *s, double t, double h, double *restrict Z
     double *restrict W = s->W, *restrict F = s->F, *restrict dW = s->dW, *restrict yi = s->tmp;
     const double *restrict inv_scale = s->inv_scale;
     cplx *restrict fc = s->ctmp;
-    for (int i = 0; i < 3; i++)
-        for (int c = 0; c < n; c++)
-            W[i * n + c] = k->TI[i][0] * Z[c] + k->TI[i][1] * Z[n + c] + k->TI[i][2] * Z[2 * n + c];
+    /* the transformation matrices as locals: the stage loops below then keep them in
+     * registers (through k the compiler reloads them for every element) */
+    const double T00 = k->T[0][0], T01 = k->T[0][1], T02 = k->T[0][2],
+                 T10 = k->T[1][0], T11 = k->T[1][1], T12 = k->T[1][2],
+                 T20 = k->T[2][0], T21 = k->T[2][1], T22 = k->T[2][2];
+    const double Ti00 = k->TI[0][0], Ti01 = k->TI[0][1], Ti02 = k->TI[0][2],
+                 Ti10 = k->TI[1][0], Ti11 = k->TI[1][1], Ti12 = k->TI[1][2],
+                 Ti20 = k->TI[2][0], Ti21 = k->TI[2][1], Ti22 = k->TI[2][2];
+    for (int c = 0; c < n; c++) {
+        double z0 = Z[c], z1 = Z[n + c], z2 = Z[2 * n + c];
+        W[c] = Ti00 * z0 + Ti01 * z1 + Ti02 * z2;
+        W[n + c] = Ti10 * z0 + Ti11 * z1 + Ti12 * z2;
+        W[2 * n + c] = Ti20 * z0 + Ti21 * z1 + Ti22 * z2;
+    }
+    const cplx tc0 = k->ti_complex[0], tc1 = k->ti_complex[1], tc2 = k->ti_complex[2];
     double dW_norm_old = 0, rate = 0, theta = 0, rate_prev = 0;
     int have_old = 0, have_rate = 0, converged = 0, it;
     for (it = 0; it < maxiter; it++) {
@@ -271,9 +283,8 @@ static int solve_collocation(solver_t *s, double t, double h, double *restrict Z
         if (!finite) break;
         for (int c = 0; c < n; c++) {
             double f0 = F[c], f1 = F[n + c], f2 = F[2 * n + c];
-            dW[c] = f0 * k->TI[0][0] + f1 * k->TI[0][1] + f2 * k->TI[0][2] - M_real * W[c];
-            fc[c] = f0 * k->ti_complex[0] + f1 * k->ti_complex[1] + f2 * k->ti_complex[2]
-                    - M_complex * (W[n + c] + I * W[2 * n + c]);
+            dW[c] = f0 * Ti00 + f1 * Ti01 + f2 * Ti02 - M_real * W[c];
+            fc[c] = f0 * tc0 + f1 * tc1 + f2 * tc2 - M_complex * (W[n + c] + I * W[2 * n + c]);
         }
         solve_real(s, dW);
         solve_complex(s, fc);
@@ -299,9 +310,12 @@ static int solve_collocation(solver_t *s, double t, double h, double *restrict Z
                           pow(rate, maxiter - it) / (1 - rate) * dW_norm > s->newton_tol))
             break;
         for (int i = 0; i < 3 * n; i++) W[i] += dW[i];
-        for (int i = 0; i < 3; i++)
-            for (int c = 0; c < n; c++)
-                Z[i * n + c] = k->T[i][0] * W[c] + k->T[i][1] * W[n + c] + k->T[i][2] * W[2 * n + c];
+        for (int c = 0; c < n; c++) {
+            double w0 = W[c], w1 = W[n + c], w2 = W[2 * n + c];
+            Z[c] = T00 * w0 + T01 * w1 + T02 * w2;
+            Z[n + c] = T10 * w0 + T11 * w1 + T12 * w2;
+            Z[2 * n + c] = T20 * w0 + T21 * w1 + T22 * w2;
+        }
         if (dW_norm == 0 || (have_rate && rate / (1 - rate) * dW_norm < s->newton_tol)) {
             converged = 1;
             break;
