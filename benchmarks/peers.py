@@ -658,7 +658,11 @@ def write_markdown(bench, tolerances, args, elapsed, path):
         "each segment kind's start state, the C cost inside radau5 in a "
         "`-DRADAU5_PROFILE` build.  It leaves in each peer's own bridge (array wrapping in "
         "Cython / f2py before the callable runs) and per-step Python (assimulo's `solout`), "
-        "so it is an *upper bound* of what the peer would cost with C callbacks.",
+        "so it is an *upper bound* of what the peer would cost with C callbacks -- a loose "
+        "one: for CVODE, driven from C on the same replay ([cvode_c](cvode_c.md), "
+        "`python -m benchmarks.cvode_c`), the measured CPU is 4-12x below this estimate, "
+        "and CVODE BDF is level with radau5 there (CVODE Adams faster at tight "
+        "tolerances).",
         "- **equal-error ratio**: the peer's CPU interpolated (log-log, between its two "
         "neighbouring tolerances) at radau5's err6 for that tolerance, over radau5's CPU; "
         "`n/r` when the peer never got that accurate, `<` when it was more accurate even at "
