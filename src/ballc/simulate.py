@@ -231,7 +231,10 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         End time (s), > 0.
     method : str
         "radau5" (default): ballc's compiled Radau IIA (order 5) -- scipy's Radau
-        algorithm in C, same error control and events.  Or a scipy.integrate.solve_ivp
+        algorithm in C, same error control and events, except that the state at a
+        terminal event (a contact or stick/slip boundary, or a terminal user event) is
+        the end of a step taken to the event's time, not the dense output's value there.
+        Or a scipy.integrate.solve_ivp
         method: "Radau" (the reference radau5 is tested against), "BDF", "LSODA" (given
         the analytic Jacobian), "DOP853", "RK45", "RK23".
     rtol, atol : float
