@@ -819,7 +819,10 @@ static int store_eval(solver_t *s, double t_upto)
  * contact's end (where the Hertz force's higher derivatives are singular) it was off
  * by 100 times the tolerance.  On success y_stop (n) is overwritten with the new state
  * and the interpolant of the crossing step is replaced by those of the new steps;
- * when a step fails y_stop is kept (the dense value) and so is the old interpolant.
+ * when a step fails y_stop is kept (the dense value) and so is the old interpolant of
+ * the dense output (t_eval points already stored from new steps stay; any later ones
+ * up to t_stop from the interpolant in hand: the last new step's, else the crossing
+ * step's).
  * The next step size (h_next) stays the one chosen before.  The crossing step is no
  * predictor here: past the event the equations may jump (the slip law's orientation
  * flips where u . d < 0, just past a slip's approach event), and a polynomial through

@@ -173,8 +173,10 @@ class _Run:
         u = stickslip.slip_velocity(self.params, plane, self.y)
         speed = float(np.hypot(*u))
         clear = self.clear_speed()
-        if kind == "approach":   # u . d fell to its threshold: near zero, passing by, or
-            self.relatches[plane] += 1   # only turned away
+        if kind == "approach":
+            # u . d fell to its threshold: u is near zero, passing by it, or has only
+            # turned away from d
+            self.relatches[plane] += 1
             direction = stickslip.slip_direction(self.latch, plane)
             free = (self.relatches[plane] <= stickslip.MAX_RELATCH
                     and (speed > 2 * clear
@@ -183,10 +185,12 @@ class _Run:
                 self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))
             else:
                 self.set_mode(plane, "slip_fixed", u / speed)
-        elif kind == "stop":     # u . d = 0 with the direction held: a slip left within the
-            if speed <= stickslip.PASS_FACTOR * self.error_speed():   # error is error
+        elif kind == "stop":
+            # u . d = 0 with the direction held: a slip left within the integration error
+            # is error (settle); one beyond it passes by zero and slips on freely
+            if speed <= stickslip.PASS_FACTOR * self.error_speed():
                 self.settle(plane)
-            else:                # a slip left beyond it passes by zero: free again
+            else:
                 self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))
         elif kind == "clear":    # clear of zero again: the direction goes free
             self.set_mode(plane, "slip", u / speed)
