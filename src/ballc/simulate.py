@@ -188,7 +188,7 @@ class _Run:
         elif kind == "stop":
             # u . d = 0 with the direction held: a slip left within the integration error
             # is error (settle); one beyond it passes by zero and slips on freely
-            if speed <= stickslip.PASS_FACTOR * self.error_speed():
+            if speed <= stickslip.STOP_FACTOR * self.error_speed():
                 self.settle(plane)
             else:
                 self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))
