@@ -25,7 +25,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--t-end", type=float, default=5.0)
     parser.add_argument("--rtol", type=float, default=1e-12)
-    parser.add_argument("--repeat", type=int, default=3, help="ballc repetitions (best taken)")
+    parser.add_argument("--repeat", type=int, default=5, help="ballc repetitions (best taken)")
     args = parser.parse_args(argv)
 
     build_seed_model()   # build outside the timed region
