@@ -32,6 +32,7 @@ Writes docs/cvode_c.md.
 from __future__ import annotations
 
 import argparse
+import ast
 import os
 import platform
 import re
@@ -52,12 +53,26 @@ from benchmarks import peers
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 HARNESS = Path(__file__).resolve().parent / "cvode_harness.c"
-#: ballc's C sources, compiled into the harness as setup.py compiles them into _core
-C_SOURCES = [ROOT / "generated" / "ballc_kernels.c", ROOT / "src" / "ballc" / "_system.c",
-             ROOT / "src" / "ballc" / "_radau5_solver.c", ROOT / "src" / "ballc" / "_lu.c"]
-INCLUDE_DIRS = [ROOT / "generated", ROOT / "src" / "ballc"]
-#: setup.py's extra_compile_args
-CFLAGS = ["-O3", "-std=c99", "-fno-math-errno", "-fcx-limited-range"]
+
+
+def _core_extension():
+    """The keywords of setup.py's ``Extension("ballc._core", ...)`` (literals only), read
+    from its source so that the harness is compiled from the same C files, include
+    directories and flags as ``_core`` without repeating them here."""
+    for node in ast.walk(ast.parse((ROOT / "setup.py").read_text())):
+        if (isinstance(node, ast.Call) and getattr(node.func, "id", None) == "Extension"
+                and node.args and ast.literal_eval(node.args[0]) == "ballc._core"):
+            return {k.arg: ast.literal_eval(k.value) for k in node.keywords
+                    if k.arg in ("sources", "include_dirs", "extra_compile_args")}
+    raise RuntimeError("setup.py has no Extension('ballc._core', ...)")
+
+
+_CORE = _core_extension()
+#: ballc's C sources (the extension's, without its Cython bridge), include directories
+#: and flags, as setup.py builds ``_core``
+C_SOURCES = [ROOT / s for s in _CORE["sources"] if s.endswith(".c")]
+INCLUDE_DIRS = [ROOT / d for d in _CORE["include_dirs"]]
+CFLAGS = list(_CORE["extra_compile_args"])
 SUNDIALS_LIBS = ("sundials_core", "sundials_nvecserial", "sundials_sunmatrixdense",
                  "sundials_sunlinsoldense", "sundials_cvode")
 #: the harness's names -> peers.py's
