@@ -172,7 +172,8 @@ class _Run:
             return
         u = stickslip.slip_velocity(self.params, plane, self.y)
         speed = float(np.hypot(*u))
-        clear = self.clear_speed()
+        error = self.error_speed()
+        clear = stickslip.CLEAR_FACTOR * error   # = self.clear_speed(), without a second scale
         if kind == "approach":
             # u . d fell to its threshold: u is near zero, passing by it, or has only
             # turned away from d
@@ -180,7 +181,7 @@ class _Run:
             direction = stickslip.slip_direction(self.latch, plane)
             free = (self.relatches[plane] <= stickslip.MAX_RELATCH
                     and (speed > 2 * clear
-                         or stickslip.passes_by_zero(u, direction, self.error_speed())))
+                         or stickslip.passes_by_zero(u, direction, error)))
             if free:
                 self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))
             else:
@@ -188,7 +189,7 @@ class _Run:
         elif kind == "stop":
             # u . d = 0 with the direction held: a slip left within the integration error
             # is error (settle); one beyond it passes by zero and slips on freely
-            if speed <= stickslip.STOP_FACTOR * self.error_speed():
+            if speed <= stickslip.STOP_FACTOR * error:
                 self.settle(plane)
             else:
                 self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))

@@ -97,8 +97,9 @@ def mode_flags(plane: str, mode: str | None) -> int:
 
 #: plane -> where its slip direction d (x, y) sits in the latch vector
 _SLIP_DIRECTION_SLICE = {
-    plane: slice(k, k + 2) for plane, k in (
-        (plane, i * _core.N_LATCH_PER_PLANE + _SLIP_DIRECTION) for i, plane in enumerate(PLANES))}
+    plane: slice(i * _core.N_LATCH_PER_PLANE + _SLIP_DIRECTION,
+                 i * _core.N_LATCH_PER_PLANE + _SLIP_DIRECTION + 2)
+    for i, plane in enumerate(PLANES)}
 
 
 def slip_direction(latch: np.ndarray, plane: str) -> np.ndarray:
