@@ -127,13 +127,26 @@ class Segment:
 def record_segments(scene=None, t_end=T_END, rtol=REFERENCE_TOL, atol=REFERENCE_TOL):
     """(result, segments): a ballc.simulate run and its smooth segments, recorded by
     wrapping the driver's one call to an integrator (``integrate_segment``, as
-    ``ballc.simulate`` imported it); what it returns is passed on unchanged."""
+    ``ballc.simulate`` imported it); what it returns is passed on unchanged.
+
+    A driver segment in which radau5 re-armed an event (ballc.events.LinearEvent's
+    ``rearm``: a slip's approach re-latched without ending the segment) is recorded as
+    one piece per latch: it is split at each re-arming, whose time, state and new latch
+    the recording's wrapper of ``rearm`` keeps, so that every piece integrates one
+    fixed right-hand side (a replay without events would otherwise run on with the
+    first latch, whose slip orientation flips where u . d < 0).  The segment's RHS
+    calls are counted on its first piece."""
     scene = ballc.Scene() if scene is None else scene
     driver = importlib.import_module("ballc.simulate")
     original = driver.integrate_segment
     segments = []
 
     def recording(system, t0, t1, y0, events, **options):
+        latch = np.array(system.latch, dtype=float)
+        rearmed = []   # (t, state, latch after) of each re-arming, in order
+        for event in events:
+            if getattr(event, "rearm", None) is not None:
+                event.rearm = _recorded_rearm(event.rearm, rearmed)
         sol = original(system, t0, t1, y0, events, **options)
         if sol.status == 1:   # as the driver does: the earliest terminal event
             fired = [i for i, e in enumerate(events)
@@ -145,9 +158,11 @@ def record_segments(scene=None, t_end=T_END, rtol=REFERENCE_TOL, atol=REFERENCE_
         else:
             t_end_, y_end = None, None
         if t_end_ is not None:
-            segments.append(Segment(float(t0), np.array(y0, dtype=float), t_end_, y_end,
-                                    system.params, system.latch, int(system.flags),
-                                    int(sol.nfev)))
+            starts = [(float(t0), np.array(y0, dtype=float), latch)] + rearmed
+            ends = [(t, y) for t, y, _ in rearmed] + [(t_end_, y_end)]
+            for k, ((ta, ya, la), (tb, yb)) in enumerate(zip(starts, ends)):
+                segments.append(Segment(ta, ya, tb, yb, system.params, la, int(system.flags),
+                                        int(sol.nfev) if k == 0 else 0))
         return sol
 
     driver.integrate_segment = recording
@@ -156,6 +171,16 @@ def record_segments(scene=None, t_end=T_END, rtol=REFERENCE_TOL, atol=REFERENCE_
     finally:
         driver.integrate_segment = original
     return result, segments
+
+
+def _recorded_rearm(rearm, rearmed):
+    """``rearm`` that also keeps (t, state, new latch) of each re-arming it makes."""
+    def recorded(t, y):
+        out = rearm(t, y)
+        if out is not None:
+            rearmed.append((float(t), np.array(y, dtype=float), np.array(out[2], dtype=float)))
+        return out
+    return recorded
 
 
 #: A segment whose exact-Coulomb slip starts this close to zero slip (m/s) is

@@ -21,6 +21,8 @@ take (nearly) the same steps.  What the tolerances below allow:
   differ by 0.6e-4 .. 1.1e-4 m; the bound for this scene is 3e-4 m / 1e-3 m/s,
   about twice the reference's own uncertainty.
 """
+import math
+
 import numpy as np
 import pytest
 from scipy.linalg import expm
@@ -84,10 +86,12 @@ def test_work_is_that_of_scipy_radau(pair):
     held to the reference by test_every_controller_reaches_the_reference, not to scipy's
     counts): the RHS-call counts of a whole run differ by rounding-level step
     changes and by the step radau5's driver carries across stick/slip transitions
-    (measured: 0.05 .. 0.6 %), and radau5 steps again to each terminal event where
-    scipy interpolates (measured: +1.2 % on the observer-free scene, whose slips swing
-    past zero: stepping there takes ~13 short steps, where scipy's state is the dense
-    output of a step across the slip law's jump); 2 % bounds them (the README says
+    (measured: 0.05 .. 0.6 %), radau5 steps again to each terminal event where
+    scipy interpolates (+1.2 % on the observer-free scene, whose slips swing past zero:
+    stepping there takes ~13 short steps, where scipy's state is the dense output of a
+    step across the slip law's jump), and radau5 re-arms a slip's approach event where
+    the driver restarts scipy (measured with both, at 1e-12: seed -1.1 %, conservative
+    +0.2 %, friction +0.6 %, no observer +1.6 %); 2 % bounds them (the README says
     so)."""
     name, ours, ref = pair
     assert abs(ours.nfev - ref.nfev) <= 0.02 * ref.nfev
@@ -320,3 +324,64 @@ def test_a_non_finite_right_hand_side_of_ballc_is_reported_not_integrated():
                                (0.0, 1.0), y0, rtol=1e-6, atol=1e-6)
     assert sol.status == -1 and not sol.success
     assert "cannot be evaluated at the initial state" in sol.message
+
+
+def _falling_ball():
+    """A ball in free flight from rest at z = 5 m: z(t) = 5 - g t^2 / 2 exactly."""
+    scene = ballc.Scene(position=(0.0, 0.0, 5.0), velocity=(0.0, 0.0, 0.0),
+                        angular_velocity=(0.0, 0.0, 0.0))
+    return scene, scene.parameter_vector(), np.zeros(_core.N_LATCH), scene.initial_state()
+
+
+def test_a_re_armed_event_moves_on_without_a_stop():
+    """radau5 calls a terminal event's ``rearm`` where it fires: a new (coefficients,
+    offset) goes on integrating without a stop or a hit; None stops there as usual.
+    A falling ball's height event re-armed from 4.5 to 4 to 3 to 2 m: three re-arms at
+    the exact times of those heights (the state handed to rearm is a step's end), one
+    hit at the last, and the samples run through them."""
+    scene, params, latch, y0 = _falling_ball()
+    g = abs(scene.gravity)
+    heights = [4.5, 4.0, 3.0, 2.0]
+    seen = []
+
+    def rearm(t, y):
+        seen.append((t, y[_core.STATE_NAMES.index("z")]))
+        if len(seen) == len(heights):
+            return None
+        return event.coefficients, -heights[len(seen)], latch
+    event = LinearEvent.of_state("z", 1.0, -heights[0], terminal=True, direction=-1)
+    event.rearm = rearm
+    sol = _radau5.solve_system(params, latch, 0, (0.0, 2.0), y0, rtol=1e-10, atol=1e-10,
+                               events=[event])
+    expected = [math.sqrt(2 * (5.0 - h) / g) for h in heights]
+    assert sol.status == 1 and sol.n_rearmed == 3
+    np.testing.assert_allclose([t for t, _ in seen], expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose([z for _, z in seen], heights, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(sol.t_events[0], expected[-1:], rtol=0, atol=1e-12)
+    assert sol.t[-1] == sol.t_events[0][0]
+    for t_rearm in expected[:-1]:   # each re-arming state is a stored step end
+        assert np.min(np.abs(sol.t - t_rearm)) < 1e-12
+    np.testing.assert_allclose(sol.y[_core.STATE_NAMES.index("z")],
+                               5.0 - g * sol.t ** 2 / 2, rtol=0, atol=1e-11)
+
+
+def test_a_re_arming_that_fails_is_reported():
+    scene, params, latch, y0 = _falling_ball()
+
+    def broken(t, y):
+        raise RuntimeError("rearm broke")
+
+    def wrong_shape(t, y):
+        return np.ones(3), 0.0, latch
+    for rearm, error, match in [(broken, RuntimeError, "rearm broke"),
+                                (wrong_shape, ValueError, "rearm coefficients")]:
+        event = LinearEvent.of_state("z", 1.0, -4.0, terminal=True, direction=-1)
+        event.rearm = rearm
+        with pytest.raises(error, match=match):
+            _radau5.solve_system(params, latch, 0, (0.0, 2.0), y0, rtol=1e-8, atol=1e-8,
+                                 events=[event])
+    event = LinearEvent.of_state("z", 1.0, -4.0, terminal=True, direction=-1)
+    event.rearm = broken
+    with pytest.raises(TypeError, match="re-arm"):
+        _radau5.solve_linear(np.eye(_core.N_STATES), (0.0, 1.0), y0, rtol=1e-8, atol=1e-8,
+                             events=[event])

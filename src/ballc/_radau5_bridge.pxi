@@ -32,6 +32,7 @@ cdef extern from "_radau5_solver.h":
     ctypedef int (*radau5_fun)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_jac)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_event_fun)(void *, int, double, const double *, double *) noexcept nogil
+    ctypedef int (*radau5_rearm_fun)(void *, int, double, const double *) noexcept nogil
     ctypedef struct radau5_problem:
         int n
         radau5_fun fun
@@ -56,6 +57,8 @@ cdef extern from "_radau5_solver.h":
         int controller
         int outputs_checked
         int refine_events
+        const int *ev_rearm
+        radau5_rearm_fun rearm
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -65,6 +68,7 @@ cdef extern from "_radau5_solver.h":
         double *t_out
         double *y_out
         long n_hits
+        long n_rearmed
         int *hit_event
         double *hit_t
         double *hit_y
@@ -91,6 +95,10 @@ ctypedef struct ball_ctx:
                              # -2 - k the user's Python event k
     void *user_events        # list of the user's event callables (borrowed)
     void *errors             # list collecting exceptions raised by them (borrowed)
+    void *rearms             # per event: its ``rearm`` callable or None (borrowed)
+    double *latch_w          # the latch (writable: a re-armed event may change it)
+    double *ev_coef_w        # the event arrays radau5 reads (events x N_STATES, events)
+    double *ev_offset_w
 
 cdef int _ball_fun(void *ctx, double t, const double *y, double *f) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
@@ -131,6 +139,44 @@ cdef int _user_event(ball_ctx *c, int k, double t, const double *y, double *g) n
         errors.append(error)
         g[0] = NAN
         return -1
+
+cdef int _ball_rearm(void *ctx, int e, double t, const double *y) noexcept nogil:
+    with gil:
+        return _rearm_event(<ball_ctx *>ctx, e, t, y)
+
+
+cdef int _rearm_event(ball_ctx *c, int e, double t, const double *y) noexcept:
+    """Call event e's ``rearm(t, y)`` (Python, with the GIL): None declines (the event
+    stops the integration as usual); (coefficients (N_STATES,), offset, latch (N_LATCH,))
+    re-arms it: written where radau5 and the right-hand side read them.  An exception
+    is kept for solve_system to raise, and the event stops the integration meanwhile."""
+    cdef double[::1] yv, cv, lv
+    cdef Py_ssize_t i
+    errors = <list>c.errors
+    if errors:
+        return 0
+    try:
+        state = np.empty(BALLC_N_STATES)
+        yv = state
+        memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+        out = (<list>c.rearms)[e](t, state)
+        if out is None:
+            return 0
+        coefficients, offset, latch = out
+        cv = _vector("rearm coefficients", coefficients, BALLC_N_STATES)
+        lv = _vector("rearm latch", latch, BALLC_N_LATCH)
+        offset = float(offset)
+        if not isfinite(offset):
+            raise ValueError(f"rearm offset = {offset!r} is not allowed: must be finite")
+        memcpy(c.ev_coef_w + <size_t>e * BALLC_N_STATES, &cv[0],
+               BALLC_N_STATES * sizeof(double))
+        c.ev_offset_w[e] = offset
+        memcpy(c.latch_w, &lv[0], BALLC_N_LATCH * sizeof(double))
+        return 1
+    except BaseException as error:
+        errors.append(error)
+        return 0
+
 
 ctypedef struct linear_ctx:
     int n
@@ -223,31 +269,31 @@ def _event_arrays(events, int n):
     """Linear events (``coefficients``, ``offset``), stick-release events
     (``stick_plane``, ``offset``: g = mu N - |lambda| + offset, evaluated in C) and, for
     ballc's system, any other callable g(t, y) (a user event, called from C).
-    Returns (m, coef, offset, ints, user callables); ``ints`` (4 rows): terminal,
-    direction, plane (-1 linear, 0/1 stick release, -2 - k the user's event k) and
-    nonlinear (not evaluated from ``coef``)."""
+    Returns (m, coef, offset, ints, user callables, rearms); ``ints`` (5 rows):
+    terminal, direction, plane (-1 linear, 0/1 stick release, -2 - k the user's event
+    k), nonlinear (not evaluated from ``coef``) and re-armable (a terminal linear event
+    with a ``rearm`` callable, see solve_system); ``rearms``: per event, that callable
+    or None."""
     cdef Py_ssize_t m = len(events), k, i, size = max(len(events), 1)
     coef = np.zeros((size, n))
     reals = np.zeros(size)
-    ints = np.zeros((4, size), dtype=np.intc)
+    ints = np.zeros((5, size), dtype=np.intc)
     cdef double[:, ::1] cv = coef
     cdef double[::1] offset = reals
-    cdef int[:, ::1] iv = ints   # terminal, direction, plane, nonlinear
-    cdef const double[::1] row
+    cdef int[:, ::1] iv = ints   # terminal, direction, plane, nonlinear, re-armable
     iv[2, :] = -1
     users = []
+    rearms = [None] * m
     for k in range(m):
         e = events[k]
         c = getattr(e, "coefficients", None)   # the driver's events are LinearEvents
         if c is not None:
-            if not (isinstance(c, np.ndarray) and c.shape == (n,) and c.dtype == np.float64
-                    and c.flags.c_contiguous):
+            if not (type(c) is np.ndarray and c.shape == (n,) and c.dtype == np.float64):
                 c = _vector(f"events[{k}].coefficients", c, n)
-            row = c
+            coef[k] = c   # one row copy (no view per event: they cost more than the copy)
             for i in range(n):
-                if not isfinite(row[i]):
+                if not isfinite(cv[k, i]):
                     _vector(f"events[{k}].coefficients", c, n)   # raises, naming it
-                cv[k, i] = row[i]
             offset[k] = float(getattr(e, "offset", 0.0))
         elif hasattr(e, "stick_plane"):
             iv[2, k] = int(e.stick_plane)
@@ -264,7 +310,11 @@ def _event_arrays(events, int n):
         iv[0, k] = bool(getattr(e, "terminal", False))
         dirn = float(getattr(e, "direction", 0))
         iv[1, k] = (dirn > 0) - (dirn < 0)
-    return m, coef, reals, ints, users
+        rearm = getattr(e, "rearm", None)
+        if rearm is not None and c is not None and iv[0, k]:
+            rearms[k] = rearm
+            iv[4, k] = 1
+    return m, coef, reals, ints, users, rearms
 
 
 cdef extern from "_radau5_solver.h":
@@ -357,7 +407,7 @@ cdef object _run(radau5_problem *p, int n, int m):
             memcpy(&hyv[0, 0], r.hit_y, r.n_hits * n * sizeof(double))
         status, message, r_hits = r.status, r.message.decode(), r.n_hits
         counts = dict(nfev=r.nfev, njev=r.njev, nlu=r.nlu, nstep=r.nstep, nreject=r.nreject,
-                      h_next=r.h_next)
+                      h_next=r.h_next, n_rearmed=r.n_rearmed)
         if r.profiled:   # a -DRADAU5_PROFILE build (benchmarks/profile_step.py)
             counts["profile"] = dict(zip(("fun", "jac", "factor", "solve", "events",
                                           "total", "total_ns"), [r.prof[i] for i in range(7)]))
@@ -405,7 +455,9 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    rtol, atol, max_step, t_eval, events, first_step, max_nfev,
                    radau5_event_fun event_fun=NULL, int[::1] event_plane=None,
                    list users=None, bint dense_output=False, controller=None,
-                   bint outputs_checked=False, bint refine_events=True):
+                   bint outputs_checked=False, bint refine_events=True,
+                   ball_ctx *ball=NULL):
+    """``ball``: ballc's system context (solve_system), which re-arms events."""
     cdef radau5_problem p
     cdef int ctrl = _controller_bits(controller)
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
@@ -415,10 +467,16 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     t0, t1, rtol, atol_v, max_step, t_eval, first = _options(
         n, t0, t1, rtol, atol, max_step, t_eval, first_step)
     y0 = _vector("y0", y0, n)
-    m, coef, offset, ints, found = _event_arrays(list(events or ()), n)
-    cdef int[:, ::1] iv = ints   # terminal, direction, plane, nonlinear
+    m, coef, offset, ints, found, rearms = _event_arrays(list(events or ()), n)
+    cdef int[:, ::1] iv = ints   # terminal, direction, plane, nonlinear, re-armable
     cdef Py_ssize_t k
+    cdef bint rearmable = False
     for k in range(m):
+        if iv[4, k]:
+            if ball == NULL:
+                raise TypeError("this system does not re-arm events (a `rearm` callable "
+                                "needs ballc's system: solve_system)")
+            rearmable = True
         if event_plane is not None:   # the system evaluates its own events: it reads the planes
             event_plane[k] = iv[2, k]
         elif iv[3, k]:
@@ -462,6 +520,14 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.controller = ctrl
     p.outputs_checked = outputs_checked
     p.refine_events = refine_events
+    p.ev_rearm = NULL
+    p.rearm = NULL
+    if rearmable:
+        ball.rearms = <void *>rearms
+        ball.ev_coef_w = &coefv[0, 0]
+        ball.ev_offset_w = &offv[0]
+        p.ev_rearm = &iv[4, 0]
+        p.rearm = _ball_rearm
     return _run(&p, n, m)
 
 
@@ -476,7 +542,14 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     or with ``stick_plane`` (0 floor, 1 ceiling) instead of ``coefficients``: the
     stick-to-slip margin mu N - |lambda| + offset of that plane, evaluated in C; or
     any other callable g(t, y) with optional ``terminal``/``direction`` (called from C
-    with the GIL; an exception it raises is re-raised after the integration).
+    with the GIL; an exception it raises is re-raised after the integration).  A
+    terminal linear event may carry ``rearm``: a callable (t, y) -> None or
+    (coefficients, offset, latch), called at the event's state (with refine_events,
+    once the integration has stepped to its time).  None stops the integration there as
+    usual; a triple re-arms it: the event becomes coefficients . y + offset, the system
+    goes on with ``latch`` (which must leave the right-hand side unchanged at and just
+    past the event), the integration continues from the event's state with its step
+    size, Jacobian and history, and the hit is not reported (``n_rearmed`` counts them).
     Returns a solve_ivp-shaped OptimizeResult (t, y, t_events, y_events, status,
     message, success, nfev, njev, nlu) plus nstep and nreject (``y`` is the transpose of
     the solver's rows: shape (N_STATES, samples), Fortran order), and ``dense``: with
@@ -491,7 +564,7 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     """
     cdef ball_ctx ctx
     params = _vector("params", params, BALLC_N_PARAMETERS)
-    latch = _vector("latch", latch, BALLC_N_LATCH)
+    latch = np.array(_vector("latch", latch, BALLC_N_LATCH))   # own copy: re-arming writes it
     cdef double[::1] pv = params, lv = latch
     planes_array = np.empty(max(len(events or ()), 1), dtype=np.intc)
     planes_array.fill(-1)
@@ -499,6 +572,7 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ctx.params = &pv[0]
     ballc_parameters_init(&ctx.prepared, &pv[0])
     ctx.latch = &lv[0]
+    ctx.latch_w = &lv[0]
     ctx.flags = flags
     ctx.event_plane = &planes[0]
     users, errors = [], []
@@ -508,7 +582,7 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes,
                  users, bool(dense_output), controller,
                  True,   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
-                 bool(refine_events))
+                 bool(refine_events), &ctx)
     if errors:
         raise errors[0]
     return sol

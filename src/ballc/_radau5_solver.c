@@ -1002,8 +1002,21 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
             if (terminate < 0) goto oom;
             if (terminate) {   /* handle_events stored the hit's state, from the dense output */
                 double *hit = r->hit_y + (size_t)(r->n_hits - 1) * n;
-                if (p->refine_events && step_to_event(&s, t_out, hit) < 0) goto oom;
+                const int e_hit = r->hit_event[r->n_hits - 1];
+                int refined = 0;
+                if (p->refine_events && (refined = step_to_event(&s, t_out, hit)) < 0) goto oom;
                 y_out = hit;
+                if (refined == 1 && p->rearm != NULL && p->ev_rearm != NULL
+                        && p->ev_rearm[e_hit] && p->rearm(p->ctx, e_hit, s.t, s.y) == 1) {
+                    /* re-armed: no stop and no hit; go on from the event's state (the
+                     * solver's, a step's end) with the new event */
+                    r->n_hits--;
+                    r->n_rearmed++;
+                    terminate = 0;
+                    y_out = s.y;
+                    finished = s.direction * (s.t - p->t_bound) >= 0;
+                    for (int e = 0; e < m; e++) s.g_new[e] = event_value(&s, e, s.t, s.y);
+                }
             }
             memcpy(s.g, s.g_new, m * sizeof(double));
         }

@@ -37,6 +37,13 @@ typedef int (*radau5_jac)(void *ctx, double t, const double *y, double *jac);
 /* *g = value of the system-defined (non-linear) event ``e`` at (t, y), before its offset.
  * Return 0 on success. */
 typedef int (*radau5_event_fun)(void *ctx, int e, double t, const double *y, double *g);
+/* Re-arm terminal event ``e`` at its hit (t, y), or decline.  Returns 1 when it has
+ * written the event's new coefficients and offset into the arrays behind ev_coef and
+ * ev_offset (and updated whatever else of ctx the right-hand side reads, which must
+ * then be unchanged at and just past (t, y)): the integration goes on from (t, y) with
+ * its step size, Jacobian and history, and the hit is not stored.  Returns 0 to stop
+ * there as any terminal event. */
+typedef int (*radau5_rearm_fun)(void *ctx, int e, double t, const double *y);
 
 typedef struct {
     int n;                    /* number of states */
@@ -66,6 +73,8 @@ typedef struct {
     int refine_events;        /* nonzero: the state at a terminal event is a step's end
                                * point (the crossing step is taken again from its start
                                * to the event's time), not the dense output's value */
+    const int *ev_rearm;      /* may be NULL; nonzero: the terminal event may be re-armed */
+    radau5_rearm_fun rearm;   /*   by rearm (only where refine_events stepped to its time) */
 } radau5_problem;
 
 /* Step control: scipy's Radau (0) or elements of Hairer & Wanner's RADAU5 (radau5.f,
@@ -107,7 +116,8 @@ typedef struct {
     long n_out;               /* stored points: t_out (n_out), y_out (n_out x n) */
     double *t_out;
     double *y_out;
-    long n_hits;              /* event occurrences, in the order found */
+    long n_hits;              /* event occurrences, in the order found (not the re-armed) */
+    long n_rearmed;           /* terminal events re-armed (see radau5_rearm_fun) */
     int *hit_event;
     double *hit_t;
     double *hit_y;            /* n_hits x n */

@@ -29,10 +29,14 @@ class LinearEvent:
 
     Callable like a solve_ivp event, ``event(t, y)``, with solve_ivp's ``terminal``
     and ``direction`` attributes; radau5 reads ``coefficients`` and ``offset`` and
-    evaluates it in C.  Every event of the driver is of this form.
+    evaluates it in C.  Every event of the driver is of this form.  ``rearm`` (None, or
+    a callable (t, y) -> None or (coefficients, offset, latch)): radau5 may re-arm the
+    event where it fires instead of stopping (see ``ballc._radau5.solve_system``);
+    scipy's methods ignore it.
     """
 
-    __slots__ = ("coefficients", "offset", "terminal", "direction", "_index", "_scale")
+    __slots__ = ("coefficients", "offset", "terminal", "direction", "_index", "_scale",
+                 "rearm")
 
     def __init__(self, coefficients, offset=0.0, terminal=False, direction=0):
         self.coefficients = np.array(coefficients, dtype=float)
@@ -42,6 +46,7 @@ class LinearEvent:
         self.offset = float(offset)
         self.terminal = bool(terminal)
         self.direction = direction
+        self.rearm = None
         nonzero = np.flatnonzero(self.coefficients)
         # one state only (all of the driver's): skip the dot product when called
         self._index = int(nonzero[0]) if nonzero.size == 1 else None
@@ -56,6 +61,7 @@ class LinearEvent:
         event.coefficients, event.offset = coefficients, float(offset)
         event.terminal, event.direction = bool(terminal), direction
         event._index, event._scale = None, 0.0   # several states: the dot product
+        event.rearm = None
         return event
 
     @classmethod
@@ -74,6 +80,7 @@ class LinearEvent:
         event.offset = self.offset + float(delta)
         event.terminal = bool(terminal)
         event.direction = direction
+        event.rearm = None
         return event
 
     def __call__(self, t, y):
@@ -127,7 +134,7 @@ def contact_threshold(scene, plane, rho0, entering):
 
 
 def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
-                    clear=0.0, approach=None):
+                    clear=0.0, approach=None, rearm=None):
     """Events of one segment starting at state y0: [(kind, plane, event)].
 
     ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
@@ -136,7 +143,8 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
     free slip's approach event fires when it is not ``clear`` (a slip passing by
     zero).  The stop and release events sit a rounding-level margin past their zero,
     so that a segment starting on it (slip from rest, a stick that starts at the cone)
-    does not fire at once.
+    does not fire at once.  ``rearm`` (optional): plane -> the ``rearm`` callable of
+    that plane's approach event (see :class:`LinearEvent`).
     """
     events = []
     for plane in PLANES:
@@ -157,7 +165,10 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
             if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
                 speed = approach.get(plane) if approach else None
                 speed = clear if speed is None else speed
-                events.append(("approach", plane, LinearEvent.over(along, -speed, True, -1)))
+                event = LinearEvent.over(along, -speed, True, -1)
+                if rearm is not None:
+                    event.rearm = rearm(plane)
+                events.append(("approach", plane, event))
             else:                # fixed direction: stop at u . d = 0, or go free at 2 clear
                 margin = 4 * math.ulp(stickslip.speed_scale(scene, y0))
                 events.append(("stop", plane, LinearEvent.over(along, margin, True, -1)))

@@ -26,12 +26,19 @@ class Samples:
         self._latches.append(latch.copy())
         self._counts.append(t.size)
 
-    def add_later(self, t, y, after, first, flags, latch):
+    def add_later(self, t, y, after, first, flags, latch, changes=()):
         """Store a segment's samples from index ``first`` on that are later than time
-        ``after`` (``t`` is non-decreasing: the others are the first few)."""
+        ``after`` (``t`` is non-decreasing: the others are the first few).  ``changes``:
+        (time, latch before it) where the latch changed within the segment (a re-armed
+        event): the samples up to each such time were computed with that latch, the
+        rest with ``latch``."""
         n = t.size
         while first < n and t[first] <= after:
             first += 1
+        for when, before in changes:
+            cut = max(first, int(np.searchsorted(t, when, side="right")))
+            self.add(t[first:cut], y[:, first:cut], flags, before)
+            first = cut
         self.add(t[first:], y[:, first:], flags, latch)
 
     @property

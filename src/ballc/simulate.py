@@ -75,6 +75,7 @@ class _Run:
         self.contacts: list[Contact] = []
         self.status, self.message = 0, SUCCESS
         self.last_transition, self.stalled = None, 0   # mode changes that left t unchanged
+        self.rearmed: list[tuple[float, np.ndarray]] = []   # this segment's: (t, latch before)
         self._flags: dict[tuple, int] = {}
 
     def flags(self, with_coulomb=True):
@@ -151,7 +152,7 @@ class _Run:
         """At a contact start: slip freely when |u| is clear of zero, with a fixed
         direction below that, settle (stick, or slip from rest) at u = 0."""
         u = stickslip.slip_velocity(self.params, plane, self.y)
-        speed = float(np.hypot(*u))
+        speed = math.hypot(*u.tolist())
         if speed > 2 * self.clear_speed():
             self.set_mode(plane, "slip", u / speed)
         elif speed > 0:
@@ -171,7 +172,7 @@ class _Run:
                             f"{self.stalled} of them at t = {self.t:.17g} s")
             return
         u = stickslip.slip_velocity(self.params, plane, self.y)
-        speed = float(np.hypot(*u))
+        speed = math.hypot(*u.tolist())
         error = self.error_speed()
         clear = stickslip.CLEAR_FACTOR * error   # = self.clear_speed(), without a second scale
         if kind == "approach":
@@ -183,7 +184,7 @@ class _Run:
                     and (speed > 2 * clear
                          or stickslip.passes_by_zero(u, direction, error)))
             if free:
-                self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))
+                self.set_mode(plane, "slip", u / speed, approach=min(clear, stickslip.APPROACH_FRACTION * speed))
             else:
                 self.set_mode(plane, "slip_fixed", u / speed)
         elif kind == "stop":
@@ -192,7 +193,7 @@ class _Run:
             if speed <= stickslip.STOP_FACTOR * error:
                 self.settle(plane)
             else:
-                self.set_mode(plane, "slip", u / speed, approach=min(clear, speed / 2))
+                self.set_mode(plane, "slip", u / speed, approach=min(clear, stickslip.APPROACH_FRACTION * speed))
         elif kind == "clear":    # clear of zero again: the direction goes free
             self.set_mode(plane, "slip", u / speed)
         else:                    # "release": |lambda| reached mu N; slip from rest along -lambda
@@ -202,6 +203,40 @@ class _Run:
             direction = -lam / size if size > 0 else None
             self.y = _core.remove_slip(self.y, self.params, self.flags(False), index)
             self.set_mode(plane, "slip_fixed", direction)
+
+    def rearm_approach(self, plane):
+        """The ``rearm`` callable of ``plane``'s approach event (see ballc.events): radau5
+        calls it at the event's state, and it takes :meth:`coulomb_event`'s decision
+        there.  When that is to re-latch a free slip (u passes by zero, or has only
+        turned away from d), it applies it and re-arms the event without ending the
+        segment: the right-hand side is the same on both sides (a free slip's force is
+        along u/|u|, turned by d only where u . d < 0, which neither the old nor the new
+        d is there).  Any other outcome, or a limit reached, declines (None) without
+        changing anything: the segment ends and coulomb_event decides as always.  A
+        slip swinging past zero fires the event 3-7 times in a microsecond; re-armed,
+        that is one segment instead of several."""
+        def rearm(t, y):
+            stalled = self.stalled + 1 if t == self.last_transition else 0
+            if (self.transitions[plane] >= stickslip.MAX_TRANSITIONS
+                    or stalled >= stickslip.MAX_STALLED
+                    or self.relatches[plane] + 1 > stickslip.MAX_RELATCH):
+                return None
+            u = stickslip.slip_velocity(self.params, plane, y)
+            speed = math.hypot(*u.tolist())
+            error = stickslip.error_speed(self.scene, y, self.options.rtol, self.options.atol)
+            clear = stickslip.CLEAR_FACTOR * error
+            if not (speed > 2 * clear or stickslip.passes_by_zero(
+                    u, stickslip.slip_direction(self.latch, plane), error)):
+                return None
+            self.stalled, self.last_transition = stalled, t
+            self.relatches[plane] += 1
+            self.rearmed.append((t, self.latch.copy()))
+            direction = u / speed
+            approach = min(clear, stickslip.APPROACH_FRACTION * speed)
+            self.set_mode(plane, "slip", direction, approach=approach)
+            return (stickslip.slip_stop_coefficients(self.params, plane, direction), -approach,
+                    self.latch)
+        return rearm
 
     # ---- one event ----
 
@@ -319,7 +354,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         system = _core.System(run.params, run.latch, flags)
         driver_events = ev.segment_events(scene, run.in_contact, run.y, run.coulomb,
                                           run.params, run.latch, flags, run.clear_speed(),
-                                          run.approach)
+                                          run.approach, run.rearm_approach)
+        run.rearmed = []
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
@@ -332,13 +368,15 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                                 dense_output=options.dense_output,
                                 exact_flight=options.exact_flight)
         first = None
-        nfev += sol.nfev
-        njev += sol.njev
-        nlu += sol.nlu
-        t, t_events, y_events = sol.t, sol.t_events, sol.y_events
+        # every integrator's solution is a solve_ivp-style OptimizeResult, a dict: item
+        # access is a dict lookup (its attribute access goes through a Python __getattr__)
+        nfev += sol["nfev"]
+        njev += sol["njev"]
+        nlu += sol["nlu"]
+        t, t_events, y_events, status = sol["t"], sol["t_events"], sol["y_events"], sol["status"]
         # An event at the segment's very start ends a zero-length segment whose event
         # sample repeats t; keep only later samples so that result.t stays increasing.
-        samples.add_later(t, sol.y, run.t, skip, flags, run.latch)
+        samples.add_later(t, sol["y"], run.t, skip, flags, run.latch, run.rearmed)
         n_driver = len(driver_events)
         fired, t_fired = -1, np.inf   # the earliest terminal event that fired
         for i, hits in enumerate(t_events):
@@ -355,7 +393,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             user_y[k].append(np.asarray(y_events[n_driver + k], dtype=float).reshape(
                 -1, _core.N_STATES))
 
-        if sol.status == -1:
+        if status == -1:
             run.status = -1
             reason = sol.message
             if "max_nfev" in reason:
@@ -367,7 +405,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             if options.dense_output and t.size:
                 pieces.append((run.t, float(t[-1]), sol.interpolant))
             break
-        if sol.status == 0:
+        if status == 0:
             if options.dense_output:
                 pieces.append((run.t, t_end, sol.interpolant))
             run.t = t_end
@@ -385,10 +423,11 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             break
         kind, plane, _ = driver_events[fired]
         run.handle(kind, plane)
-        if kind in CARRY_STEP and getattr(sol, "h_next", 0) > 0:
+        h_next = sol.get("h_next", 0)
+        if kind in CARRY_STEP and h_next > 0:
             # within a contact the dynamics do not jump at a stick/slip transition: go on
             # with the step the controller had chosen instead of a fresh start
-            first = min(sol.h_next, options.max_step)
+            first = min(h_next, options.max_step)
 
     if bar is not None:
         bar.update((t_end if run.status == 0 else run.t) - bar.n)

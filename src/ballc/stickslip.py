@@ -70,6 +70,11 @@ PASS_FACTOR = 3.0
 #: frozen along the wrong direction for 50 us (tests/test_stickslip.py).
 STOP_FACTOR = 10.0
 
+#: A slip that passes by zero is re-latched with its next approach event at
+#: min(clear, APPROACH_FRACTION |u|): u . d falling to that fraction of the slip speed
+#: it had at the event.
+APPROACH_FRACTION = 0.5
+
 #: At most this many re-latches of the slip direction per contact (a direction that
 #: keeps turning away from its latched value) before a stop is forced.
 MAX_RELATCH = 1000
@@ -167,12 +172,27 @@ def _slip_map(params_bytes: bytes, plane: str) -> np.ndarray:
 
 
 def slip_stop_coefficients(params, plane: str, direction) -> np.ndarray:
-    """Coefficients c of the stop event u . d = c . y (u is linear in the state)."""
-    return np.asarray(direction, dtype=float) @ slip_map(params, plane)
+    """Coefficients c of the stop event u . d = c . y (u is linear in the state):
+    d_x du_x/dy + d_y du_y/dy, elementwise (the same bits with every BLAS)."""
+    rows = slip_map(params, plane)
+    return float(direction[0]) * rows[0] + float(direction[1]) * rows[1]
 
 
 def slip_velocity(params, plane: str, y) -> np.ndarray:
-    return slip_map(params, plane) @ y
+    """The slip velocity u (m/s, 2) of ``plane`` at state y: du/dy . y over the few
+    states it depends on, in Python floats in a fixed order (cheaper than a matrix
+    product at this size, and the same bits with every BLAS)."""
+    values = y.tolist() if isinstance(y, np.ndarray) else list(y)
+    return np.array([sum([c * values[j] for j, c in row])
+                     for row in _slip_terms(np.ascontiguousarray(params, dtype=float).tobytes(),
+                                            plane)])
+
+
+@functools.lru_cache(maxsize=16)
+def _slip_terms(params_bytes: bytes, plane: str) -> tuple:
+    """Per row of :func:`slip_map`: its nonzero (state index, coefficient) pairs."""
+    rows = _slip_map(params_bytes, plane)
+    return tuple(tuple((int(j), float(row[j])) for j in np.flatnonzero(row)) for row in rows)
 
 
 def settle(scene, params, latch, base_flags: int, plane: str, y):
