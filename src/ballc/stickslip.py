@@ -13,7 +13,9 @@ about 1e-12 s) makes loose tolerances crawl and chatter:
   misses zero by more than the integration error can explain
   (:func:`passes_by_zero`: a slip that swings past zero, as in the seed scene's
   contacts, which miss it by ~1e-5 m/s); the next approach of such a slip fires at
-  min(clear, |u|/2).
+  min(clear, |u|/2).  Such a re-latch leaves the right-hand side as it is, so radau5
+  makes it without ending the segment (the approach event's ``rearm``, see
+  simulate._Run.rearm_approach).
 * **slip with a fixed direction**: F_t = -mu N d.  Near zero slip u/|u| is singular
   (its Jacobian grows like 1/|u|, and an implicit step across u = 0 cannot converge
   when u misses zero by the integration error), so the last approach to zero and the
