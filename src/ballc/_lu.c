@@ -64,6 +64,7 @@ int ballc_lu_factor(int n, double *a, int *piv)
             ri[k] = l;
             if (l != 0.0) row_update(n - k - 1, l, rk + k + 1, ri + k + 1);
         }
+        rk[k] = 1.0 / rk[k];   /* the solves multiply by it (see _lu.h) */
     }
     return BALLC_LU_OK;
 }
@@ -103,6 +104,7 @@ int ballc_lu_factor_complex(int n, double _Complex *a, int *piv)
                 row_update_complex(n - k - 1, creal(l), cimag(l), (const double *)(rk + k + 1),
                                    (double *)(ri + k + 1));
         }
+        rk[k] = rinv;   /* the solves multiply by it (see _lu.h) */
     }
     return BALLC_LU_OK;
 }
@@ -125,8 +127,8 @@ void ballc_lu_solve(int n, const double *lu, const int *piv, double *b)
         if (bj != 0.0)
             for (int i = j + 1; i < n; i++) b[i] -= lu[(size_t)i * n + j] * bj;
     }
-    for (int j = n - 1; j >= 0; j--) {
-        b[j] /= lu[(size_t)j * n + j];
+    for (int j = n - 1; j >= 0; j--) {   /* the diagonal holds 1 / U(j, j) */
+        b[j] *= lu[(size_t)j * n + j];
         double bj = b[j];
         if (bj != 0.0)
             for (int i = 0; i < j; i++) b[i] -= lu[(size_t)i * n + j] * bj;
@@ -150,7 +152,7 @@ void ballc_lu_solve_complex(int n, const double _Complex *lu, const int *piv,
             for (int i = j + 1; i < n; i++) b[i] -= lu[(size_t)i * n + j] * bj;
     }
     for (int j = n - 1; j >= 0; j--) {
-        b[j] /= lu[(size_t)j * n + j];
+        b[j] *= lu[(size_t)j * n + j];
         double _Complex bj = b[j];
         if (creal(bj) != 0.0 || cimag(bj) != 0.0)
             for (int i = 0; i < j; i++) b[i] -= lu[(size_t)i * n + j] * bj;

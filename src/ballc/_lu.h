@@ -6,7 +6,9 @@
  *
  * Storage: row-major, a[i * n + j] = A(i, j), factored in place as LAPACK's getrf
  * does: P A = L U with L unit lower triangular (its multipliers below the
- * diagonal) and U upper triangular (on and above it).  piv[k] (0-based) is the
+ * diagonal) and U upper triangular (above it), except that the diagonal holds the
+ * reciprocal pivots 1 / U(k, k): a solve's back substitution then multiplies where a
+ * division (~15 cycles, on the substitution's critical path) would stand.  piv[k] (0-based) is the
  * row swapped with row k at step k, applied to the whole row (as LAPACK's ipiv,
  * minus one).
  *

@@ -53,7 +53,8 @@ static const double *law_latch(const double *latch, int plane)
 }
 
 typedef struct {
-    double L[6];   /* Cholesky factor of S, packed lower: L00 L10 L11 L20 L21 L22 */
+    double L[6];   /* Cholesky factor of S, packed lower: L00 L10 L11 L20 L21 L22, */
+    double Linv[3];   /* and the reciprocals of its diagonal (the solves multiply) */
     double B[9];
     double D, inverse_D;
 } schur_t;
@@ -203,25 +204,26 @@ static int schur_factor(const double *mass, schur_t *f)
     l22 = sqrt(l22);
     f->L[0] = l00; f->L[1] = l10; f->L[2] = l11;
     f->L[3] = l20; f->L[4] = l21; f->L[5] = l22;
+    f->Linv[0] = 1.0 / l00; f->Linv[1] = 1.0 / l11; f->Linv[2] = 1.0 / l22;
     return BALLC_OK;
 }
 
 /* Solve M z = b in place (b: 6 = [b_omega; b_v]). */
 static void schur_solve(const schur_t *f, double *b)
 {
-    const double *B = f->B, *L = f->L;
+    const double *B = f->B, *L = f->L, *Li = f->Linv;
     double *bw = b, *bv = b + 3;
     double r[3];
     for (int i = 0; i < 3; i++)
         r[i] = bw[i] - (B[3*i]*bv[0] + B[3*i+1]*bv[1] + B[3*i+2]*bv[2]) * f->inverse_D;
     /* forward: L y = r */
-    double y0 = r[0] / L[0];
-    double y1 = (r[1] - L[1]*y0) / L[2];
-    double y2 = (r[2] - L[3]*y0 - L[4]*y1) / L[5];
+    double y0 = r[0] * Li[0];
+    double y1 = (r[1] - L[1]*y0) * Li[1];
+    double y2 = (r[2] - L[3]*y0 - L[4]*y1) * Li[2];
     /* backward: L^T w = y */
-    double w2 = y2 / L[5];
-    double w1 = (y1 - L[4]*w2) / L[2];
-    double w0 = (y0 - L[1]*w1 - L[3]*w2) / L[0];
+    double w2 = y2 * Li[2];
+    double w1 = (y1 - L[4]*w2) * Li[1];
+    double w0 = (y0 - L[1]*w1 - L[3]*w2) * Li[0];
     bw[0] = w0; bw[1] = w1; bw[2] = w2;
     for (int j = 0; j < 3; j++)
         bv[j] = (bv[j] - (B[j]*w0 + B[3+j]*w1 + B[6+j]*w2)) * f->inverse_D;
