@@ -112,12 +112,17 @@ typedef struct {
     size_t cap_out, cap_hits, cap_dense;
 } solver_t;
 
-/* common.norm: RMS norm. */
+/* common.norm: RMS norm (two partial sums: half the chain of dependent additions). */
 static double rms(const double *x, int n)
 {
-    double s = 0;
-    for (int i = 0; i < n; i++) s += x[i] * x[i];
-    return sqrt(s / n);
+    double s0 = 0, s1 = 0;
+    int i = 0;
+    for (; i + 1 < n; i += 2) {
+        s0 += x[i] * x[i];
+        s1 += x[i + 1] * x[i + 1];
+    }
+    if (i < n) s0 += x[i] * x[i];
+    return sqrt((s0 + s1) / n);
 }
 
 static int call_fun(solver_t *s, double t, const double *y, double *f)
@@ -288,16 +293,19 @@ static int solve_collocation(solver_t *s, double t, double h, double *restrict Z
         }
         solve_real(s, dW);
         solve_complex(s, fc);
-        double sum = 0;
+        double sum0 = 0, sum1 = 0, sum2 = 0;   /* one partial sum per stage: three short
+                                                * chains of dependent additions, not one */
         for (int c = 0; c < n; c++) {
-            dW[n + c] = creal(fc[c]);
-            dW[2 * n + c] = cimag(fc[c]);
-            for (int i = 0; i < 3; i++) {
-                double v = dW[i * n + c] * inv_scale[c];
-                sum += v * v;
-            }
+            double v0 = dW[c] * inv_scale[c], v1 = creal(fc[c]), v2 = cimag(fc[c]);
+            dW[n + c] = v1;
+            dW[2 * n + c] = v2;
+            v1 *= inv_scale[c];
+            v2 *= inv_scale[c];
+            sum0 += v0 * v0;
+            sum1 += v1 * v1;
+            sum2 += v2 * v2;
         }
-        double dW_norm = sqrt(sum / (3 * n));
+        double dW_norm = sqrt((sum0 + sum1 + sum2) / (3 * n));
         if (!isfinite(dW_norm)) break;
         if (have_old) {
             rate = dW_norm / dW_norm_old;
@@ -428,9 +436,10 @@ static int step(solver_t *s)
             continue;
         }
 
+        const double E0 = k->E[0] / h, E1 = k->E[1] / h, E2 = k->E[2] / h;
         for (int c = 0; c < n; c++) {
             y_new[c] = y[c] + Z[2 * n + c];
-            ZE[c] = (Z[c] * k->E[0] + Z[n + c] * k->E[1] + Z[2 * n + c] * k->E[2]) / h;
+            ZE[c] = Z[c] * E0 + Z[n + c] * E1 + Z[2 * n + c] * E2;
             err[c] = s->f[c] + ZE[c];
         }
         solve_real(s, err);
