@@ -150,8 +150,10 @@ cdef int _rearm_event(ball_ctx *c, int e, double t, const double *y) noexcept:
     stops the integration as usual); (coefficients (N_STATES,), offset, latch (N_LATCH,))
     re-arms it: written where radau5 and the right-hand side read them.  An exception
     is kept for solve_system to raise, and the event stops the integration meanwhile."""
-    cdef double[::1] yv, cv, lv
+    cdef double[::1] yv
+    cdef const double[::1] cv, lv
     cdef Py_ssize_t i
+    cdef double off
     errors = <list>c.errors
     if errors:
         return 0
@@ -163,14 +165,14 @@ cdef int _rearm_event(ball_ctx *c, int e, double t, const double *y) noexcept:
         if out is None:
             return 0
         coefficients, offset, latch = out
-        cv = _vector("rearm coefficients", coefficients, BALLC_N_STATES)
-        lv = _vector("rearm latch", latch, BALLC_N_LATCH)
-        offset = float(offset)
-        if not isfinite(offset):
+        cv = _checked_row("rearm coefficients", coefficients, BALLC_N_STATES)
+        lv = _checked_row("rearm latch", latch, BALLC_N_LATCH)
+        off = float(offset)
+        if not isfinite(off):
             raise ValueError(f"rearm offset = {offset!r} is not allowed: must be finite")
         memcpy(c.ev_coef_w + <size_t>e * BALLC_N_STATES, &cv[0],
                BALLC_N_STATES * sizeof(double))
-        c.ev_offset_w[e] = offset
+        c.ev_offset_w[e] = off
         memcpy(c.latch_w, &lv[0], BALLC_N_LATCH * sizeof(double))
         return 1
     except BaseException as error:
@@ -218,6 +220,20 @@ cdef bint _finite_nonnegative(const double[::1] a) noexcept:
         if not (isfinite(a[i]) and a[i] >= 0):
             return False
     return True
+
+
+cdef const double[::1] _checked_row(str name, value, Py_ssize_t n):
+    """``value`` as n finite float64s (one view; ``_vector`` for anything else)."""
+    cdef const double[::1] v
+    cdef Py_ssize_t i
+    if not (type(value) is np.ndarray and value.dtype == np.float64 and value.shape == (n,)
+            and value.flags.c_contiguous):
+        value = _vector(name, value, n)
+    v = value
+    for i in range(n):
+        if not isfinite(v[i]):
+            _vector(name, value, n)   # raises, naming it
+    return v
 
 
 def _vector(name, value, n):

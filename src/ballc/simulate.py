@@ -215,23 +215,27 @@ class _Run:
         changing anything: the segment ends and coulomb_event decides as always.  A
         slip swinging past zero fires the event 3-7 times in a microsecond; re-armed,
         that is one segment instead of several."""
-        def rearm(t, y):
+        terms = stickslip.slip_terms(self.params, plane)
+        rtol, atol = self.options.rtol, self.options.atol
+
+        def rearm(t, y):   # Python floats where coulomb_event has arrays: the same values
             stalled = self.stalled + 1 if t == self.last_transition else 0
             if (self.transitions[plane] >= stickslip.MAX_TRANSITIONS
                     or stalled >= stickslip.MAX_STALLED
                     or self.relatches[plane] + 1 > stickslip.MAX_RELATCH):
                 return None
-            u = stickslip.slip_velocity(self.params, plane, y)
-            speed = math.hypot(*u.tolist())
-            error = stickslip.error_speed(self.scene, y, self.options.rtol, self.options.atol)
+            values = y.tolist()
+            u = stickslip.slip_velocity_of(terms, values)
+            speed = math.hypot(*u)
+            error = stickslip.error_speed(self.scene, values, rtol, atol)
             clear = stickslip.CLEAR_FACTOR * error
             if not (speed > 2 * clear or stickslip.passes_by_zero(
-                    u, stickslip.slip_direction(self.latch, plane), error)):
+                    u, stickslip.slip_direction(self.latch, plane).tolist(), error)):
                 return None
             self.stalled, self.last_transition = stalled, t
             self.relatches[plane] += 1
             self.rearmed.append((t, self.latch.copy()))
-            direction = u / speed
+            direction = np.array([u[0] / speed, u[1] / speed])
             approach = min(clear, stickslip.APPROACH_FRACTION * speed)
             self.set_mode(plane, "slip", direction, approach=approach)
             return (stickslip.slip_stop_coefficients(self.params, plane, direction), -approach,

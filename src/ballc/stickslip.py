@@ -185,9 +185,19 @@ def slip_velocity(params, plane: str, y) -> np.ndarray:
     states it depends on, in Python floats in a fixed order (cheaper than a matrix
     product at this size, and the same bits with every BLAS)."""
     values = y.tolist() if isinstance(y, np.ndarray) else list(y)
-    return np.array([sum([c * values[j] for j, c in row])
-                     for row in _slip_terms(np.ascontiguousarray(params, dtype=float).tobytes(),
-                                            plane)])
+    return np.array(slip_velocity_of(slip_terms(params, plane), values))
+
+
+def slip_terms(params, plane: str) -> tuple:
+    """Per row of :func:`slip_map`: its nonzero (state index, coefficient) pairs (kept
+    per parameter vector)."""
+    return _slip_terms(np.ascontiguousarray(params, dtype=float).tobytes(), plane)
+
+
+def slip_velocity_of(terms, values) -> tuple:
+    """(u_x, u_y) (m/s, Python floats) from :func:`slip_terms` and the state as a list:
+    what :func:`slip_velocity` computes, for callers that keep the terms."""
+    return tuple(sum([c * values[j] for j, c in row]) for row in terms)
 
 
 @functools.lru_cache(maxsize=16)
