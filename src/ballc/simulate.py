@@ -77,6 +77,7 @@ class _Run:
         self.last_transition, self.stalled = None, 0   # mode changes that left t unchanged
         self.rearmed: list[tuple[float, np.ndarray]] = []   # this segment's: (t, latch before)
         self._flags: dict[tuple, int] = {}
+        self._slip_terms = {plane: stickslip.slip_terms(self.params, plane) for plane in PLANES}
 
     def flags(self, with_coulomb=True):
         key = (self.in_contact["floor"], self.in_contact["ceiling"],
@@ -126,9 +127,6 @@ class _Run:
     def clear_speed(self):
         return stickslip.clear_speed(self.scene, self.y, self.options.rtol, self.options.atol)
 
-    def error_speed(self):
-        return stickslip.error_speed(self.scene, self.y, self.options.rtol, self.options.atol)
-
     def set_mode(self, plane, mode, direction=None, approach=None):
         """Enter ``mode`` on ``plane`` now; the contact records when each phase of slip
         or stick begins.  ``approach``: the slip speed u . d (m/s) at which a free slip's
@@ -151,12 +149,11 @@ class _Run:
     def start_coulomb(self, plane):
         """At a contact start: slip freely when |u| is clear of zero, with a fixed
         direction below that, settle (stick, or slip from rest) at u = 0."""
-        u = stickslip.slip_velocity(self.params, plane, self.y)
-        speed = math.hypot(*u.tolist())
-        if speed > 2 * self.clear_speed():
-            self.set_mode(plane, "slip", u / speed)
+        u, speed, _, clear = self.slip(plane, self.y)
+        if speed > 2 * clear:
+            self.set_mode(plane, "slip", np.array([u[0] / speed, u[1] / speed]))
         elif speed > 0:
-            self.set_mode(plane, "slip_fixed", u / speed)
+            self.set_mode(plane, "slip_fixed", np.array([u[0] / speed, u[1] / speed]))
         else:
             self.settle(plane)
 
@@ -171,31 +168,26 @@ class _Run:
                             f"{self.transitions[plane]} mode changes in one contact, "
                             f"{self.stalled} of them at t = {self.t:.17g} s")
             return
-        u = stickslip.slip_velocity(self.params, plane, self.y)
-        speed = math.hypot(*u.tolist())
-        error = self.error_speed()
-        clear = stickslip.CLEAR_FACTOR * error   # = self.clear_speed(), without a second scale
+        u, speed, error, clear = self.slip(plane, self.y)
+        direction = np.array([u[0] / speed, u[1] / speed]) if speed > 0 else None
         if kind == "approach":
             # u . d fell to its threshold: u is near zero, passing by it, or has only
             # turned away from d
             self.relatches[plane] += 1
-            direction = stickslip.slip_direction(self.latch, plane)
-            free = (self.relatches[plane] <= stickslip.MAX_RELATCH
-                    and (speed > 2 * clear
-                         or stickslip.passes_by_zero(u, direction, error)))
-            if free:
-                self.set_mode(plane, "slip", u / speed, approach=min(clear, stickslip.APPROACH_FRACTION * speed))
+            if (self.relatches[plane] <= stickslip.MAX_RELATCH
+                    and self.slips_on_freely(plane, u, speed, error, clear)):
+                self.set_mode(plane, "slip", direction, approach=self.approach_speed(clear, speed))
             else:
-                self.set_mode(plane, "slip_fixed", u / speed)
+                self.set_mode(plane, "slip_fixed", direction)
         elif kind == "stop":
             # u . d = 0 with the direction held: a slip left within the integration error
             # is error (settle); one beyond it passes by zero and slips on freely
             if speed <= stickslip.STOP_FACTOR * error:
                 self.settle(plane)
             else:
-                self.set_mode(plane, "slip", u / speed, approach=min(clear, stickslip.APPROACH_FRACTION * speed))
+                self.set_mode(plane, "slip", direction, approach=self.approach_speed(clear, speed))
         elif kind == "clear":    # clear of zero again: the direction goes free
-            self.set_mode(plane, "slip", u / speed)
+            self.set_mode(plane, "slip", direction)
         else:                    # "release": |lambda| reached mu N; slip from rest along -lambda
             index = PLANES.index(plane)
             lam = _core.stick_state(self.y, self.params, self.latch, self.flags(), index)[:2]
@@ -203,6 +195,26 @@ class _Run:
             direction = -lam / size if size > 0 else None
             self.y = _core.remove_slip(self.y, self.params, self.flags(False), index)
             self.set_mode(plane, "slip_fixed", direction)
+
+    def slip(self, plane, y):
+        """(u (m/s, two floats), |u|, error scale, clear speed) of ``plane``'s slip at
+        state y (see stickslip.error_speed and clear_speed)."""
+        values = y.tolist()
+        u = stickslip.slip_velocity_of(self._slip_terms[plane], values)
+        error = stickslip.error_speed(self.scene, values, self.options.rtol, self.options.atol)
+        return u, math.hypot(*u), error, stickslip.CLEAR_FACTOR * error
+
+    def slips_on_freely(self, plane, u, speed, error, clear):
+        """At an approach: whether the slip is not coming to rest but only turned away
+        from d (|u| still clear of zero) or passing by zero (stickslip.passes_by_zero):
+        then its direction is re-latched and stays free."""
+        return speed > 2 * clear or stickslip.passes_by_zero(
+            u, stickslip.slip_direction(self.latch, plane).tolist(), error)
+
+    @staticmethod
+    def approach_speed(clear, speed):
+        """Where a re-latched free slip's next approach fires (u . d, m/s)."""
+        return min(clear, stickslip.APPROACH_FRACTION * speed)
 
     def rearm_approach(self, plane):
         """The ``rearm`` callable of ``plane``'s approach event (see ballc.events): radau5
@@ -215,28 +227,20 @@ class _Run:
         changing anything: the segment ends and coulomb_event decides as always.  A
         slip swinging past zero fires the event 3-7 times in a microsecond; re-armed,
         that is one segment instead of several."""
-        terms = stickslip.slip_terms(self.params, plane)
-        rtol, atol = self.options.rtol, self.options.atol
-
-        def rearm(t, y):   # Python floats where coulomb_event has arrays: the same values
+        def rearm(t, y):
             stalled = self.stalled + 1 if t == self.last_transition else 0
             if (self.transitions[plane] >= stickslip.MAX_TRANSITIONS
                     or stalled >= stickslip.MAX_STALLED
                     or self.relatches[plane] + 1 > stickslip.MAX_RELATCH):
                 return None
-            values = y.tolist()
-            u = stickslip.slip_velocity_of(terms, values)
-            speed = math.hypot(*u)
-            error = stickslip.error_speed(self.scene, values, rtol, atol)
-            clear = stickslip.CLEAR_FACTOR * error
-            if not (speed > 2 * clear or stickslip.passes_by_zero(
-                    u, stickslip.slip_direction(self.latch, plane).tolist(), error)):
+            u, speed, error, clear = self.slip(plane, y)
+            if not self.slips_on_freely(plane, u, speed, error, clear):
                 return None
             self.stalled, self.last_transition = stalled, t
             self.relatches[plane] += 1
             self.rearmed.append((t, self.latch.copy()))
             direction = np.array([u[0] / speed, u[1] / speed])
-            approach = min(clear, stickslip.APPROACH_FRACTION * speed)
+            approach = self.approach_speed(clear, speed)
             self.set_mode(plane, "slip", direction, approach=approach)
             return (stickslip.slip_stop_coefficients(self.params, plane, direction), -approach,
                     self.latch)
