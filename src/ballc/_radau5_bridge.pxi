@@ -290,13 +290,14 @@ def _event_arrays(events, int n):
     k), nonlinear (not evaluated from ``coef``) and re-armable (a terminal linear event
     with a ``rearm`` callable, see solve_system); ``rearms``: per event, that callable
     or None."""
-    cdef Py_ssize_t m = len(events), k, i, size = max(len(events), 1)
+    cdef Py_ssize_t m = len(events), k, size = max(len(events), 1)
     coef = np.zeros((size, n))
     reals = np.zeros(size)
     ints = np.zeros((5, size), dtype=np.intc)
     cdef double[:, ::1] cv = coef
     cdef double[::1] offset = reals
     cdef int[:, ::1] iv = ints   # terminal, direction, plane, nonlinear, re-armable
+    cdef const double[::1] row
     iv[2, :] = -1
     users = []
     rearms = [None] * m
@@ -304,12 +305,8 @@ def _event_arrays(events, int n):
         e = events[k]
         c = getattr(e, "coefficients", None)   # the driver's events are LinearEvents
         if c is not None:
-            if not (type(c) is np.ndarray and c.shape == (n,) and c.dtype == np.float64):
-                c = _vector(f"events[{k}].coefficients", c, n)
-            coef[k] = c   # one row copy (no view per event: they cost more than the copy)
-            for i in range(n):
-                if not isfinite(cv[k, i]):
-                    _vector(f"events[{k}].coefficients", c, n)   # raises, naming it
+            row = _checked_row(f"events[{k}].coefficients", c, n)
+            cv[k, :] = row
             offset[k] = float(getattr(e, "offset", 0.0))
         elif hasattr(e, "stick_plane"):
             iv[2, k] = int(e.stick_plane)
