@@ -56,6 +56,11 @@ def check_initial_state(scene, y0):
     return y
 
 
+def _unit(u, speed):
+    """u / |u| as an array (u: two floats, speed: |u| > 0)."""
+    return np.array([u[0] / speed, u[1] / speed])
+
+
 class _Run:
     """The state of one simulation between segments: contacts, modes and latches."""
 
@@ -151,25 +156,24 @@ class _Run:
         direction below that, settle (stick, or slip from rest) at u = 0."""
         u, speed, _, clear = self.slip(plane, self.y)
         if speed > 2 * clear:
-            self.set_mode(plane, "slip", np.array([u[0] / speed, u[1] / speed]))
+            self.set_mode(plane, "slip", _unit(u, speed))
         elif speed > 0:
-            self.set_mode(plane, "slip_fixed", np.array([u[0] / speed, u[1] / speed]))
+            self.set_mode(plane, "slip_fixed", _unit(u, speed))
         else:
             self.settle(plane)
 
     def coulomb_event(self, kind, plane):
         """The next exact-Coulomb mode after event ``kind`` on ``plane`` (see stickslip)."""
-        self.stalled = self.stalled + 1 if self.t == self.last_transition else 0
+        self.stalled = self.stalled_at(self.t)
         self.last_transition = self.t
-        if (self.transitions[plane] >= stickslip.MAX_TRANSITIONS
-                or self.stalled >= stickslip.MAX_STALLED):
+        if self.unsettled(plane, self.stalled):
             self.status = -1
             self.message = (f"stick-slip transitions on the {plane} did not settle: "
                             f"{self.transitions[plane]} mode changes in one contact, "
                             f"{self.stalled} of them at t = {self.t:.17g} s")
             return
         u, speed, error, clear = self.slip(plane, self.y)
-        direction = np.array([u[0] / speed, u[1] / speed]) if speed > 0 else None
+        direction = _unit(u, speed) if speed > 0 else None
         if kind == "approach":
             # u . d fell to its threshold: u is near zero, passing by it, or has only
             # turned away from d
@@ -195,6 +199,16 @@ class _Run:
             direction = -lam / size if size > 0 else None
             self.y = _core.remove_slip(self.y, self.params, self.flags(False), index)
             self.set_mode(plane, "slip_fixed", direction)
+
+    def stalled_at(self, t):
+        """How many mode changes in a row a change at time t makes without time moving on."""
+        return self.stalled + 1 if t == self.last_transition else 0
+
+    def unsettled(self, plane, stalled):
+        """Whether ``plane``'s stick-slip transitions have reached a limit (too many in
+        one contact, or ``stalled`` at one time): then they do not settle."""
+        return (self.transitions[plane] >= stickslip.MAX_TRANSITIONS
+                or stalled >= stickslip.MAX_STALLED)
 
     def slip(self, plane, y):
         """(u (m/s, two floats), |u|, error scale, clear speed) of ``plane``'s slip at
@@ -228,9 +242,8 @@ class _Run:
         slip swinging past zero fires the event 3-7 times in a microsecond; re-armed,
         that is one segment instead of several."""
         def rearm(t, y):
-            stalled = self.stalled + 1 if t == self.last_transition else 0
-            if (self.transitions[plane] >= stickslip.MAX_TRANSITIONS
-                    or stalled >= stickslip.MAX_STALLED
+            stalled = self.stalled_at(t)
+            if (self.unsettled(plane, stalled)
                     or self.relatches[plane] + 1 > stickslip.MAX_RELATCH):
                 return None
             u, speed, error, clear = self.slip(plane, y)
@@ -239,7 +252,7 @@ class _Run:
             self.stalled, self.last_transition = stalled, t
             self.relatches[plane] += 1
             self.rearmed.append((t, self.latch.copy()))
-            direction = np.array([u[0] / speed, u[1] / speed])
+            direction = _unit(u, speed)
             approach = self.approach_speed(clear, speed)
             self.set_mode(plane, "slip", direction, approach=approach)
             return (stickslip.slip_stop_coefficients(self.params, plane, direction), -approach,
