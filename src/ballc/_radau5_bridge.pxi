@@ -59,6 +59,7 @@ cdef extern from "_radau5_solver.h":
         int refine_events
         const int *ev_rearm
         radau5_rearm_fun rearm
+        int method
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -75,10 +76,12 @@ cdef extern from "_radau5_solver.h":
         long n_dense
         double *dense_t
         double *dense_c
+        int dense_terms
         int profiled
         double prof[7]
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
     int RADAU5_DONE, RADAU5_OUT_OF_MEMORY
+    int RADAU5_METHOD_RADAU, RADAU5_METHOD_DOP853
     void radau5_free(radau5_result *) nogil
 
 
@@ -394,13 +397,14 @@ cdef object _run(radau5_problem *p, int n, int m):
         dense = None
         if p.dense_output:
             dense_t = np.empty((r.n_dense, 2))
-            dense_c = np.empty((r.n_dense, 4 * n))
+            dense_c = np.empty((r.n_dense, (1 + r.dense_terms) * n))
             if r.n_dense:
                 dtv = dense_t
                 dcv = dense_c
                 memcpy(&dtv[0, 0], r.dense_t, r.n_dense * 2 * sizeof(double))
-                memcpy(&dcv[0, 0], r.dense_c, r.n_dense * 4 * n * sizeof(double))
-            dense = (dense_t, dense_c)
+                memcpy(&dcv[0, 0], r.dense_c,
+                       r.n_dense * (1 + r.dense_terms) * n * sizeof(double))
+            dense = (dense_t, dense_c, r.dense_terms)
         t = np.empty(r.n_out)
         y = np.empty((r.n_out, n))
         if r.n_out:
@@ -469,9 +473,10 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    radau5_event_fun event_fun=NULL, int[::1] event_plane=None,
                    list users=None, bint dense_output=False, controller=None,
                    bint outputs_checked=False, bint refine_events=True,
-                   ball_ctx *ball=NULL):
+                   ball_ctx *ball=NULL, method="radau5"):
     """``ball``: ballc's system context (solve_system), which re-arms events."""
     cdef radau5_problem p
+    p.method = _method_code(method)
     cdef int ctrl = _controller_bits(controller)
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
         raise ValueError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
@@ -544,10 +549,23 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     return _run(&p, n, m)
 
 
+cdef int _method_code(method) except -1:
+    if method == "radau5":
+        return RADAU5_METHOD_RADAU
+    if method == "dop853":
+        return RADAU5_METHOD_DOP853
+    raise ValueError(f"method = {method!r} is not allowed: must be 'radau5' or 'dop853'")
+
+
 def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  max_step=np.inf, t_eval=None, events=(), first_step=None, max_nfev=None,
-                 dense_output=False, controller=None, refine_events=True):
+                 dense_output=False, controller=None, refine_events=True, method="radau5"):
     """Integrate ballc's equations (N_STATES states) over ``t_span`` with radau5.
+
+    ``method``: "radau5" (Radau IIA, order 5: scipy's Radau) or "dop853" (Dormand &
+    Prince's explicit pair of order 8: scipy's DOP853, for scenes that are not stiff;
+    ``controller`` and the Jacobian play no part); the loop, events and output are the
+    same.
 
     ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
     ``_core.System``.  ``events``: objects with ``coefficients`` (N_STATES),
@@ -566,8 +584,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     Returns a solve_ivp-shaped OptimizeResult (t, y, t_events, y_events, status,
     message, success, nfev, njev, nlu) plus nstep and nreject (``y`` is the transpose of
     the solver's rows: shape (N_STATES, samples), Fortran order), and ``dense``: with
-    ``dense_output``, (dense_t (steps x 2: t_old, t), dense_c (steps x 4 N_STATES:
-    y_old then 3 coefficients per state, y = y_old + sum_j c_j x^(j+1))), else None.
+    ``dense_output``, (dense_t (steps x 2: t_old, t), dense_c (steps x (1 + terms)
+    N_STATES: y_old, then ``terms`` rows of N_STATES: radau5 3, y = y_old + sum_j
+    row_j x^(j+1); dop853 7, scipy's Dop853DenseOutput F), terms), else None.
     ``max_nfev``: give up (status -1, with what was computed) after that many
     right-hand-side calls.  ``controller``: the step control (private; None: the
     process's current one, see ``_set_controller``).  ``refine_events`` (default
@@ -595,14 +614,15 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes,
                  users, bool(dense_output), controller,
                  True,   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
-                 bool(refine_events), &ctx)
+                 bool(refine_events), &ctx, method)
     if errors:
         raise errors[0]
     return sol
 
 
 def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),
-                 first_step=None, max_nfev=None, controller=None, refine_events=True):
+                 first_step=None, max_nfev=None, controller=None, refine_events=True,
+                 method="radau5", dense_output=False):
     """Integrate y' = A y (A: n x n) with radau5; same result as ``solve_system``
     (``refine_events``: see there)."""
     cdef linear_ctx ctx
@@ -615,8 +635,8 @@ def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, eve
     ctx.n = A.shape[0]
     ctx.A = &av[0, 0]
     return _solve(_linear_fun, _linear_jac, &ctx, ctx.n, t_span, y0, rtol, atol,
-                  max_step, t_eval, events, first_step, max_nfev, NULL, None, None, False,
-                  controller, False, bool(refine_events))
+                  max_step, t_eval, events, first_step, max_nfev, NULL, None, None,
+                  bool(dense_output), controller, False, bool(refine_events), NULL, method)
 
 
 def _lu_solve(A, b):
@@ -678,3 +698,25 @@ def _constants():
         "NEWTON_MAXITER": int(values[42]), "MIN_FACTOR": float(values[43]),
         "MAX_FACTOR": float(values[44]),
     }
+
+
+cdef extern from "_dop853.h":
+    int DOP853_N_CONSTANTS
+    void dop853_constants(double *out)
+
+
+def _dop853_constants():
+    """DOP853's coefficients as its C code uses them (private; for the test that compares
+    them with scipy.integrate._ivp.dop853_coefficients): dict with A (16, 16), B (12,),
+    C (16,), E3, E5 (13,), D (4, 16)."""
+    values = np.empty(DOP853_N_CONSTANTS)
+    cdef double[::1] v = values
+    dop853_constants(&v[0])
+    sizes = (("A", (16, 16)), ("B", (12,)), ("C", (16,)), ("E3", (13,)), ("E5", (13,)),
+             ("D", (4, 16)))
+    out, k = {}, 0
+    for name, shape in sizes:
+        size = int(np.prod(shape))
+        out[name] = values[k:k + size].reshape(shape).copy()
+        k += size
+    return out

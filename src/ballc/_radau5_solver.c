@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "_dop853.h"
 #include "_lu.h"
 #include "_radau5_solver.h"
 
@@ -106,6 +107,10 @@ typedef struct {
     /* scratch */
     double *y_new, *f_new, *scale, *Z0, *Znew, *W, *F, *dW, *tmp, *err, *ZE;
     cplx *ctmp;
+    /* DOP853 (problem.method): the stages of the last step (DOP853_STAGES_EXTENDED x n),
+     * its dense output's terms (DOP853_DENSE_TERMS x n) once computed (dense_ready) */
+    int dop853, dense_ready;
+    double *K, *Fdense;
     /* events */
     double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */
     int *active;
@@ -350,18 +355,23 @@ static double predict_factor(double h_abs, double h_abs_old, int have_h_abs_old,
     return fmin(1, multiplier) * pow(error_norm, -0.25);   /* inf when error_norm == 0 */
 }
 
-/* RadauDenseOutput of the last accepted step at time tt. */
+/* RadauDenseOutput (or Dop853DenseOutput: its terms computed by prepare_dense) of the
+ * last accepted step at time tt. */
 static void dense(const solver_t *s, double tt, double *out)
 {
     const int n = s->n;
     double x = (tt - s->t_old) / (s->dense_end - s->t_old);
+    if (s->dop853) {
+        dop853_eval(n, x, s->y_old, s->Fdense, out);
+        return;
+    }
     double p1 = x, p2 = x * x, p3 = x * x * x;
     for (int c = 0; c < n; c++)
         out[c] = s->y_old[c] + s->Q[3 * c] * p1 + s->Q[3 * c + 1] * p2 + s->Q[3 * c + 2] * p3;
 }
 
 /* Radau._step_impl.  Returns 1 on success, 0 on failure (message set). */
-static int step(solver_t *s)
+static int step_radau(solver_t *s)
 {
     const radau5_problem *p = s->p;
     const constants_t *k = &s->k;
@@ -547,7 +557,96 @@ static int step(solver_t *s)
     return 1;
 }
 
-/* common.select_initial_step with order 3. */
+/* The function the DOP853 stages call: call_fun (counted, checked, profiled). */
+static int dop853_call(void *ctx, double t, const double *y, double *f)
+{
+    solver_t *s = ctx;
+    return call_fun(s, t, y, f);
+}
+
+/* RungeKutta._step_impl with DOP853's error norm.  Returns 1 on success, 0 on failure
+ * (message set).  A step whose stages cannot be evaluated is rejected with its size
+ * halved (scipy would carry the NaN on). */
+static int step_dop853(solver_t *s)
+{
+    const radau5_problem *p = s->p;
+    const int n = s->n;
+    const double t = s->t;
+    double *y = s->y, *y_new = s->y_new, *K = s->K;
+    const double exponent = -1.0 / (DOP853_ERROR_ORDER + 1);
+    double min_step = 10 * fabs(nextafter(t, s->direction * INFINITY) - t);
+    double h_abs = s->h_abs > p->max_step ? p->max_step
+                   : (s->h_abs < min_step ? min_step : s->h_abs);
+    int rejected = 0;
+    double h = 0, t_new = t;
+    memcpy(K, s->f, n * sizeof(double));
+    for (;;) {
+        if (h_abs < min_step) {
+            snprintf(s->r->message, sizeof s->r->message,
+                     "Required step size is less than spacing between numbers.");
+            return 0;
+        }
+        h = h_abs * s->direction;
+        t_new = t + h;
+        if (s->direction * (t_new - s->t_bound) > 0) t_new = s->t_bound;
+        h = t_new - t;
+        h_abs = fabs(h);
+        if (dop853_attempt(dop853_call, s, n, t, h, y, K, y_new, s->tmp) != 0) {
+            h_abs *= 0.5;
+            rejected = 1;
+            s->r->nreject++;
+            continue;
+        }
+        for (int c = 0; c < n; c++)
+            s->scale[c] = s->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * s->rtol;
+        double error_norm = dop853_error_norm(n, K, h, s->scale);
+        if (error_norm < 1) {
+            double factor = error_norm == 0 ? MAX_FACTOR
+                            : fmin(MAX_FACTOR, 0.9 * pow(error_norm, exponent));
+            if (rejected) factor = fmin(1, factor);
+            h_abs *= factor;
+            break;
+        }
+        h_abs *= fmax(MIN_FACTOR, 0.9 * pow(error_norm, exponent));
+        rejected = 1;
+        s->r->nreject++;
+    }
+    s->h_abs = h_abs;
+    memcpy(s->y_old, y, n * sizeof(double));
+    memcpy(y, y_new, n * sizeof(double));
+    memcpy(s->f, K + DOP853_STAGES * n, n * sizeof(double));
+    s->t_old = t;
+    s->t = t_new;
+    s->dense_end = t_new;
+    s->dense_ready = 0;
+    s->have_sol = 1;
+    s->r->nstep++;
+    return 1;
+}
+
+static int step(solver_t *s)
+{
+    return s->dop853 ? step_dop853(s) : step_radau(s);
+}
+
+/* The last step's dense output made ready for dense(): DOP853 computes its extra stages
+ * here, once per step and only for the steps whose dense output is used (Radau's is
+ * part of the step).  Returns 0, or -1 (message set) when they cannot be evaluated. */
+static int prepare_dense(solver_t *s)
+{
+    if (!s->dop853 || s->dense_ready) return 0;
+    if (dop853_dense(dop853_call, s, s->n, s->t_old, s->t - s->t_old, s->y_old, s->y, s->K,
+                     s->Fdense, s->tmp) != 0) {
+        snprintf(s->r->message, sizeof s->r->message,
+                 "the right-hand side cannot be evaluated for the dense output of the step "
+                 "from t = %.17g", s->t_old);
+        return -1;
+    }
+    s->dense_ready = 1;
+    return 0;
+}
+
+/* common.select_initial_step with the error estimator's order (Radau 3, DOP853 7). */
 static double initial_step(solver_t *s)
 {
     const radau5_problem *p = s->p;
@@ -572,8 +671,9 @@ static double initial_step(solver_t *s)
         }
         d2 = sqrt(d2 / n) / h0;
     }
+    const int order = s->dop853 ? DOP853_ERROR_ORDER : 3;
     double h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? fmax(1e-6, h0 * 1e-3)
-                                             : pow(0.01 / fmax(d1, d2), 1.0 / 4);
+                                             : pow(0.01 / fmax(d1, d2), 1.0 / (order + 1));
     return fmin(fmin(100 * h0, h1), fmin(interval, p->max_step));
 }
 
@@ -628,19 +728,28 @@ static int store_hit(solver_t *s, int event, double t, const double *y)
     return 0;
 }
 
-/* The last accepted step's interpolant, for dense output over the whole run. */
+/* The last accepted step's interpolant, for dense output over the whole run.  Returns
+ * 0, -1 on out of memory, -2 when the dense output cannot be computed (message set). */
 static int store_dense(solver_t *s)
 {
     radau5_result *r = s->r;
     const int n = s->n;
+    if (prepare_dense(s) != 0) return -2;
     void **buffers[] = {(void **)&r->dense_t, (void **)&r->dense_c};
-    const size_t sizes[] = {2 * sizeof(double), 4 * (size_t)n * sizeof(double)};
+    const int terms = r->dense_terms;
+    const size_t sizes[] = {2 * sizeof(double), (1 + terms) * (size_t)n * sizeof(double)};
     if (reserve(&s->cap_dense, r->n_dense, 256, 2, buffers, sizes) != 0) return -1;
     r->dense_t[2 * r->n_dense] = s->t_old;
     r->dense_t[2 * r->n_dense + 1] = s->t;
-    double *c = r->dense_c + (size_t)r->n_dense * 4 * n;
+    double *c = r->dense_c + (size_t)r->n_dense * (1 + terms) * n;
     memcpy(c, s->y_old, n * sizeof(double));
-    memcpy(c + n, s->Q, 3 * (size_t)n * sizeof(double));
+    /* Radau: Q is n x 3 (per state), stored as 3 rows of n; DOP853: F is already rows */
+    if (s->dop853) {
+        memcpy(c + n, s->Fdense, (size_t)terms * n * sizeof(double));
+    } else {
+        for (int j = 0; j < 3; j++)
+            for (int i = 0; i < n; i++) c[(1 + j) * n + i] = s->Q[3 * i + j];
+    }
     r->n_dense++;
     return 0;
 }
@@ -671,14 +780,17 @@ static double event_value(const solver_t *s, int e, double t, const double *y)
 /* A function of t whose root brentq finds. */
 typedef double (*scalar_fn)(void *ctx, double t);
 
-/* A linear event on the last step's dense output: a cubic in x = (t - t_old) / h. */
-typedef struct { double a[4], t_old, h; } cubic_t;
+/* A linear event on the last step's dense output: c . y_old + offset plus the dense
+ * output's terms dotted with c, a polynomial in x = (t - t_old) / h (Radau: a cubic,
+ * a[j] the coefficient of x^(j+1); DOP853: dop853_eval_scalar's nested form). */
+typedef struct { double a0, a[DOP853_DENSE_TERMS], t_old, h; int dop853; } poly_t;
 
-static double cubic_at(void *ctx, double tt)
+static double poly_at(void *ctx, double tt)
 {
-    const cubic_t *q = ctx;
+    const poly_t *q = ctx;
     double x = (tt - q->t_old) / q->h;
-    return q->a[0] + x * (q->a[1] + x * (q->a[2] + x * q->a[3]));
+    if (q->dop853) return dop853_eval_scalar(x, q->a0, q->a);
+    return q->a0 + x * (q->a[0] + x * (q->a[1] + x * q->a[2]));
 }
 
 /* A system event on the last step's dense output. */
@@ -753,17 +865,23 @@ static double event_root(solver_t *s, int e)
         dense_event_t q = {s, e};
         return brentq(dense_event_at, &q, s->t_old, s->t);
     }
-    const double *c = s->p->ev_coef + (size_t)e * s->n;
-    cubic_t q = {{s->p->ev_offset[e], 0, 0, 0}, s->t_old, s->t - s->t_old};
-    for (int i = 0; i < s->n; i++) q.a[0] += c[i] * s->y_old[i];
-    for (int i = 0; i < s->n; i++)
-        for (int j = 0; j < 3; j++) q.a[j + 1] += c[i] * s->Q[3 * i + j];
-    return brentq(cubic_at, &q, s->t_old, s->t);
+    const int n = s->n;
+    const double *c = s->p->ev_coef + (size_t)e * n;
+    poly_t q = {s->p->ev_offset[e], {0}, s->t_old, s->t - s->t_old, s->dop853};
+    for (int i = 0; i < n; i++) q.a0 += c[i] * s->y_old[i];
+    if (s->dop853) {
+        for (int j = 0; j < DOP853_DENSE_TERMS; j++)
+            for (int i = 0; i < n; i++) q.a[j] += c[i] * s->Fdense[j * n + i];
+    } else {
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < 3; j++) q.a[j] += c[i] * s->Q[3 * i + j];
+    }
+    return brentq(poly_at, &q, s->t_old, s->t);
 }
 
 /* ivp.find_active_events + handle_events after a step.  Returns 1 when a terminal
  * event stopped the integration (then *t_stop is its time), 0 otherwise, -1 on
- * out of memory. */
+ * out of memory, -2 when the dense output cannot be computed (message set). */
 static int handle_events(solver_t *s, double *t_stop)
 {
     const radau5_problem *p = s->p;
@@ -776,6 +894,7 @@ static int handle_events(solver_t *s, double *t_stop)
             s->active[m++] = e;
     }
     if (m == 0) return 0;
+    if (prepare_dense(s) != 0) return -2;
     for (int i = 0; i < m; i++) {
         s->roots[i] = event_root(s, s->active[i]);
         if (p->ev_terminal[s->active[i]]) terminate = 1;
@@ -808,11 +927,13 @@ static int handle_events(solver_t *s, double *t_stop)
     return terminate;
 }
 
-/* Store the points of t_eval up to t_upto from the last step's dense output. */
+/* Store the points of t_eval up to t_upto from the last step's dense output.  Returns
+ * 0, -1 on out of memory, -2 when the dense output cannot be computed (message set). */
 static int store_eval(solver_t *s, double t_upto)
 {
     const radau5_problem *p = s->p;
     while (s->i_eval < p->n_eval && s->direction * (p->t_eval[s->i_eval] - t_upto) <= 0) {
+        if (prepare_dense(s) != 0) return -2;
         dense(s, p->t_eval[s->i_eval], s->err);
         if (store_point(s, p->t_eval[s->i_eval], s->err) != 0) return -1;
         s->i_eval++;
@@ -850,7 +971,7 @@ static int step_to_event(solver_t *s, double t_stop, double *y_stop)
     s->have_sol = 0;   /* zero predictor: see above */
     memcpy(s->y, s->y_old, n * sizeof(double));
     int ok = call_fun(s, s->t, s->y, s->f) == 0;
-    if (ok && s->direction * (s->jac_t - s->t) > 0) {
+    if (ok && !s->dop853 && s->direction * (s->jac_t - s->t) > 0) {
         /* J was evaluated at the crossing step's end, past the event (the mode's
          * equations may have turned sharply there, e.g. a slip direction swinging
          * through zero): take it at the start again */
@@ -862,8 +983,11 @@ static int step_to_event(solver_t *s, double t_stop, double *y_stop)
     s->lu_valid = 0;
     while (ok && s->direction * (t_stop - s->t) > 0) {
         ok = step(s);
-        if (ok && s->p->dense_output && store_dense(s) != 0) return -1;
-        if (ok && s->p->t_eval != NULL && store_eval(s, s->t) != 0) return -1;
+        int rc = 0;
+        if (ok && s->p->dense_output) rc = store_dense(s);
+        if (ok && rc == 0 && s->p->t_eval != NULL) rc = store_eval(s, s->t);
+        if (rc == -1) return -1;
+        if (rc != 0) ok = 0;   /* the dense output failed: as a failed step */
     }
     s->t_bound = s->p->t_bound;
     s->h_abs = h_next;
@@ -874,7 +998,7 @@ static int step_to_event(solver_t *s, double t_stop, double *y_stop)
     }
     memcpy(y_stop, s->y, n * sizeof(double));
     if (s->p->dense_output) {   /* the new steps' pieces replace the crossing step's */
-        const size_t width = 4 * (size_t)n;
+        const size_t width = (1 + (size_t)r->dense_terms) * n;
         memmove(r->dense_t + 2 * (n_dense - 1), r->dense_t + 2 * n_dense,
                 2 * (size_t)(r->n_dense - n_dense) * sizeof(double));
         memmove(r->dense_c + (n_dense - 1) * width, r->dense_c + n_dense * width,
@@ -906,6 +1030,15 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         snprintf(r->message, sizeof r->message, "n = %d and n_events = %d: need n > 0, n_events >= 0", n, m);
         return RADAU5_BAD_PROBLEM;
     }
+    if (p->method != RADAU5_METHOD_RADAU && p->method != RADAU5_METHOD_DOP853) {
+        snprintf(r->message, sizeof r->message, "method = %d: need RADAU5_METHOD_RADAU (0) "
+                 "or RADAU5_METHOD_DOP853 (1)", p->method);
+        return RADAU5_BAD_PROBLEM;
+    }
+    if (p->method == RADAU5_METHOD_RADAU && p->jac == NULL) {
+        snprintf(r->message, sizeof r->message, "Radau needs a Jacobian: jac is NULL");
+        return RADAU5_BAD_PROBLEM;
+    }
 
 #ifdef RADAU5_PROFILE
     prof_acc = r->prof;
@@ -919,6 +1052,8 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.p = p;
     s.r = r;
     s.n = n;
+    s.dop853 = p->method == RADAU5_METHOD_DOP853;
+    r->dense_terms = s.dop853 ? DOP853_DENSE_TERMS : 3;
     init_constants(&s.k);
     s.direction = p->t_bound >= p->t0 ? 1.0 : -1.0;
     s.ctrl = p->controller;
@@ -933,7 +1068,8 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
          + (size_t)m * 3 + (size_t)n                        /* g g_new roots, ev_y */
          + (size_t)n * n + (size_t)n                        /* Joc, xc */
          + (size_t)n                                        /* atol */
-         + (size_t)n;                                       /* inv_scale */
+         + (size_t)n                                        /* inv_scale */
+         + (size_t)n * (DOP853_STAGES_EXTENDED + DOP853_DENSE_TERMS);   /* K, F */
     double *dblock = calloc(nd, sizeof(double));
     cplx *cblock = calloc((size_t)n * n + 2 * (size_t)n, sizeof(cplx));
     int *iblock = calloc(5 * (size_t)n + 2 * (size_t)m + 3 + (size_t)n * n, sizeof(int));
@@ -950,6 +1086,8 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.Joc = d; d += n * n; s.xc = d; d += n;
     s.atol = d; d += n;
     s.inv_scale = d; d += n;
+    s.K = d; d += (size_t)n * DOP853_STAGES_EXTENDED;
+    s.Fdense = d; d += (size_t)n * DOP853_DENSE_TERMS;
     for (int c = 0; c < n; c++) s.atol[c] = s.rtol * (p->atol[c] / p->rtol);
     if (!(s.ctrl & RADAU5_CTRL_TOL)) memcpy(s.atol, p->atol, n * sizeof(double));
     s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n; s.xcc = s.ctmp + n;
@@ -972,7 +1110,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     }
     for (int e = 0; e < m; e++) s.g[e] = event_value(&s, e, s.t, s.y);
     s.h_abs = p->first_step > 0 ? p->first_step : initial_step(&s);
-    if (call_jac(&s, s.t, s.y) != 0) {
+    if (!s.dop853 && call_jac(&s, s.t, s.y) != 0) {
         snprintf(r->message, sizeof r->message,
                  "the Jacobian cannot be evaluated at the initial state (t = %.17g)", s.t);
         r->status = RADAU5_FAILED;
@@ -998,7 +1136,9 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
             r->status = RADAU5_FAILED;
             break;
         }
-        if (p->dense_output && store_dense(&s) != 0) goto oom;
+        int rc = p->dense_output ? store_dense(&s) : 0;
+        if (rc == -1) goto oom;
+        if (rc != 0) break;   /* status RADAU5_FAILED, message set */
         int finished = s.direction * (s.t - p->t_bound) >= 0;
         double t_out = s.t;
         const double *y_out = s.y;
@@ -1008,7 +1148,8 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
             for (int e = 0; e < m; e++) s.g_new[e] = event_value(&s, e, s.t, s.y);
             terminate = handle_events(&s, &t_out);
             PROF_STOP(RADAU5_PROF_EVENTS);
-            if (terminate < 0) goto oom;
+            if (terminate == -1) goto oom;
+            if (terminate < 0) break;   /* status RADAU5_FAILED, message set */
             if (terminate) {   /* handle_events stored the hit's state, from the dense output */
                 double *hit = r->hit_y + (size_t)(r->n_hits - 1) * n;
                 const int e_hit = r->hit_event[r->n_hits - 1];
@@ -1031,8 +1172,9 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         }
         if (p->t_eval == NULL) {
             if (store_point(&s, t_out, y_out) != 0) goto oom;
-        } else if (store_eval(&s, t_out) != 0) {
-            goto oom;
+        } else if ((rc = store_eval(&s, t_out)) != 0) {
+            if (rc == -1) goto oom;
+            break;   /* status RADAU5_FAILED, message set */
         }
         if (terminate) {
             r->status = RADAU5_EVENT;

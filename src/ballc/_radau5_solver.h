@@ -1,4 +1,5 @@
-/* radau5: compiled Radau IIA (order 5) integrator with linear events.
+/* radau5: compiled Radau IIA (order 5) integrator with linear events, and the same
+ * loop, events and output around Dormand & Prince's explicit DOP853 (order 8).
  *
  * The same method and error control as scipy.integrate.Radau
  * (scipy/integrate/_ivp/radau.py): the same constants, simplified Newton
@@ -24,6 +25,15 @@
  * outputs, e.g. positions nothing depends on, accumulated work) make mu/h I - J
  * lower block-triangular, so they follow from the coupled block's solution by
  * substitution; they stay in the error norm and in the Newton convergence test.
+ *
+ * With problem.method = RADAU5_METHOD_DOP853 the steps are scipy.integrate.DOP853's
+ * instead (_dop853.h: its coefficients, error estimate, step-size control and 7th-order
+ * dense output; no Jacobian, which may then be NULL): for scenes that are not stiff,
+ * where its order 8 takes far fewer steps at tight tolerances.  Everything else (events,
+ * their refinement and re-arming, t_eval, dense output, the call budget) is the same
+ * code.  The dense output's 3 extra stages are computed only for the steps that need
+ * them (an event's sign change, a t_eval point, dense_output), where scipy computes them
+ * on every step when there are events: nfev is smaller than scipy's by that much.
  */
 #ifndef BALLC_RADAU5_H
 #define BALLC_RADAU5_H
@@ -75,7 +85,10 @@ typedef struct {
                                * to the event's time), not the dense output's value */
     const int *ev_rearm;      /* may be NULL; nonzero: the terminal event may be re-armed */
     radau5_rearm_fun rearm;   /*   by rearm (only where refine_events stepped to its time) */
+    int method;               /* RADAU5_METHOD_RADAU (0) or RADAU5_METHOD_DOP853 */
 } radau5_problem;
+
+enum { RADAU5_METHOD_RADAU = 0, RADAU5_METHOD_DOP853 = 1 };
 
 /* Step control: scipy's Radau (0) or elements of Hairer & Wanner's RADAU5 (radau5.f,
  * RADCOR/ESTRAD), each a bit, for benchmarks/controllers.py.
@@ -122,9 +135,12 @@ typedef struct {
     double *hit_t;
     double *hit_y;            /* n_hits x n */
     long n_dense;             /* with dense_output: accepted steps, each (t_old, t) in */
-    double *dense_t;          /*   dense_t (n_dense x 2) and y_old then the 3 coefficients */
-    double *dense_c;          /*   per state in dense_c (n_dense x 4n): y(t) = y_old +
-                               *   sum_j Q_j x^(j+1), x = (t - t_old) / (t_new - t_old) */
+    double *dense_t;          /*   dense_t (n_dense x 2) and y_old then dense_terms rows */
+    double *dense_c;          /*   of n coefficients in dense_c (n_dense x (1 + terms) n),
+                               *   x = (t - t_old) / (t_new - t_old).  Radau (3 terms):
+                               *   y(t) = y_old + sum_j Q_j x^(j+1), Q_j the j-th row.
+                               *   DOP853 (7): rows F0..F6 of dop853_eval. */
+    int dense_terms;          /* 3 (Radau) or 7 (DOP853) */
     int profiled;             /* 1 in a -DRADAU5_PROFILE build */
     double prof[RADAU5_PROF_N];
 } radau5_result;

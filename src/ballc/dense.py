@@ -1,7 +1,8 @@
 """Dense output: a continuous solution y(t) over a whole run, piecewise across events.
 
 Each segment between events has its integrator's own interpolant (radau5: the
-collocation polynomial of every step, as scipy's ``RadauDenseOutput``; scipy's
+collocation polynomial of every step, as scipy's ``RadauDenseOutput``; dop853: its
+7th-order interpolant, as scipy's ``Dop853DenseOutput``; scipy's
 methods: their ``OdeSolution``).  :class:`PiecewiseSolution` joins them the way
 scipy's ``OdeSolution`` joins steps: ``sol(t)`` for a scalar t gives the state
 (N_STATES,), for an array of times (N_STATES, len(t)).  At an event time shared by
@@ -13,16 +14,23 @@ import numpy as np
 
 
 class Radau5Interpolant:
-    """radau5's dense output of one segment: per step (t_old, t) and, per state,
-    y(t) = y_old + c1 x + c2 x^2 + c3 x^3 with x = (t - t_old) / (t_new - t_old)."""
+    """The compiled integrator's dense output of one segment: per step (t_old, t_new),
+    y_old and the step's terms (rows of N_STATES), x = (t - t_old) / (t_new - t_old).
 
-    def __init__(self, steps, coefficients):
+    radau5 (3 terms, as scipy's ``RadauDenseOutput``): y = y_old + q1 x + q2 x^2 + q3 x^3.
+    dop853 (7 terms F0..F6, as scipy's ``Dop853DenseOutput``):
+    y = y_old + x (F0 + (1 - x) (F1 + x (F2 + (1 - x) (F3 + x (F4 + (1 - x) (F5 + x F6)))))).
+    """
+
+    def __init__(self, steps, coefficients, terms=3):
         self.steps = np.asarray(steps, dtype=float).reshape(-1, 2)
-        n4 = np.asarray(coefficients).shape[1] if np.ndim(coefficients) == 2 else 0
-        self.n = n4 // 4
-        c = np.asarray(coefficients, dtype=float).reshape(len(self.steps), 4 * self.n)
+        self.terms = int(terms)
+        width = np.asarray(coefficients).shape[1] if np.ndim(coefficients) == 2 else 0
+        self.n = width // (1 + self.terms)
+        c = np.asarray(coefficients, dtype=float).reshape(len(self.steps),
+                                                          (1 + self.terms) * self.n)
         self.y_old = c[:, :self.n]
-        self.q = c[:, self.n:].reshape(len(self.steps), self.n, 3)
+        self.q = c[:, self.n:].reshape(len(self.steps), self.terms, self.n)
         self.t_min = float(self.steps[0, 0]) if len(self.steps) else np.nan
         self.t_max = float(self.steps[-1, 1]) if len(self.steps) else np.nan
 
@@ -32,10 +40,16 @@ class Radau5Interpolant:
         tt = np.atleast_1d(t)
         k = np.clip(np.searchsorted(self.steps[:, 1], tt, side="left"), 0, len(self.steps) - 1)
         t_old, t_new = self.steps[k, 0], self.steps[k, 1]
-        x = (tt - t_old) / (t_new - t_old)
-        q = self.q[k]                                   # (m, n, 3)
-        y = self.y_old[k] + x[:, None] * (q[:, :, 0] + x[:, None] * (
-            q[:, :, 1] + x[:, None] * q[:, :, 2]))
+        x = ((tt - t_old) / (t_new - t_old))[:, None]
+        q = self.q[k]                                   # (m, terms, n)
+        y = np.zeros((tt.size, self.n))
+        if self.terms == 3:                             # Horner in x
+            for j in range(2, -1, -1):
+                y = (y + q[:, j]) * x
+        else:                                           # scipy's Dop853DenseOutput
+            for i, j in enumerate(range(self.terms - 1, -1, -1)):
+                y = (y + q[:, j]) * (x if i % 2 == 0 else 1 - x)
+        y = y + self.y_old[k]
         return y[0] if scalar else y.T
 
 

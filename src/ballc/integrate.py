@@ -1,7 +1,8 @@
 """The one seam between the driver and an integrator: integrate one smooth segment.
 
 ``method`` "radau5" runs ballc's compiled Radau IIA (scipy's Radau, step by step in
-C) on the system's C right-hand side and Jacobian; any other is handed to scipy's
+C) on the system's C right-hand side and Jacobian, "dop853" ballc's compiled DOP853
+(scipy's DOP853, in the same C loop, with the same events); any other is handed to scipy's
 ``solve_ivp`` (with the analytic Jacobian when implicit).  scipy has no call budget
 of its own: :func:`_call_budget` gives it one as a terminal event.  With
 ``exact_flight``, a free-flight segment that has an exact solution (massless observer,
@@ -15,7 +16,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import _radau5, dense, flight
-from .options import IMPLICIT_METHODS
+from .options import COMPILED_METHODS, IMPLICIT_METHODS
 
 
 def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval, max_step,
@@ -40,11 +41,11 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
                                 max_step=max_step, dense_output=dense_output)
     if first_step is not None:   # a step carried over may be longer than what is left
         first_step = min(first_step, t1 - t0)
-    if method == "radau5":
+    if method in COMPILED_METHODS:
         sol = _radau5.solve_system(system.params, system.latch, system.flags, (t0, t1), y0,
                                    rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
                                    events=events, max_nfev=max_nfev, first_step=first_step,
-                                   dense_output=dense_output)
+                                   dense_output=dense_output, method=method)
         if dense_output:
             sol.interpolant = dense.Radau5Interpolant(*sol.dense)
         return sol

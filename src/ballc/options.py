@@ -16,8 +16,11 @@ from .scene import Scene, SceneError
 
 SCIPY_METHODS = ("Radau", "BDF", "LSODA", "DOP853", "RK45", "RK23")
 IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
-#: "radau5": ballc's compiled Radau IIA (order 5), scipy's Radau step by step in C.
-METHODS = ("radau5",) + SCIPY_METHODS
+#: ballc's compiled integrators: "radau5", Radau IIA (order 5), scipy's Radau step by
+#: step in C; "dop853", Dormand & Prince's explicit pair of order 8, scipy's DOP853 step
+#: by step in C (for scenes that are not stiff), in the same loop with the same events.
+COMPILED_METHODS = ("radau5", "dop853")
+METHODS = COMPILED_METHODS + SCIPY_METHODS
 
 #: Default budget of right-hand-side evaluations of one simulate call.
 DEFAULT_MAX_NFEV = 20_000_000
