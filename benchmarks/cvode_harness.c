@@ -1,4 +1,4 @@
-/* C side of benchmarks/cvode_c.py: radau5 and SUNDIALS CVODE, both driven from C, on
+/* C side of benchmarks/cvode_c.py: radau5, dop853 and SUNDIALS CVODE, all driven from C, on
  * ballc's compiled right-hand side and analytic Jacobian.  No Python anywhere.
  *
  *   cvode_harness SEGMENT_FILE REPEAT TOL [TOL ...]
@@ -15,8 +15,9 @@
  *   run CONTENDER TOL CPU_S NFEV NJEV NSTEP NLU FAILED_SEGMENTS
  *   end CONTENDER TOL SEGMENT y[N_STATES]       (from the last pass)
  *   fail CONTENDER TOL SEGMENT CODE             (a segment that did not reach t1)
- * CONTENDER: radau5, cvode_bdf, cvode_adams.  radau5 is not run below rtol = 100 machine
- * epsilons (ballc refuses such tolerances: ballc/options.py).
+ * CONTENDER: radau5, dop853 (radau5_solve with method RADAU5_METHOD_DOP853), cvode_bdf,
+ * cvode_adams.  radau5 and dop853 are not run below rtol = 100 machine epsilons (ballc
+ * refuses such tolerances: ballc/options.py).
  *
  * SUNDIALS has no headers here (the library comes from the scikit-sundae wheel): the
  * few prototypes below are those of the SUNDIALS 7 API, with sunrealtype = double and
@@ -145,7 +146,7 @@ static int ball_jac(void *ctx, double t, const double *y, double *jac) {
     return ballc_jacobian_checked_inputs(y, &s->prepared, s->latch, s->flags, jac);
 }
 
-static void radau5_pass(segment_t *segs, int m, double tol, pass_t *out) {
+static void radau5_pass(segment_t *segs, int m, double tol, int method, pass_t *out) {
     double atol[N], dummy_real[N];
     int dummy_int[1] = {0};
     for (int i = 0; i < N; i++)
@@ -179,6 +180,7 @@ static void radau5_pass(segment_t *segs, int m, double tol, pass_t *out) {
         p.controller = 0;            /* scipy's step control: ballc's default */
         p.outputs_checked = 1;       /* ballc_rhs/_jacobian report non-finite outputs */
         p.refine_events = 1;
+        p.method = method;           /* RADAU5_METHOD_RADAU or RADAU5_METHOD_DOP853 */
         int rc = radau5_solve(&p, &r);
         if (rc != RADAU5_DONE || r.status != RADAU5_REACHED || r.n_out < 1) {
             out->code[k] = rc != RADAU5_DONE ? rc : (r.status != 0 ? r.status : -9);
@@ -305,8 +307,8 @@ static void cvode_pass(cvode_t *c, segment_t *segs, int m, double tol, pass_t *o
 }
 
 /* ---- driver ---- */
-enum { RADAU5, CVODE_BDF, CVODE_ADAMS, N_CONTENDERS };
-static const char *NAMES[N_CONTENDERS] = {"radau5", "cvode_bdf", "cvode_adams"};
+enum { RADAU5, DOP853, CVODE_BDF, CVODE_ADAMS, N_CONTENDERS };
+static const char *NAMES[N_CONTENDERS] = {"radau5", "dop853", "cvode_bdf", "cvode_adams"};
 #define RADAU5_MIN_TOL (100 * DBL_EPSILON)
 
 int main(int argc, char **argv) {
@@ -346,14 +348,15 @@ int main(int argc, char **argv) {
         for (int a = 0; a < n_tol; a++) {
             for (int j = 0; j < N_CONTENDERS; j++) {
                 int c = (j + rep) % N_CONTENDERS;
-                if (c == RADAU5 && tols[a] < RADAU5_MIN_TOL)
+                if ((c == RADAU5 || c == DOP853) && tols[a] < RADAU5_MIN_TOL)
                     continue;
                 pass_t *p = &last[a * N_CONTENDERS + c];
                 p->nfev = p->njev = p->nstep = p->nlu = 0;
                 p->failed = 0;
                 double started = cpu_seconds();
-                if (c == RADAU5)
-                    radau5_pass(segs, m, tols[a], p);
+                if (c == RADAU5 || c == DOP853)
+                    radau5_pass(segs, m, tols[a],
+                                c == RADAU5 ? RADAU5_METHOD_RADAU : RADAU5_METHOD_DOP853, p);
                 else
                     cvode_pass(&cv[c], segs, m, tols[a], p);
                 double cpu = cpu_seconds() - started;
