@@ -216,3 +216,30 @@ def test_energy_is_conserved_when_nothing_dissipates():
         total = run.energy["total"]
         assert len(run.contacts) >= 8
         assert np.ptp(total) <= bound * np.abs(total).max()
+
+
+def test_a_stiff_system_is_noticed():
+    """Hairer's stiffness test (15 steps in a row with |h lambda| > 6.1): a decay of rate
+    1e4 beside a slow one is reported (stiff_at: the step where it fired, early on);
+    the smooth system is not; nor is anything radau5 integrates."""
+    stiff = _radau5.solve_linear(np.array([[-1e4, 0.0], [1.0, -1.0]]), (0, 1.0),
+                                 np.array([1.0, 1.0]), rtol=1e-6, atol=1e-6, method="dop853")
+    assert stiff.status == 0 and 0 < stiff.stiff_at < 0.05   # measured 0.012
+    smooth = _radau5.solve_linear(A_SMOOTH, (0, 10.0), Y0_SMOOTH, rtol=1e-6, atol=1e-6,
+                                  method="dop853")
+    assert np.isnan(smooth.stiff_at)
+    radau = _radau5.solve_linear(np.array([[-1e4, 0.0], [1.0, -1.0]]), (0, 1.0),
+                                 np.array([1.0, 1.0]), rtol=1e-6, atol=1e-6)
+    assert np.isnan(radau.stiff_at)
+
+
+def test_simulate_says_when_dop853_found_the_scene_stiff():
+    """The compliant tangential law's sticking spring is stiff for an explicit method:
+    the run's message says so (measured: from the first contact's stick, t = 0.636 s),
+    and still finishes; the rubber ball with the default law is not stiff."""
+    compliant = ballc.simulate(ballc.Scene(tangential_model="compliant"), 1.0,
+                               method="dop853", rtol=1e-6, atol=1e-6)
+    assert compliant.status == 0 and "found the scene stiff" in compliant.message
+    assert "method='radau5'" in compliant.message
+    seed = ballc.simulate(ballc.Scene(), 1.0, method="dop853", rtol=1e-6, atol=1e-6)
+    assert seed.status == 0 and "stiff" not in seed.message

@@ -503,10 +503,13 @@ def test_digin_first_impact_against_the_seeds_band_latch(seed_model):
     Radau's rejected steps at the boundary bring the last band call within ~1e-7 s of
     the event, so the latched direction agrees with ballc's to ~1e-8; the remaining
     difference of the states (a few 1e-6) depends on the seed's call pattern, i.e. on
-    its tolerance.  So the bound here is the seed's own spread between rtol 1e-10 and
-    1e-11 (+ 1e-6), not 1e-6: what is honest for a formulation whose result depends on
+    its tolerance and on rounding in its lambdified numpy code: which rejected step
+    lands last in the band.  Measured: 1e-6 or less on one machine, 5.0e-6 (the spin,
+    |omega| ~ 24 rad/s: 2e-7 of it) on another with the same scipy (1.17.1), where the
+    seed's own spread between rtol 1e-10 and 1e-11 was 9.9e-7.  So the bound is that
+    spread + 1e-5, not 1e-6: what is honest for a formulation whose result depends on
     the solver's call pattern (test_digin_first_impact_matches_the_seeds_equations is
-    the 1e-6 check of the model).
+    the 1e-6 check of the model; a wrong latch moves the spin by 1e-2 or more).
     """
     runs = [run_seed_pipeline(0.22, rtol=tol, atol=tol, t_eval_points=2,
                               params={"mixtur": 1.0}) for tol in (1e-10, 1e-11)]
@@ -519,7 +522,7 @@ def test_digin_first_impact_against_the_seeds_band_latch(seed_model):
     ours = np.concatenate([result.position[:, -1], result.angular_velocity[:, -1],
                            result.velocity[:, -1]])
     theirs = runs[1]["y"][3:, -1]
-    assert np.abs(ours - theirs).max() <= spread + 1e-6, (np.abs(ours - theirs), spread)
+    assert np.abs(ours - theirs).max() <= spread + 1e-5, (np.abs(ours - theirs), spread)
     # the latched direction: written at the last band call before the contact
     # (ru1..ru3 are not overwritten on the way out, where the contact point rises)
     seed_direction = np.array(runs[1]["final_params"][_P("ru1"):_P("ru3") + 1])

@@ -111,7 +111,7 @@ def test_trajectory_matches_seed_pipeline():
     np.testing.assert_allclose([c.t_start for c in ours.contacts], seed_times, atol=2e-3)
 
 
-@pytest.mark.parametrize("method", ["radau5", "Radau"])
+@pytest.mark.parametrize("method", ["radau5", "dop853", "Radau"])
 def test_call_budget_stops_honestly_with_the_results_so_far(method):
     """A friction contact at a loose tolerance crawls with the seed's literal law (the
     1e-10 m/s Coulomb regularisation, "max"): tens of thousands of calls go into the

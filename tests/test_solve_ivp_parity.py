@@ -27,7 +27,7 @@ def first_floor_contact_time(scene=ballc.Scene()):
     return (-vz0 - math.sqrt(vz0 ** 2 + 2 * G * (z0 - r))) / (-G)
 
 
-@pytest.mark.parametrize("method", ["radau5", "Radau"])
+@pytest.mark.parametrize("method", ["radau5", "dop853", "Radau"])
 def test_dense_output_follows_the_parabola_in_flight(method):
     """In free flight (before the first contact) sol(t) is the integrator's interpolant
     of an exact parabola: it must match it to the tolerance's order."""
@@ -39,7 +39,7 @@ def test_dense_output_follows_the_parabola_in_flight(method):
     assert result.sol(t).shape == (len(ballc.STATE_NAMES), t.size)
 
 
-@pytest.mark.parametrize("method", ["radau5", "Radau"])
+@pytest.mark.parametrize("method", ["radau5", "dop853", "Radau"])
 def test_dense_output_agrees_with_the_stored_samples_across_contacts(method):
     """Over a run with contacts and stick/slip events the interpolant passes through
     every stored sample (the integrator's own steps) and is continuous at the events."""
@@ -61,7 +61,7 @@ def test_no_dense_output_by_default():
     assert ballc.simulate(ballc.Scene(), 0.1).sol is None
 
 
-@pytest.mark.parametrize("method", ["radau5", "Radau", "BDF"])
+@pytest.mark.parametrize("method", ["radau5", "dop853", "Radau", "BDF"])
 def test_user_event_finds_the_ballistic_crossing(method):
     """g = z - 3 m falling: the parabola crosses at t = (25 - sqrt(625 - 2 g 2)) / g...
     solved exactly; the event is not terminal, so the run goes on to t_end."""

@@ -77,6 +77,7 @@ cdef extern from "_radau5_solver.h":
         double *dense_t
         double *dense_c
         int dense_terms
+        double stiff_at
         int profiled
         double prof[7]
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
@@ -424,7 +425,7 @@ cdef object _run(radau5_problem *p, int n, int m):
             memcpy(&hyv[0, 0], r.hit_y, r.n_hits * n * sizeof(double))
         status, message, r_hits = r.status, r.message.decode(), r.n_hits
         counts = dict(nfev=r.nfev, njev=r.njev, nlu=r.nlu, nstep=r.nstep, nreject=r.nreject,
-                      h_next=r.h_next, n_rearmed=r.n_rearmed)
+                      h_next=r.h_next, n_rearmed=r.n_rearmed, stiff_at=r.stiff_at)
         if r.profiled:   # a -DRADAU5_PROFILE build (benchmarks/profile_step.py)
             counts["profile"] = dict(zip(("fun", "jac", "factor", "solve", "events",
                                           "total", "total_ns"), [r.prof[i] for i in range(7)]))

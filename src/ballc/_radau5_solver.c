@@ -111,6 +111,7 @@ typedef struct {
      * its dense output's terms (DOP853_DENSE_TERMS x n) once computed (dense_ready) */
     int dop853, dense_ready;
     double *K, *Fdense;
+    int stiff_steps, nonstiff_steps;      /* Hairer's stiffness test (step_dop853) */
     /* events */
     double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */
     int *active;
@@ -611,6 +612,23 @@ static int step_dop853(solver_t *s)
         rejected = 1;
         s->r->nreject++;
     }
+    /* Hairer's stiffness test (dop853.f, after each accepted step here): h lambda
+     * estimated from the last two stages at c = 1, K[11] at the stage argument (s->tmp,
+     * as dop853_attempt left it) and K[12] at y_new; 15 estimates in a row beyond the
+     * stability boundary (6.1) mean the steps are bounded by stability, not accuracy */
+    double num = 0, den = 0;
+    for (int c = 0; c < n; c++) {
+        double dk = K[DOP853_STAGES * n + c] - K[(DOP853_STAGES - 1) * n + c];
+        double dy = y_new[c] - s->tmp[c];
+        num += dk * dk;
+        den += dy * dy;
+    }
+    if (den > 0 && fabs(h) * sqrt(num / den) > 6.1) {
+        s->nonstiff_steps = 0;
+        if (++s->stiff_steps == 15 && isnan(s->r->stiff_at)) s->r->stiff_at = t;
+    } else if (++s->nonstiff_steps == 6) {
+        s->stiff_steps = 0;
+    }
     s->h_abs = h_abs;
     memcpy(s->y_old, y, n * sizeof(double));
     memcpy(y, y_new, n * sizeof(double));
@@ -1024,6 +1042,7 @@ void radau5_free(radau5_result *r)
 int radau5_solve(const radau5_problem *p, radau5_result *r)
 {
     memset(r, 0, sizeof *r);
+    r->stiff_at = NAN;
     const int n = p->n, m = p->n_events;
     r->status = RADAU5_FAILED;
     if (n <= 0 || m < 0) {

@@ -141,6 +141,9 @@ typedef struct {
                                *   y(t) = y_old + sum_j Q_j x^(j+1), Q_j the j-th row.
                                *   DOP853 (7): rows F0..F6 of dop853_eval. */
     int dense_terms;          /* 3 (Radau) or 7 (DOP853) */
+    double stiff_at;          /* DOP853: the start of the step at which Hairer's stiffness
+                               * test (15 steps in a row with |h lambda| > 6.1) first
+                               * fired; NaN when it did not (and always for Radau) */
     int profiled;             /* 1 in a -DRADAU5_PROFILE build */
     double prof[RADAU5_PROF_N];
 } radau5_result;

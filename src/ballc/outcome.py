@@ -8,6 +8,8 @@ contacts the last completed one decides; with none, it did not come back.)
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import _core
@@ -149,3 +151,14 @@ def _phase_times(contact, end):
     durations = np.diff(starts)
     sticking = sum(d for d, (_, phase) in zip(durations, contact.transitions) if phase == "stick")
     return float(sticking), float(end - contact.t_start - sticking)
+
+
+def stiffness_note(stiff_at):
+    """A note for the message when dop853 found the scene stiff (Hairer's test: 15 steps
+    in a row beyond its stability boundary) from ``stiff_at`` (s) on; "" when it did not
+    (None or NaN)."""
+    if stiff_at is None or not math.isfinite(stiff_at):
+        return ""
+    return (f" (dop853 found the scene stiff from t = {stiff_at:.6g} s on: its steps there "
+            "were limited by stability, not accuracy; the results are as accurate, but if "
+            "the run is slow, method='radau5' is the integrator for stiff scenes)")

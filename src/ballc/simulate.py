@@ -374,6 +374,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     bar = progress_bar(progress, t_end)
     nfev = njev = nlu = 0
     first = options.first_step
+    stiff_at = None
 
     while run.t < t_end and run.status == 0:
         if bar is not None:
@@ -401,6 +402,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         nfev += sol["nfev"]
         njev += sol["njev"]
         nlu += sol["nlu"]
+        if stiff_at is None and math.isfinite(sol.get("stiff_at", math.nan)):
+            stiff_at = sol["stiff_at"]   # dop853's stiffness test fired in this segment
         t, t_events, y_events, status = sol["t"], sol["t_events"], sol["y_events"], sol["status"]
         # An event at the segment's very start ends a zero-length segment whose event
         # sample repeats t; keep only later samples so that result.t stays increasing.
@@ -474,6 +477,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     sol=PiecewiseSolution(pieces) if options.dense_output else None)
     outcome.summarize_contact_forces(result)
     result.message += outcome.balance_warning(result, options.rtol)
+    result.message += outcome.stiffness_note(stiff_at)
     return result
 
 
