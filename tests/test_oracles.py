@@ -509,7 +509,7 @@ def test_digin_first_impact_against_the_seeds_band_latch(seed_model):
     seed's own spread between rtol 1e-10 and 1e-11 was 9.9e-7.  So the bound is that
     spread + 1e-5, not 1e-6: what is honest for a formulation whose result depends on
     the solver's call pattern (test_digin_first_impact_matches_the_seeds_equations is
-    the 1e-6 check of the model; a wrong latch moves the spin by 1e-2 or more).
+    the 1e-6 check of the model, and the latched direction is compared below).
     """
     runs = [run_seed_pipeline(0.22, rtol=tol, atol=tol, t_eval_points=2,
                               params={"mixtur": 1.0}) for tol in (1e-10, 1e-11)]
