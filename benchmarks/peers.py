@@ -234,9 +234,12 @@ def errors(y, y_ref):
 
 # ---- the contenders: one segment each, (end state, counts) ----
 
-def run_radau5(segment, system, tol):
+def run_radau5(segment, system, tol, method="radau5"):
+    """ballc's own integrator on one segment; ``method``: "radau5" or "dop853"
+    (``ballc._radau5.solve_system``'s)."""
     sol = _radau5.solve_system(segment.params, segment.latch, segment.flags,
-                               (segment.t0, segment.t1), segment.y0, rtol=tol, atol=tol)
+                               (segment.t0, segment.t1), segment.y0, rtol=tol, atol=tol,
+                               method=method)
     if sol.status != 0:
         raise RuntimeError(sol.message)
     return sol.y[:, -1], {"nfev": sol.nfev, "njev": sol.njev, "nstep": sol.nstep,
@@ -575,25 +578,25 @@ def _interp_cpu(points, err):
     return None
 
 
-def equal_error_ratios(rows, tolerances, key="err6"):
-    """{(peer, tol): (raw ratio, corrected ratio)}: the peer's CPU at radau5's error at
-    that tolerance (interpolated on the peer's curve) over radau5's CPU."""
+def equal_error_ratios(rows, tolerances, key="err6", base="radau5", peers=PEERS):
+    """{(peer, tol): (raw ratio, corrected ratio)}: the peer's CPU at the base's (radau5's)
+    error at that tolerance (interpolated on the peer's curve) over the base's CPU."""
     out = {}
-    for peer in PEERS:
+    for peer in peers:
         pts = [(rows[(peer, t)]["cpu"], rows[(peer, t)][key]) for t in tolerances
                if "cpu" in rows.get((peer, t), {})]
         pts_c = [(rows[(peer, t)]["cpu_c"], rows[(peer, t)][key]) for t in tolerances
                  if "cpu_c" in rows.get((peer, t), {})]
         for t in tolerances:
-            base = rows.get(("radau5", t), {})
-            if "cpu" not in base:
+            ref = rows.get((base, t), {})
+            if "cpu" not in ref:
                 continue
-            raw, cor = _interp_cpu(pts, base[key]), _interp_cpu(pts_c, base[key])
+            raw, cor = _interp_cpu(pts, ref[key]), _interp_cpu(pts_c, ref[key])
             if raw is None:      # say why: never that accurate, or always more accurate
                 finite = [e for _, e in pts if np.isfinite(e)]
-                out[(peer, t)] = ("n/r" if finite and base[key] < min(finite) else "<", "")
+                out[(peer, t)] = ("n/r" if finite and ref[key] < min(finite) else "<", "")
                 continue
-            out[(peer, t)] = (raw / base["cpu"], None if cor is None else cor / base["cpu"])
+            out[(peer, t)] = (raw / ref["cpu"], None if cor is None else cor / ref["cpu"])
     return out
 
 
