@@ -3,6 +3,10 @@ factorisation, solves, events (their values after each step and their roots) and
 rest, on the seed scene.
 
     python -m benchmarks.profile_step [--build DIR] [--t-end 5] [--tol 1e-8 1e-10 1e-12]
+                                      [--method radau5|dop853]
+
+``--method dop853``: the same for ballc's explicit DOP853 (same loop; no Jacobian,
+factorisation or solves: its step is 12 RHS calls and their combinations).
 
 The split needs a build of ``ballc._core`` with the solver's timers compiled in
 (``-DRADAU5_PROFILE``: time-stamp-counter reads around every right-hand side,
@@ -48,7 +52,7 @@ def build_profiled(where: Path, quiet: bool = False) -> Path:
     return lib
 
 
-def measure(t_end, tol, repeat):
+def measure(t_end, tol, repeat, method="radau5"):
     import ballc
     from ballc import _radau5
 
@@ -72,7 +76,7 @@ def measure(t_end, tol, repeat):
 
         _radau5.solve_system = wrapped
         try:
-            result = ballc.simulate(ballc.Scene(), t_end, rtol=tol, atol=tol)
+            result = ballc.simulate(ballc.Scene(), t_end, method=method, rtol=tol, atol=tol)
         finally:
             _radau5.solve_system = original
         totals.update(nfev=result.nfev, njev=result.njev, nlu=result.nlu)
@@ -82,16 +86,17 @@ def measure(t_end, tol, repeat):
     return best[1]
 
 
-def report(t_end, tols, repeat):
+def report(t_end, tols, repeat, method="radau5"):
     import ballc
     print(f"build: {ballc.__file__}")
-    print(f"scene: seed defaults, {t_end:g} s, rtol = atol = tol, best of {repeat}")
+    print(f"scene: seed defaults, {t_end:g} s, rtol = atol = tol, method {method}, "
+          f"best of {repeat}")
     header = (f"{'tol':>7s} {'steps':>6s} {'rej':>5s} {'RHS/st':>6s} {'Jac/st':>6s} {'LU/st':>6s} "
               f"{'us/step':>7s} " + " ".join(f"{LABELS[k]:>8s}" for k in PARTS)
               + f" {'rest':>8s} {'bridge':>8s}")
     print(header)
     for tol in tols:
-        m = measure(t_end, tol, repeat)
+        m = measure(t_end, tol, repeat, method)
         n = m["nstep"]
         line = (f"{tol:7.0e} {n:6d} {m['nreject']:5d} {m['nfev'] / n:6.2f} {m['njev'] / n:6.3f} "
                 f"{m['nlu'] / n:6.3f} ")
@@ -119,14 +124,16 @@ def main(argv=None):
     parser.add_argument("--t-end", type=float, default=5.0)
     parser.add_argument("--tol", type=float, nargs="+", default=[1e-8, 1e-10, 1e-12])
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--method", choices=("radau5", "dop853"), default="radau5")
     args = parser.parse_args(argv)
     if args.build is not None:
         lib = build_profiled(args.build.resolve())
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(lib), str(ROOT)]))
         command = [sys.executable, "-m", "benchmarks.profile_step", "--t-end", str(args.t_end),
-                   "--repeat", str(args.repeat), "--tol", *map(str, args.tol)]
+                   "--repeat", str(args.repeat), "--method", args.method,
+                   "--tol", *map(str, args.tol)]
         raise SystemExit(subprocess.run(command, cwd=ROOT, env=env).returncode)
-    report(args.t_end, args.tol, args.repeat)
+    report(args.t_end, args.tol, args.repeat, args.method)
 
 
 if __name__ == "__main__":

@@ -285,8 +285,9 @@ def main(argv=None) -> int:
     run.add_argument("--atol", type=float, default=None,
                      help="absolute tolerance (default: [simulate] atol, else simulate's)")
     run.add_argument("--method", default=None,
-                     help="integrator: radau5 or a solve_ivp method (default: [simulate] "
-                          "method, else radau5)")
+                     help="integrator: radau5, dop853 (explicit, order 8: several times "
+                          "faster at tight tolerances on scenes that are not stiff) or a "
+                          "solve_ivp method (default: [simulate] method, else radau5)")
     run.add_argument("--no-exact-flight", action="store_true",
                      help="integrate free flight even where it has a closed form (default: "
                           "[simulate] exact_flight, else closed form where exact)")
