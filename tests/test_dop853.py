@@ -7,8 +7,6 @@ of right-hand-side calls; the values differ by rounding (summation order).  Its 
 their refinement and re-arming, t_eval and dense output are radau5's code, with
 DOP853's 7th-order interpolant in place of Radau's cubic.
 """
-import math
-
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -17,7 +15,6 @@ from scipy.linalg import expm
 
 import ballc
 from ballc import _core, _radau5
-from ballc.events import LinearEvent
 
 # A lightly damped oscillator and a slow decay: smooth, not stiff.
 A_SMOOTH = np.array([[-0.1, 3.0, 0.0], [-3.0, -0.1, 0.0], [0.5, 0.0, -0.7]])
@@ -116,33 +113,6 @@ def test_extra_stages_only_where_the_dense_output_is_used():
                                method="dop853", t_eval=[base.t[3] / 2 + base.t[4] / 2])
     assert quiet.nfev == base.nfev
     assert one.nfev == base.nfev + 3
-
-
-def test_a_re_armed_event_moves_on_without_a_stop():
-    """As radau5's test of the same name: a falling ball's height event re-armed from
-    4.5 to 4 to 3 m, then a hit at 2 m, each at its exact time."""
-    scene = ballc.Scene(observer_mass=0.0, position=(0.0, 0.0, 5.0), velocity=(0.0, 0.0, 0.0),
-                        angular_velocity=(0.0, 0.0, 0.0))
-    params = scene.parameter_vector()
-    latch = np.zeros(_core.N_LATCH)
-    y0 = scene.initial_state()
-    g = abs(scene.gravity)
-    heights = [4.5, 4.0, 3.0, 2.0]
-    seen = []
-
-    def rearm(t, y):
-        seen.append(t)
-        if len(seen) == len(heights):
-            return None
-        return event.coefficients, -heights[len(seen)], latch
-    event = LinearEvent.of_state("z", 1.0, -heights[0], terminal=True, direction=-1)
-    event.rearm = rearm
-    sol = _radau5.solve_system(params, latch, 0, (0.0, 2.0), y0, rtol=1e-10, atol=1e-10,
-                               events=[event], method="dop853")
-    expected = [math.sqrt(2 * (5.0 - h) / g) for h in heights]
-    assert sol.status == 1 and sol.n_rearmed == 3
-    np.testing.assert_allclose(seen, expected, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(sol.t_events[0], expected[-1:], rtol=0, atol=1e-12)
 
 
 def test_failure_and_budget_are_honest():

@@ -35,10 +35,12 @@ static const double D_[4][16] = {
     {-25.69393346270375, 0.0, 0.0, 0.0, 0.0, -154.18974869023643, -231.5293791760455, 357.6391179106141, 93.40532418362432, -37.45832313645163, 104.0996495089623, 29.8402934266605, -43.53345659001114, 96.32455395918828, -39.17726167561544, -149.72683625798564},
 };
 
-int dop853_attempt(dop853_fun fun, void *ctx, int n, double t, double h, const double *y,
-                   double *K, double *y_new, double *ytmp)
+/* Stages first .. last - 1 from (t, y): K[s] = f(t + C[s] h, y + h sum_j A[s][j] K[j]).
+ * Returns 0, or the first nonzero return of fun. */
+static int stages(dop853_fun fun, void *ctx, int n, double t, double h, const double *y,
+                  double *K, int first, int last, double *ytmp)
 {
-    for (int s = 1; s < DOP853_STAGES; s++) {
+    for (int s = first; s < last; s++) {
         for (int c = 0; c < n; c++) {
             double dy = 0;
             for (int j = 0; j < s; j++)
@@ -48,6 +50,14 @@ int dop853_attempt(dop853_fun fun, void *ctx, int n, double t, double h, const d
         int rc = fun(ctx, t + C[s] * h, ytmp, K + s * n);
         if (rc != 0) return rc;
     }
+    return 0;
+}
+
+int dop853_attempt(dop853_fun fun, void *ctx, int n, double t, double h, const double *y,
+                   double *K, double *y_new, double *ytmp)
+{
+    int rc = stages(fun, ctx, n, t, h, y, K, 1, DOP853_STAGES, ytmp);
+    if (rc != 0) return rc;
     for (int c = 0; c < n; c++) {
         double dy = 0;
         for (int j = 0; j < DOP853_STAGES; j++)
@@ -78,16 +88,9 @@ double dop853_error_norm(int n, const double *K, double h, const double *scale)
 int dop853_dense(dop853_fun fun, void *ctx, int n, double t_old, double h,
                  const double *y_old, const double *y, double *K, double *F, double *ytmp)
 {
-    for (int s = DOP853_STAGES + 1; s < DOP853_STAGES_EXTENDED; s++) {
-        for (int c = 0; c < n; c++) {
-            double dy = 0;
-            for (int j = 0; j < s; j++)
-                if (A[s][j] != 0) dy += A[s][j] * K[j * n + c];
-            ytmp[c] = y_old[c] + h * dy;
-        }
-        int rc = fun(ctx, t_old + C[s] * h, ytmp, K + s * n);
-        if (rc != 0) return rc;
-    }
+    int rc = stages(fun, ctx, n, t_old, h, y_old, K, DOP853_STAGES + 1,
+                    DOP853_STAGES_EXTENDED, ytmp);
+    if (rc != 0) return rc;
     const double *f_old = K, *f = K + DOP853_STAGES * n;
     for (int c = 0; c < n; c++) {
         double delta = y[c] - y_old[c];

@@ -371,6 +371,25 @@ static void dense(const solver_t *s, double tt, double *out)
         out[c] = s->y_old[c] + s->Q[3 * c] * p1 + s->Q[3 * c + 1] * p2 + s->Q[3 * c + 2] * p3;
 }
 
+/* The next attempt's step from t: *h_abs in the direction of integration, cut at
+ * t_bound; sets *h and *t_new, and *h_abs to the cut size.  Returns 0 (message set)
+ * when *h_abs is below min_step (as scipy's solvers). */
+static int attempt_size(solver_t *s, double t, double min_step, double *h_abs, double *h,
+                        double *t_new)
+{
+    if (*h_abs < min_step) {
+        snprintf(s->r->message, sizeof s->r->message,
+                 "Required step size is less than spacing between numbers.");
+        return 0;
+    }
+    *h = *h_abs * s->direction;
+    *t_new = t + *h;
+    if (s->direction * (*t_new - s->t_bound) > 0) *t_new = s->t_bound;
+    *h = *t_new - t;
+    *h_abs = fabs(*h);
+    return 1;
+}
+
 /* Radau._step_impl.  Returns 1 on success, 0 on failure (message set). */
 static int step_radau(solver_t *s)
 {
@@ -398,16 +417,7 @@ static int step_radau(solver_t *s)
     double rate = 0, theta = 0, h = 0, t_new = t, error_norm = 0, safety = 0;
     double *Z = s->Znew, *y_new = s->y_new, *err = s->err, *ZE = s->ZE;
     for (;;) {   /* while not step_accepted */
-        if (h_abs < min_step) {
-            snprintf(s->r->message, sizeof s->r->message,
-                     "Required step size is less than spacing between numbers.");
-            return 0;
-        }
-        h = h_abs * s->direction;
-        t_new = t + h;
-        if (s->direction * (t_new - s->t_bound) > 0) t_new = s->t_bound;
-        h = t_new - t;
-        h_abs = fabs(h);
+        if (!attempt_size(s, t, min_step, &h_abs, &h, &t_new)) return 0;
 
         if (!s->have_sol) {
             memset(s->Z0, 0, 3 * n * sizeof(double));
@@ -582,16 +592,7 @@ static int step_dop853(solver_t *s)
     double h = 0, t_new = t;
     memcpy(K, s->f, n * sizeof(double));
     for (;;) {
-        if (h_abs < min_step) {
-            snprintf(s->r->message, sizeof s->r->message,
-                     "Required step size is less than spacing between numbers.");
-            return 0;
-        }
-        h = h_abs * s->direction;
-        t_new = t + h;
-        if (s->direction * (t_new - s->t_bound) > 0) t_new = s->t_bound;
-        h = t_new - t;
-        h_abs = fabs(h);
+        if (!attempt_size(s, t, min_step, &h_abs, &h, &t_new)) return 0;
         if (dop853_attempt(dop853_call, s, n, t, h, y, K, y_new, s->tmp) != 0) {
             h_abs *= 0.5;
             rejected = 1;
