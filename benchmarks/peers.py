@@ -15,6 +15,9 @@ compiled right-hand side and analytic Jacobian (``ballc._core.System(params, lat
 flags)``), at rtol = atol = tol; no events, no output but the end state:
 
 - ``radau5``: ballc's solver, ``ballc._radau5.solve_system`` (C callbacks, no Python);
+- ``dop853``: ballc's other compiled integrator, Dormand & Prince's explicit DOP853
+  (order 8, scipy's DOP853 step by step in C), through the same ``solve_system`` with
+  ``method="dop853"`` (C callbacks; no Jacobian, no LU);
 - ``CVODE BDF`` and ``CVODE Adams``: SUNDIALS CVODE through scikit-sundae
   (``sksundae.cvode.CVODE``, dense linear solver, user Jacobian, ``tstop`` at the
   segment's end so that it steps onto it rather than interpolating back);
@@ -24,7 +27,8 @@ flags)``), at rtol = atol = tol; no events, no output but the end state:
   wrapper in the same wheel (``assimulo.lib.radau5.radau5``), called directly
   (IOUT = 0, default WORK/IWORK parameters, analytic full Jacobian).
 
-The peers call the RHS and the Jacobian through Python; radau5 calls them in C.
+The peers call the RHS and the Jacobian through Python; radau5 and dop853 call them in
+C (so they have no callback cost to subtract: their "C-level" CPU is their CPU).
 
 Measured per tolerance: total CPU over the segments (``time.process_time``, best of
 ``--repeat``; within a repeat the contenders run one after another in a rotated
@@ -80,9 +84,12 @@ TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-
 QUICK_TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14)
 #: radau5 refuses rtol < 100 machine epsilons (ballc.options)
 RADAU5_MIN_TOL = 100 * np.finfo(float).eps
-CONTENDERS = ("radau5", "CVODE BDF", "CVODE Adams", "assimulo Radau5ODE",
+CONTENDERS = ("radau5", "dop853", "CVODE BDF", "CVODE Adams", "assimulo Radau5ODE",
               "Hairer RADAU5 (f2py)")
-PEERS = CONTENDERS[1:]
+#: ballc's own compiled integrators (C callbacks, rtol >= RADAU5_MIN_TOL)
+BALLC = ("radau5", "dop853")
+#: the others, called back through Python
+PEERS = tuple(name for name in CONTENDERS if name not in BALLC)
 MISSING = ('benchmarks/peers.py needs the optional peers (scikit-sundae, assimulo-testing): '
            'pip install ".[bench]"')
 
@@ -246,6 +253,17 @@ def run_radau5(segment, system, tol, method="radau5"):
                           "nlu": sol.nlu}
 
 
+def run_dop853(segment, system, tol):
+    """ballc's compiled DOP853 (explicit, order 8) in radau5's loop: no Jacobian, no LU."""
+    sol = _radau5.solve_system(segment.params, segment.latch, segment.flags,
+                               (segment.t0, segment.t1), segment.y0, rtol=tol, atol=tol,
+                               method="dop853")
+    if sol.status != 0:
+        raise RuntimeError(sol.message)
+    return sol.y[:, -1], {"nfev": sol.nfev, "njev": sol.njev, "nstep": sol.nstep,
+                          "nlu": sol.nlu}
+
+
 def cvode_callbacks(system):
     def rhsfn(t, y, yp):
         yp[:] = system(t, y)
@@ -339,7 +357,7 @@ def run_fortran(segment, system, tol):
 
 
 def contenders():
-    return {"radau5": run_radau5, "CVODE BDF": make_cvode("BDF"),
+    return {"radau5": run_radau5, "dop853": run_dop853, "CVODE BDF": make_cvode("BDF"),
             "CVODE Adams": make_cvode("Adams"), "assimulo Radau5ODE": run_assimulo,
             "Hairer RADAU5 (f2py)": run_fortran}
 
@@ -502,13 +520,15 @@ def benchmark(tolerances, repeat, budget, c_cost=True, log=print):
         best = {}
         outputs = {}
         if tol < RADAU5_MIN_TOL:
-            rows[("radau5", tol)] = {"skipped": f"rtol below radau5's limit {RADAU5_MIN_TOL:.2g}"}
+            for name in BALLC:
+                rows[(name, tol)] = {"skipped": "rtol below ballc's limit "
+                                                f"{RADAU5_MIN_TOL:.2g}"}
         for rep in range(repeat):
             order = CONTENDERS[rep % len(CONTENDERS):] + CONTENDERS[:rep % len(CONTENDERS)]
             for name in order:
                 if name in dropped or (rep > 0 and name not in outputs):
                     continue
-                if name == "radau5" and tol < RADAU5_MIN_TOL:
+                if name in BALLC and tol < RADAU5_MIN_TOL:
                     continue
                 if rep > 0 and best[name] > budget:
                     continue              # one pass was enough for a slow one
@@ -578,15 +598,21 @@ def _interp_cpu(points, err):
     return None
 
 
-def equal_error_ratios(rows, tolerances, key="err6", base="radau5", peers=PEERS):
-    """{(peer, tol): (raw ratio, corrected ratio)}: the peer's CPU at the base's (radau5's)
-    error at that tolerance (interpolated on the peer's curve) over the base's CPU."""
+def equal_error_ratios(rows, tolerances, key="err6", base="radau5", peers=None):
+    """{(contender, tol): (raw ratio, corrected ratio)}: the contender's CPU at the base's
+    (radau5's, or dop853's) error at that tolerance (interpolated on its curve) over the
+    base's CPU, for ``peers`` (default: every contender in ``rows`` but the base).
+    ballc's compiled ones (BALLC) have no callback cost: their corrected ratio is their
+    raw one."""
     out = {}
+    if peers is None:
+        peers = [name for name in dict.fromkeys(name for name, _ in rows) if name != base]
     for peer in peers:
+        c_key = "cpu" if peer in BALLC else "cpu_c"
         pts = [(rows[(peer, t)]["cpu"], rows[(peer, t)][key]) for t in tolerances
                if "cpu" in rows.get((peer, t), {})]
-        pts_c = [(rows[(peer, t)]["cpu_c"], rows[(peer, t)][key]) for t in tolerances
-                 if "cpu_c" in rows.get((peer, t), {})]
+        pts_c = [(rows[(peer, t)][c_key], rows[(peer, t)][key]) for t in tolerances
+                 if c_key in rows.get((peer, t), {})]
         for t in tolerances:
             ref = rows.get((base, t), {})
             if "cpu" not in ref:
@@ -612,28 +638,34 @@ def plot(bench, tolerances, path):
     import matplotlib.pyplot as plt
     rows = bench["rows"]
     fig, axes = plt.subplots(2, 2, figsize=(13, 10.5), sharex=True)
-    styles = dict(zip(CONTENDERS, ("o-", "s--", "^--", "v--", "d--")))
-    colours = dict(zip(CONTENDERS, ("black", "tab:blue", "tab:cyan", "tab:orange", "tab:red")))
+    styles = dict(zip(CONTENDERS, ("o-", "D-", "s--", "^--", "v--", "d--")))
+    colours = dict(zip(CONTENDERS, ("black", "tab:red", "tab:blue", "tab:cyan", "tab:orange",
+                                    "tab:brown")))
     n_near = sum(near_singular(s) for s in bench["segments"])
     for i, (err_key, err_label) in enumerate((
             ("err6", f"all {len(bench['segments'])} segments"),
             ("err6_regular", f"without the {n_near} near-singular slip starts"))):
-        for j, (key, title) in enumerate((("cpu", "raw CPU (peers call back into Python)"),
+        for j, (key, title) in enumerate((("cpu", "raw CPU (peers call back into Python; "
+                                                  "radau5, dop853 in C)"),
                                           ("cpu_c", "peers: Python callback cost subtracted "
                                                     "(est. C-level)"))):
             ax = axes[i, j]
             for name in CONTENDERS:
-                k = "cpu" if name == "radau5" else key
+                k = "cpu" if name in BALLC else key
                 pts = [(rows[(name, t)][k], max(rows[(name, t)][err_key], 1e-16), t)
                        for t in tolerances if k in rows.get((name, t), {})]
                 if not pts:
                     continue
                 cpu, err, tols = zip(*pts)
-                ax.loglog(cpu, err, styles[name], color=colours[name], label=name, ms=4)
-                if name == "radau5":
+                ax.loglog(cpu, err, styles[name], color=colours[name], ms=4,
+                          label="dop853 (ballc, compiled)" if name == "dop853" else name,
+                          lw=1.6 if name in BALLC else 1.0)
+                if name in BALLC:
+                    below = name == "dop853"
                     for c, e, t in zip(cpu, err, tols):
-                        ax.annotate(f"{t:.0e}", (c, e), fontsize=6, xytext=(3, 3),
-                                    textcoords="offset points")
+                        ax.annotate(f"{t:.0e}", (c, e), fontsize=6,
+                                    xytext=(3, -9 if below else 3), textcoords="offset points",
+                                    color=colours[name])
             ax.set_title(f"{title}\nerror: {err_label}", fontsize=9)
             ax.grid(True, which="both", alpha=0.3)
             if i == 1:
@@ -643,7 +675,7 @@ def plot(bench, tolerances, path):
                               fontsize=8)
     axes[0, 0].legend(fontsize=8)
     fig.suptitle(f"Segment replay of the seed scene ({T_END:g} s), same compiled RHS and "
-                 "analytic Jacobian for every contender; rtol = atol (labels on radau5)",
+                 "analytic Jacobian for every contender; rtol = atol (labels on radau5, dop853)",
                  fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -660,7 +692,7 @@ def write_markdown(bench, tolerances, args, elapsed, path):
         names = [flag_names[b] for b in sorted(flag_names) if flags & b]
         return ", ".join(names) if names else "free flight (no flags)"
     lines = [
-        "# Peers: radau5 against CVODE and Hairer's RADAU5", "",
+        "# Peers: radau5 and dop853 against CVODE and Hairer's RADAU5", "",
         f"Generated by `python -m benchmarks.peers{' --quick' if args.quick else ''}` "
         f"({elapsed:.0f} s wall; 2-core machine shared with other work: CPU is "
         f"`time.process_time()`, best of {args.repeat}, the contenders interleaved in one "
@@ -691,11 +723,15 @@ def write_markdown(bench, tolerances, args, elapsed, path):
         "`python -m benchmarks.cvode_c`), the measured CPU is 4-12x below this estimate, "
         "and CVODE BDF is level with radau5 there (CVODE Adams faster at tight "
         "tolerances).",
-        "- **equal-error ratio**: the peer's CPU interpolated (log-log, between its two "
-        "neighbouring tolerances) at radau5's err6 for that tolerance, over radau5's CPU; "
-        "`n/r` when the peer never got that accurate, `<` when it was more accurate even at "
-        "its loosest tolerance.", "",
-        "Contenders: `radau5` -- `ballc._radau5.solve_system` (C callbacks); `CVODE BDF`, "
+        "- **equal-error ratio**: the contender's CPU interpolated (log-log, between its "
+        "two neighbouring tolerances) at radau5's err6 for that tolerance, over radau5's "
+        "CPU; `n/r` when the contender never got that accurate, `<` when it was more "
+        "accurate even at its loosest tolerance.", "",
+        "Contenders: `radau5` -- `ballc._radau5.solve_system` (C callbacks); `dop853` -- "
+        "ballc's other compiled integrator, Dormand & Prince's explicit DOP853 (order 8, "
+        "scipy's DOP853 step by step in C), the same `solve_system` with "
+        "`method=\"dop853\"` (C callbacks, no Jacobian, no LU: its C-level CPU is its "
+        "CPU); `CVODE BDF`, "
         "`CVODE Adams` -- SUNDIALS CVODE via scikit-sundae, dense linear solver, user "
         "Jacobian, `tstop` at the segment end, `max_num_steps` unlimited; `assimulo Radau5ODE`"
         " -- assimulo's C translation of Hairer's RADAU5 (defaults: initial step 0.01, "
@@ -729,33 +765,48 @@ def write_markdown(bench, tolerances, args, elapsed, path):
                 f"| {r['njev']} | {_g(r['nstep'], 'd')} |")
     ratio_all = equal_error_ratios(rows, tolerances, "err6")
     ratio_reg = equal_error_ratios(rows, tolerances, "err6_regular")
-    lines += ["", "## CPU ratio peer / radau5 at equal error", "",
-              "For each tolerance of radau5: the peer's CPU at radau5's error there "
+    others = [name for name in CONTENDERS[1:]
+              if any(name == n for n, _ in ratio_all)]
+    lines += ["", "## CPU ratio contender / radau5 at equal error", "",
+              "For each tolerance of radau5: the contender's CPU at radau5's error there "
               "(log-log interpolation between the first two consecutive tolerances of the "
-              "peer whose errors bracket it) over radau5's CPU; raw / C-level (Python "
-              "callback cost subtracted).  `n/r`: the peer never got that accurate at any "
-              "measured tolerance; `<`: the peer was more accurate than that even at its "
+              "contender whose errors bracket it) over radau5's CPU; for the peers raw / "
+              "C-level (Python callback cost subtracted), for dop853 (compiled, no callback "
+              "cost) one number.  `n/r`: the contender never got that accurate at any "
+              "measured tolerance; `<`: it was more accurate than that even at its "
               "loosest tolerance (no CPU to interpolate).  Where radau5's err6 over all "
               "segments is O(1) (the near-singular segments diverged, loose tolerances) the "
               "(all) ratios compare diverged trajectories and mean nothing: read the "
               "(regular) ones there.", "",
-              "| radau5 tol | radau5 err6 | " + " | ".join(f"{p} (all)" for p in PEERS)
-              + " | radau5 err6 (regular) | " + " | ".join(f"{p} (regular)" for p in PEERS)
-              + " |", "|---|---|" + "---|" * len(PEERS) + "---|" + "---|" * len(PEERS)]
+              "| radau5 tol | radau5 err6 | " + " | ".join(f"{p} (all)" for p in others)
+              + " | radau5 err6 (regular) | " + " | ".join(f"{p} (regular)" for p in others)
+              + " |", "|---|---|" + "---|" * len(others) + "---|" + "---|" * len(others)]
 
-    def cell(ratio):
+    def cell(ratio, name=None):
         raw, cor = ratio if ratio else (None, None)
         if isinstance(raw, str):
             return raw
+        if name in BALLC:
+            return _g(raw)
         return "" if raw is None and cor is None else f"{_g(raw)} / {_g(cor)}"
     for tol in tolerances:
         base = rows.get(("radau5", tol), {})
         if "cpu" not in base:
             continue
         lines.append(f"| {tol:.0e} | {base['err6']:.1e} | "
-                     + " | ".join(cell(ratio_all.get((p, tol))) for p in PEERS)
+                     + " | ".join(cell(ratio_all.get((p, tol)), p) for p in others)
                      + f" | {base['err6_regular']:.1e} | "
-                     + " | ".join(cell(ratio_reg.get((p, tol))) for p in PEERS) + " |")
+                     + " | ".join(cell(ratio_reg.get((p, tol)), p) for p in others) + " |")
+    dop = [(tol, ratio_reg[("dop853", tol)][0]) for tol in tolerances
+           if isinstance(ratio_reg.get(("dop853", tol), (None,))[0], float)]
+    if dop:
+        lines += ["", "dop853 / radau5 at equal err6 (regular), by radau5's tolerance: "
+                  + ", ".join(f"{tol:.0e}: {ratio:.2g}" for tol, ratio in dop)
+                  + " (< 1: dop853 cheaper).  Both call the same compiled RHS from C, so "
+                  "this is the integrators alone; dop853 is explicit (no Jacobian, no LU) "
+                  "and these segments are not stiff (the seed's rubber ball; see "
+                  "[work_precision](work_precision.md#when-dop853-is-the-wrong-choice) for a "
+                  "stiff scene)."]
     py, c = bench["py"], bench["c"]
     lines += ["", "## Callback cost per call (µs)", "",
               "Python: the callable each peer is given, called from a Python loop (best of "

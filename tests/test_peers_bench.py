@@ -50,6 +50,19 @@ def test_radau5_replay_reproduces_the_reference(recorded, tol, bound):
     assert worst < bound
 
 
+@pytest.mark.parametrize("tol, bound", [(1e-8, 1e-5), (1e-10, 1e-7), (1e-12, 1e-9)])
+def test_dop853_replay_reproduces_the_reference(recorded, tol, bound):
+    """ballc's compiled DOP853 (a contender of the replay) reaches every segment's
+    recorded end to the order of the tolerance, without a Jacobian or an LU."""
+    _, segments = recorded
+    worst = 0.0
+    for seg in peers.replayable(segments):
+        y, counts = peers.run_dop853(seg, None, tol)
+        assert counts["nfev"] > 0 and counts["njev"] == 0 and counts["nlu"] == 0
+        worst = max(worst, max(peers.errors(y, seg.y1)))
+    assert worst < bound
+
+
 def test_rotation_error():
     q = np.array([1.0, 0.0, 0.0, 0.0])
     assert np.allclose(peers._rotation_error(q, q), 0)
@@ -68,7 +81,8 @@ def test_peers_replay_a_contact(recorded):
         for seg in segments:
             y, counts = run(seg, seg.system(), 1e-8)
             assert peers.errors(y, seg.y1)[0] < 1e-4, name
-            assert counts["nfev"] > 0 and counts["njev"] > 0, name
+            assert counts["nfev"] > 0, name
+            assert counts["njev"] > 0 or name == "dop853", name   # explicit: no Jacobian
 
 
 def test_missing_peer_message():
