@@ -109,7 +109,8 @@ typedef struct {
     cplx *ctmp;
     /* DOP853 (problem.method): the stages of the last step (DOP853_STAGES_EXTENDED x n),
      * its dense output's terms (DOP853_DENSE_TERMS x n) once computed (dense_ready) */
-    int dop853, dense_ready;
+    int dop853, dense_ready, k_stale;     /* k_stale: K was overwritten by attempts that
+                                           * were not accepted (a failed step) */
     double *K, *Fdense;
     int stiff_steps, nonstiff_steps;      /* Hairer's stiffness test (step_dop853) */
     /* events */
@@ -591,6 +592,7 @@ static int step_dop853(solver_t *s)
     int rejected = 0;
     double h = 0, t_new = t;
     memcpy(K, s->f, n * sizeof(double));
+    s->k_stale = 1;   /* until an attempt is accepted: K no longer holds the last step's */
     for (;;) {
         if (!attempt_size(s, t, min_step, &h_abs, &h, &t_new)) return 0;
         if (dop853_attempt(dop853_call, s, n, t, h, y, K, y_new, s->tmp) != 0) {
@@ -638,6 +640,7 @@ static int step_dop853(solver_t *s)
     s->t = t_new;
     s->dense_end = t_new;
     s->dense_ready = 0;
+    s->k_stale = 0;
     s->have_sol = 1;
     s->r->nstep++;
     return 1;
@@ -654,6 +657,12 @@ static int step(solver_t *s)
 static int prepare_dense(solver_t *s)
 {
     if (!s->dop853 || s->dense_ready) return 0;
+    if (s->k_stale) {   /* a step failed after this one without its dense output made */
+        snprintf(s->r->message, sizeof s->r->message,
+                 "the dense output of the step from t = %.17g was lost to a failed step",
+                 s->t_old);
+        return -1;
+    }
     if (dop853_dense(dop853_call, s, s->n, s->t_old, s->t - s->t_old, s->y_old, s->y, s->K,
                      s->Fdense, s->tmp) != 0) {
         snprintf(s->r->message, sizeof s->r->message,
