@@ -35,18 +35,29 @@ static const double D_[4][16] = {
     {-25.69393346270375, 0.0, 0.0, 0.0, 0.0, -154.18974869023643, -231.5293791760455, 357.6391179106141, 93.40532418362432, -37.45832313645163, 104.0996495089623, 29.8402934266605, -43.53345659001114, 96.32455395918828, -39.17726167561544, -149.72683625798564},
 };
 
+/* sum[c] = sum_j w[j] K[j][c] over j < m with w[j] != 0, j ascending (a row at a time,
+ * so the inner loop runs along contiguous memory; for each c the additions are those of
+ * the plain per-state sum, in the same order). */
+static void combine(int n, const double *w, int m, const double *restrict K,
+                    double *restrict sum)
+{
+    for (int c = 0; c < n; c++) sum[c] = 0;
+    for (int j = 0; j < m; j++) {
+        const double a = w[j];
+        if (a == 0) continue;
+        const double *restrict k = K + (size_t)j * n;
+        for (int c = 0; c < n; c++) sum[c] += a * k[c];
+    }
+}
+
 /* Stages first .. last - 1 from (t, y): K[s] = f(t + C[s] h, y + h sum_j A[s][j] K[j]).
  * Returns 0, or the first nonzero return of fun. */
 static int stages(dop853_fun fun, void *ctx, int n, double t, double h, const double *y,
                   double *K, int first, int last, double *ytmp)
 {
     for (int s = first; s < last; s++) {
-        for (int c = 0; c < n; c++) {
-            double dy = 0;
-            for (int j = 0; j < s; j++)
-                if (A[s][j] != 0) dy += A[s][j] * K[j * n + c];
-            ytmp[c] = y[c] + h * dy;
-        }
+        combine(n, A[s], s, K, ytmp);
+        for (int c = 0; c < n; c++) ytmp[c] = y[c] + h * ytmp[c];
         int rc = fun(ctx, t + C[s] * h, ytmp, K + s * n);
         if (rc != 0) return rc;
     }
@@ -58,28 +69,21 @@ int dop853_attempt(dop853_fun fun, void *ctx, int n, double t, double h, const d
 {
     int rc = stages(fun, ctx, n, t, h, y, K, 1, DOP853_STAGES, ytmp);
     if (rc != 0) return rc;
-    for (int c = 0; c < n; c++) {
-        double dy = 0;
-        for (int j = 0; j < DOP853_STAGES; j++)
-            if (B[j] != 0) dy += B[j] * K[j * n + c];
-        y_new[c] = y[c] + h * dy;
-    }
+    combine(n, B, DOP853_STAGES, K, y_new);
+    for (int c = 0; c < n; c++) y_new[c] = y[c] + h * y_new[c];
     return fun(ctx, t + h, y_new, K + DOP853_STAGES * n);
 }
 
-double dop853_error_norm(int n, const double *K, double h, const double *scale)
+double dop853_error_norm(int n, const double *K, double h, const double *scale,
+                         double *e5, double *e3)
 {
+    combine(n, E5, DOP853_STAGES + 1, K, e5);
+    combine(n, E3, DOP853_STAGES + 1, K, e3);
     double e5_2 = 0, e3_2 = 0;
     for (int c = 0; c < n; c++) {
-        double e5 = 0, e3 = 0;
-        for (int j = 0; j <= DOP853_STAGES; j++) {
-            e5 += E5[j] * K[j * n + c];
-            e3 += E3[j] * K[j * n + c];
-        }
-        e5 /= scale[c];
-        e3 /= scale[c];
-        e5_2 += e5 * e5;
-        e3_2 += e3 * e3;
+        double a = e5[c] / scale[c], b = e3[c] / scale[c];
+        e5_2 += a * a;
+        e3_2 += b * b;
     }
     if (e5_2 == 0 && e3_2 == 0) return 0;
     return fabs(h) * e5_2 / sqrt((e5_2 + 0.01 * e3_2) * n);

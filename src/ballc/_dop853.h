@@ -22,8 +22,10 @@ int dop853_attempt(dop853_fun fun, void *ctx, int n, double t, double h, const d
                    double *K, double *y_new, double *ytmp);
 
 /* scipy's DOP853._estimate_error_norm: |h| |e5|^2 / sqrt((|e5|^2 + 0.01 |e3|^2) n), where
- * e5 = K^T E5 / scale and e3 = K^T E3 / scale over rows 0..12 of K. */
-double dop853_error_norm(int n, const double *K, double h, const double *scale);
+ * e5 = K^T E5 / scale and e3 = K^T E3 / scale over rows 0..12 of K; e5, e3 (n) are
+ * scratch (they get K^T E5 and K^T E3). */
+double dop853_error_norm(int n, const double *K, double h, const double *scale,
+                         double *e5, double *e3);
 
 /* The accepted step (t_old, y_old) -> (t_old + h, y)'s dense output: the 3 extra stages
  * (rows 13..15 of K, whose rows 0..12 are the step's) and F (DOP853_DENSE_TERMS x n).

@@ -603,7 +603,7 @@ static int step_dop853(solver_t *s)
         }
         for (int c = 0; c < n; c++)
             s->scale[c] = s->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * s->rtol;
-        double error_norm = dop853_error_norm(n, K, h, s->scale);
+        double error_norm = dop853_error_norm(n, K, h, s->scale, s->err, s->ZE);
         if (error_norm < 1) {
             double factor = error_norm == 0 ? MAX_FACTOR
                             : fmin(MAX_FACTOR, 0.9 * pow(error_norm, exponent));
