@@ -47,10 +47,15 @@ def scenes(draw, models=("friction", "mixture", "dig-in"), mirror_ready=False):
     return ballc.Scene(**fields)
 
 
+#: ballc's two compiled integrators: radau5 (the default) and the explicit dop853.
+METHODS = ("radau5", "dop853")
+
+
+@pytest.mark.parametrize("method", METHODS)
 @SETTINGS
-@given(scenes())
-def test_no_nan_and_honest_status(scene):
-    result = ballc.simulate(scene, T_END, rtol=1e-7, atol=1e-9)
+@given(scene=scenes())
+def test_no_nan_and_honest_status(method, scene):
+    result = ballc.simulate(scene, T_END, method=method, rtol=1e-7, atol=1e-9)
     assert result.status in (0, 1), result.message
     assert np.all(np.isfinite(result.y)) and np.all(np.isfinite(result.energy["total"]))
     assert np.all(np.diff(result.t) > 0)
@@ -60,13 +65,14 @@ def test_no_nan_and_honest_status(scene):
         assert "passed through" in result.message and result.t[-1] < T_END
 
 
+@pytest.mark.parametrize("method", METHODS)
 @SETTINGS
-@given(scenes(models=("friction",)))
-def test_passive_model_never_creates_energy(scene):
+@given(scene=scenes(models=("friction",)))
+def test_passive_model_never_creates_energy(method, scene):
     """Friction with c_tau <= 1 is passive: E(t_j) <= E(t_i) for all i < j, up to
     integration tolerance (1e3 rtol of the energy scale; see test_stress.energy_tolerance)."""
     rtol = 1e-8
-    result = ballc.simulate(scene, T_END, rtol=rtol, atol=1e-10)
+    result = ballc.simulate(scene, T_END, method=method, rtol=rtol, atol=1e-10)
     # a soft, heavy ball can honestly pass through the floor (rho reaches r: outside
     # the model, docs/limits.md); the energy must not rise up to there either
     assert result.status == 0 or "passed through" in result.message
