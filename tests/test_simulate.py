@@ -151,3 +151,20 @@ def test_inaccurate_integration_says_so():
 def test_bad_call_budget_is_named(bad):
     with pytest.raises(ballc.SceneError, match="max_nfev"):
         ballc.simulate(ballc.Scene(), 1.0, max_nfev=bad)
+
+
+def test_an_absolute_tolerance_below_the_contact_depth_rounding_is_named():
+    """A steel-hard ball (E = 2e11 Pa) dropped 1 m, at rest on the floor by t ~ 2.2 s: with
+    atol = 1e-12 radau5's Newton iteration cannot get the centre's height and vertical
+    velocity within atol through the rounding noise of the contact depth r - z, so it
+    crawls (measured: 919,057 calls for 0.08 s of rest) until the budget stops it; the
+    message names the cause and the way out, which works: atol = 1e-10 runs (34k calls)."""
+    scene = ballc.Scene(tangential_model="friction", ball_youngs_modulus=2e11,
+                        plane_youngs_modulus=2e11, c_tau=0.5, observer_mass=0.0,
+                        position=(0.0, 0.0, 2.0), velocity=(0.5, 0.0, 0.0))
+    stuck = ballc.simulate(scene, 3.0, rtol=1e-12, atol=1e-12, max_nfev=200_000)
+    assert stuck.status == -1 and 2.2 < stuck.t[-1] < 3.0
+    assert "max_nfev" in stuck.message and "rounding noise of the contact depth" in stuck.message
+    assert "regularised" not in stuck.message
+    fine = ballc.simulate(scene, 3.0, rtol=1e-12, atol=1e-10, max_nfev=200_000)
+    assert fine.status == 0

@@ -90,16 +90,36 @@ def _event(function, terminal, direction):
     return function
 
 
-def failure_hint(scene, in_contact):
-    """Why a contact segment may defeat the integrator, when the cause is the usual one:
-    the seed's regularised Coulomb law ("max", "smooth") with a small v_s."""
-    if not any(in_contact.values()) or scene.tangential_model not in ("friction", "mixture"):
+#: Below this absolute tolerance (m, m/s) a contact's state can be tighter than the
+#: rounding of its depth r - z allows (see failure_hint).
+TIGHT_ATOL = 1e-10
+
+
+def failure_hint(scene, in_contact, atol=None):
+    """Why a contact segment may defeat the integrator, when the cause is one of the
+    usual ones: the seed's regularised Coulomb law ("max", "smooth") with a small v_s;
+    or an absolute tolerance below the rounding of the contact depth r - z (a stiff ball
+    at rest: z ~ r, so r - z keeps few digits, and the Hertz force's rounding noise
+    keeps the Newton iteration from converging to a centre height or vertical velocity
+    within atol; measured: a steel ball, E = 2e11 Pa, at rest, crawled with atol = 1e-12
+    and ran with atol = 1e-10 on z or vz alone, docs/limits.md)."""
+    if not any(in_contact.values()):
         return ""
+    if atol is not None and float(np.min(atol)) < TIGHT_ATOL:
+        tight = (f" (in contact with atol = {float(np.min(atol)):g}: so tight an absolute "
+                 "tolerance on the centre's height and vertical velocity can be below the "
+                 "rounding noise of the contact depth r - z, most of all for a hard ball "
+                 f"at rest; try atol >= {TIGHT_ATOL:g} (one number, or per state: "
+                 "ballc.STATE_NAMES))")
+    else:
+        tight = ""
+    if scene.tangential_model not in ("friction", "mixture"):
+        return tight
     if scene.friction_coefficient == 0 or scene.effective_mixture == 1:
-        return ""
+        return tight
     if scene.friction_regularization == "exact":
-        return ""
-    return (f" (in contact with regularised Coulomb friction: below the regularisation "
+        return tight
+    return tight + (f" (in contact with regularised Coulomb friction: below the regularisation "
             f"speed {scene.friction_regularization_speed:g} m/s friction is a viscous law "
             "of coefficient mu F_n / v_s, too stiff to resolve for hard materials or loose "
             "tolerances; use friction_regularization='exact' (the default), or tighter rtol)")

@@ -432,7 +432,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                           f"(max_nfev = {options.max_nfev})")
             end = t[-1] if t.size else run.t
             run.message = (f"integrator failed at t = {end:.6g} s: {reason}"
-                           + failure_hint(scene, run.in_contact))
+                           + failure_hint(scene, run.in_contact, options.atol))
             if options.dense_output and t.size:
                 pieces.append((run.t, float(t[-1]), sol.interpolant))
             break
