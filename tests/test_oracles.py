@@ -276,8 +276,9 @@ def hertz_k0(scene):
         * math.sqrt(scene.radius)
 
 
-def ceiling_impact(material, speed, c_tau, gap_time=1e-4):
-    """The ball thrown straight up at the ceiling, gravity off; returns (scene, contact)."""
+def ceiling_impact(material, speed, c_tau, gap_time=1e-4, method="radau5"):
+    """The ball thrown straight up at the ceiling, gravity off, integrated by ``method``
+    (ballc's compiled radau5 or dop853); returns (scene, contact)."""
     radius = material.get("radius", 1.0)
     height = material.get("ceiling_height", 10.0)
     scene = ballc.Scene(**{**material, "gravity": 0.0, "observer_mass": 0.0, "c_tau": c_tau,
@@ -285,7 +286,8 @@ def ceiling_impact(material, speed, c_tau, gap_time=1e-4):
                            "position": (0.0, 0.0, height - radius - speed * gap_time),
                            "velocity": (0.0, 0.0, speed)})
     rho_max = (5 * scene.mass * speed ** 2 / (4 * hertz_k0(scene))) ** 0.4
-    result = ballc.simulate(scene, gap_time + 4 * rho_max / speed, rtol=1e-12, atol=1e-14)
+    result = ballc.simulate(scene, gap_time + 4 * rho_max / speed, method=method, rtol=1e-12,
+                            atol=1e-14)
     assert result.status == 0, result.message
     assert [c.plane for c in result.contacts] == ["ceiling"]
     return scene, result.contacts[0]
@@ -324,15 +326,18 @@ def hc_restitution_formula(c_tau):
 MATERIALS = pytest.mark.parametrize("material, speed", [(SOFT, 25.0), (SOFT, 3.0),
                                                         (STEEL, 1.0)],
                                     ids=["soft-25", "soft-3", "steel-1"])
+#: The analytic impacts are checked with both of ballc's compiled integrators.
+COMPILED = pytest.mark.parametrize("method", ["radau5", "dop853"])
 
 
+@COMPILED
 @MATERIALS
-def test_hertz_impact_at_the_ceiling(material, speed):
+def test_hertz_impact_at_the_ceiling(material, speed, method):
     """c_tau = 1: Hertz.  Energy 1/2 m v^2 = 2/5 k0 rho_max^(5/2) gives
     rho_max = (5 m v0^2 / (4 k0))^(2/5); the contact time is
     t_c = 2 rho_max / v0 * int_0^1 (1 - u^(5/2))^(-1/2) du = 0.8 B(2/5, 1/2) rho_max / v0
     (= 2.94328 rho_max / v0), and the exit speed is v0."""
-    scene, contact = ceiling_impact(material, speed, c_tau=1.0)
+    scene, contact = ceiling_impact(material, speed, c_tau=1.0, method=method)
     rho_max = (5 * scene.mass * speed ** 2 / (4 * hertz_k0(scene))) ** 0.4
     duration = 0.8 * beta_function(0.4, 0.5) * rho_max / speed
     assert 0.8 * beta_function(0.4, 0.5) == pytest.approx(2.9432751843, rel=1e-10)
@@ -342,14 +347,15 @@ def test_hertz_impact_at_the_ceiling(material, speed):
     np.testing.assert_allclose(contact.velocity_after[:2], 0.0, atol=1e-12)
 
 
+@COMPILED
 @pytest.mark.parametrize("c_tau", [0.5, 0.8, 0.95])
 @MATERIALS
-def test_hunt_crossley_impact_at_the_ceiling(material, speed, c_tau):
+def test_hunt_crossley_impact_at_the_ceiling(material, speed, c_tau, method):
     """c_tau < 1 at the ceiling: the exit/entry speed ratio is the Hunt-Crossley e of
     a (1 + e) = ln((1 + a) / (1 - a e)) (independent of speed and stiffness), which
     ballc.hunt_crossley_restitution must give too; the contact time and the maximum
     penetration are those of the 1-D Hunt-Crossley ODE integrated here by scipy."""
-    scene, contact = ceiling_impact(material, speed, c_tau)
+    scene, contact = ceiling_impact(material, speed, c_tau, method=method)
     e = hc_restitution_formula(c_tau)
     rho_max, duration, exit_speed = one_dimensional_hunt_crossley(
         scene.mass, hertz_k0(scene), speed, c_tau)
@@ -474,7 +480,8 @@ def test_digin_first_impact_matches_the_seeds_equations(seed_model):
     assert_contact_matches_seed(contact, ballc_state_at(result, contact.t_end), seed[0], 1e-6)
 
 
-def test_default_throw_first_two_contacts_match_the_seeds_equations(seed_model):
+@pytest.mark.parametrize("method", ["radau5", "dop853"])
+def test_default_throw_first_two_contacts_match_the_seeds_equations(seed_model, method):
     """The seed scene (ballc.Scene() defaults: mixture 0.375, mu 0.1), t up to ~0.69 s:
     at the end of the first floor and the first ceiling contact, ballc's contact times,
     centre position and velocity, angular velocity and orientation equal those of the
@@ -485,7 +492,8 @@ def test_default_throw_first_two_contacts_match_the_seeds_equations(seed_model):
     assert spread < 1e-7
     assert [c["plane"] for c in seed] == ["floor", "ceiling"]
     assert seed[0]["y_end"][9] < 0 < seed[1]["y_end"][9]
-    result = ballc.simulate(ballc.Scene(), seed[1]["t_end"] + 0.01, rtol=1e-12, atol=1e-12)
+    result = ballc.simulate(ballc.Scene(), seed[1]["t_end"] + 0.01, method=method, rtol=1e-12,
+                            atol=1e-12)
     assert [c.plane for c in result.contacts] == ["floor", "ceiling"]
     for ours, theirs in zip(result.contacts, seed):
         assert_contact_matches_seed(ours, ballc_state_at(result, ours.t_end), theirs, 1e-6)
