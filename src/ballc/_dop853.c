@@ -101,12 +101,11 @@ int dop853_dense(dop853_fun fun, void *ctx, int n, double t_old, double h,
         F[c] = delta;
         F[n + c] = h * f_old[c] - delta;
         F[2 * n + c] = 2 * delta - h * (f[c] + f_old[c]);
-        for (int i = 0; i < 4; i++) {
-            double v = 0;
-            for (int j = 0; j < DOP853_STAGES_EXTENDED; j++)
-                if (D_[i][j] != 0) v += D_[i][j] * K[j * n + c];
-            F[(3 + i) * n + c] = h * v;
-        }
+    }
+    for (int i = 0; i < 4; i++) {
+        double *row = F + (3 + i) * n;
+        combine(n, D_[i], DOP853_STAGES_EXTENDED, K, row);
+        for (int c = 0; c < n; c++) row[c] *= h;
     }
     return 0;
 }

@@ -93,14 +93,13 @@ EPS = np.finfo(float).eps
 ctypedef struct ball_ctx:
     const double *params
     ballc_parameters_t prepared   # params and their constants, prepared once per segment
-    const double *latch
+    double *latch            # writable: a re-armed event may change it
     int flags
     const int *event_plane   # per event: 0/1 stick release of that plane, -1 linear,
                              # -2 - k the user's Python event k
     void *user_events        # list of the user's event callables (borrowed)
     void *errors             # list collecting exceptions raised by them (borrowed)
     void *rearms             # per event: its ``rearm`` callable or None (borrowed)
-    double *latch_w          # the latch (writable: a re-armed event may change it)
     double *ev_coef_w        # the event arrays radau5 reads (events x N_STATES, events)
     double *ev_offset_w
 
@@ -156,7 +155,6 @@ cdef int _rearm_event(ball_ctx *c, int e, double t, const double *y) noexcept:
     is kept for solve_system to raise, and the event stops the integration meanwhile."""
     cdef double[::1] yv
     cdef const double[::1] cv, lv
-    cdef Py_ssize_t i
     cdef double off
     errors = <list>c.errors
     if errors:
@@ -177,7 +175,7 @@ cdef int _rearm_event(ball_ctx *c, int e, double t, const double *y) noexcept:
         memcpy(c.ev_coef_w + <size_t>e * BALLC_N_STATES, &cv[0],
                BALLC_N_STATES * sizeof(double))
         c.ev_offset_w[e] = off
-        memcpy(c.latch_w, &lv[0], BALLC_N_LATCH * sizeof(double))
+        memcpy(c.latch, &lv[0], BALLC_N_LATCH * sizeof(double))
         return 1
     except BaseException as error:
         errors.append(error)
@@ -605,7 +603,6 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ctx.params = &pv[0]
     ballc_parameters_init(&ctx.prepared, &pv[0])
     ctx.latch = &lv[0]
-    ctx.latch_w = &lv[0]
     ctx.flags = flags
     ctx.event_plane = &planes[0]
     users, errors = [], []

@@ -357,6 +357,13 @@ static double predict_factor(double h_abs, double h_abs_old, int have_h_abs_old,
     return fmin(1, multiplier) * pow(error_norm, -0.25);   /* inf when error_norm == 0 */
 }
 
+/* The last accepted step's dense output terms, r->dense_terms rows of n: Radau's Q
+ * (x, x^2, x^3), or DOP853's F (once prepare_dense has computed them). */
+static const double *dense_terms(const solver_t *s)
+{
+    return s->dop853 ? s->Fdense : s->Q;
+}
+
 /* RadauDenseOutput (or Dop853DenseOutput: its terms computed by prepare_dense) of the
  * last accepted step at time tt. */
 static void dense(const solver_t *s, double tt, double *out)
@@ -369,7 +376,7 @@ static void dense(const solver_t *s, double tt, double *out)
     }
     double p1 = x, p2 = x * x, p3 = x * x * x;
     for (int c = 0; c < n; c++)
-        out[c] = s->y_old[c] + s->Q[3 * c] * p1 + s->Q[3 * c + 1] * p2 + s->Q[3 * c + 2] * p3;
+        out[c] = s->y_old[c] + s->Q[c] * p1 + s->Q[n + c] * p2 + s->Q[2 * n + c] * p3;
 }
 
 /* The next attempt's step from t: *h_abs in the direction of integration, cut at
@@ -560,10 +567,11 @@ static int step_radau(solver_t *s)
     s->t_old = t;
     s->t = t_new;
     s->dense_end = t_new;
-    /* _compute_dense_output: Q = Z^T P (n x 3) */
+    /* _compute_dense_output: Q = Z^T P (n x 3), stored transposed: row j holds the x^(j+1)
+     * coefficients of the n states (the layout of the stored dense output) */
     for (int c = 0; c < n; c++)
         for (int j = 0; j < 3; j++)
-            s->Q[3 * c + j] = Z[c] * k->P[0][j] + Z[n + c] * k->P[1][j] + Z[2 * n + c] * k->P[2][j];
+            s->Q[j * n + c] = Z[c] * k->P[0][j] + Z[n + c] * k->P[1][j] + Z[2 * n + c] * k->P[2][j];
     s->have_sol = 1;
     s->r->nstep++;
     return 1;
@@ -771,13 +779,7 @@ static int store_dense(solver_t *s)
     r->dense_t[2 * r->n_dense + 1] = s->t;
     double *c = r->dense_c + (size_t)r->n_dense * (1 + terms) * n;
     memcpy(c, s->y_old, n * sizeof(double));
-    /* Radau: Q is n x 3 (per state), stored as 3 rows of n; DOP853: F is already rows */
-    if (s->dop853) {
-        memcpy(c + n, s->Fdense, (size_t)terms * n * sizeof(double));
-    } else {
-        for (int j = 0; j < 3; j++)
-            for (int i = 0; i < n; i++) c[(1 + j) * n + i] = s->Q[3 * i + j];
-    }
+    memcpy(c + n, dense_terms(s), (size_t)terms * n * sizeof(double));
     r->n_dense++;
     return 0;
 }
@@ -897,13 +899,9 @@ static double event_root(solver_t *s, int e)
     const double *c = s->p->ev_coef + (size_t)e * n;
     poly_t q = {s->p->ev_offset[e], {0}, s->t_old, s->t - s->t_old, s->dop853};
     for (int i = 0; i < n; i++) q.a0 += c[i] * s->y_old[i];
-    if (s->dop853) {
-        for (int j = 0; j < DOP853_DENSE_TERMS; j++)
-            for (int i = 0; i < n; i++) q.a[j] += c[i] * s->Fdense[j * n + i];
-    } else {
-        for (int i = 0; i < n; i++)
-            for (int j = 0; j < 3; j++) q.a[j] += c[i] * s->Q[3 * i + j];
-    }
+    const double *rows = dense_terms(s);
+    for (int j = 0; j < s->r->dense_terms; j++)
+        for (int i = 0; i < n; i++) q.a[j] += c[i] * rows[j * n + i];
     return brentq(poly_at, &q, s->t_old, s->t);
 }
 
