@@ -14,17 +14,12 @@ from scipy.integrate._ivp import dop853_coefficients
 from scipy.linalg import expm
 
 import ballc
-from ballc import _core, _radau5
+from ballc import _radau5
+from linear_event import Event
 
 # A lightly damped oscillator and a slow decay: smooth, not stiff.
 A_SMOOTH = np.array([[-0.1, 3.0, 0.0], [-3.0, -0.1, 0.0], [0.5, 0.0, -0.7]])
 Y0_SMOOTH = np.array([1.0, 0.0, 2.0])
-
-
-class _Event:
-    def __init__(self, coefficients, offset, terminal, direction):
-        self.coefficients, self.offset = np.asarray(coefficients, dtype=float), offset
-        self.terminal, self.direction = terminal, direction
 
 
 def _exact(t):
@@ -78,7 +73,7 @@ def test_events_dense_output_and_t_eval_use_the_7th_order_interpolant():
     dense output agree with the exact solution between the step ends (a cubic there
     would be off by ~1e-6 with DOP853's long steps)."""
     A = np.array([[0.0, 1.0], [-9.0, 0.0]])
-    events = [_Event([1.0, 0.0], 0.0, False, -1), _Event([1.0, 0.0], -0.5, True, 1)]
+    events = [Event([1.0, 0.0], 0.0, False, -1), Event([1.0, 0.0], -0.5, True, 1)]
     t_stop = 5 * np.pi / 9
     t_eval = np.linspace(0, 1.9, 77)
     sol = _radau5.solve_linear(A, (0, 3), np.array([1.0, 0.0]), rtol=1e-10, atol=1e-10,
@@ -94,7 +89,7 @@ def test_events_dense_output_and_t_eval_use_the_7th_order_interpolant():
 
     dense = _radau5.solve_linear(A, (0, 3), np.array([1.0, 0.0]), rtol=1e-10, atol=1e-10,
                                  method="dop853", dense_output=True)
-    interpolant = ballc.dense.Radau5Interpolant(*dense.dense)
+    interpolant = ballc.dense.CompiledInterpolant(*dense.dense)
     assert interpolant.terms == 7 and len(interpolant.steps) == dense.nstep
     t = np.linspace(0, 3, 301)
     np.testing.assert_allclose(interpolant(t), [np.cos(3 * t), -3 * np.sin(3 * t)],
@@ -108,7 +103,7 @@ def test_extra_stages_only_where_the_dense_output_is_used():
     base = _radau5.solve_linear(A_SMOOTH, (0, 10.0), Y0_SMOOTH, rtol=1e-8, atol=1e-8,
                                 method="dop853")
     quiet = _radau5.solve_linear(A_SMOOTH, (0, 10.0), Y0_SMOOTH, rtol=1e-8, atol=1e-8,
-                                 method="dop853", events=[_Event([0, 0, 1.0], 5.0, True, 0)])
+                                 method="dop853", events=[Event([0, 0, 1.0], 5.0, True, 0)])
     one = _radau5.solve_linear(A_SMOOTH, (0, 10.0), Y0_SMOOTH, rtol=1e-8, atol=1e-8,
                                method="dop853", t_eval=[base.t[3] / 2 + base.t[4] / 2])
     assert quiet.nfev == base.nfev

@@ -30,6 +30,7 @@ from scipy.linalg import expm
 import ballc
 from ballc import _core, _radau5
 from ballc.events import LinearEvent, segment_events as _segment_events
+from linear_event import Event
 
 TOL = 1e-12
 
@@ -125,17 +126,11 @@ def test_linear_system_matches_the_matrix_exponential():
         np.testing.assert_allclose(sol.y, exact, rtol=0, atol=bound)
 
 
-class _Event:
-    def __init__(self, coefficients, offset, terminal, direction):
-        self.coefficients, self.offset = np.asarray(coefficients, dtype=float), offset
-        self.terminal, self.direction = terminal, direction
-
-
 def test_linear_events_are_located_on_the_dense_output():
     """y = (cos 3t, -3 sin 3t).  Falling zeros of y0 at t = pi/6, pi/6 + 2pi/3, ...;
     the terminal event y0 - 0.5 rising first at 3t = 5 pi / 3."""
     A = np.array([[0.0, 1.0], [-9.0, 0.0]])
-    events = [_Event([1.0, 0.0], 0.0, False, -1), _Event([1.0, 0.0], -0.5, True, 1)]
+    events = [Event([1.0, 0.0], 0.0, False, -1), Event([1.0, 0.0], -0.5, True, 1)]
     sol = _radau5.solve_linear(A, (0, 3), np.array([1.0, 0.0]), rtol=1e-12, atol=1e-12,
                                events=events)
     t_stop = 5 * np.pi / 9
@@ -155,7 +150,7 @@ def test_the_state_at_a_terminal_event_is_a_step_end_not_the_dense_output():
     state, refine_events=False) adds its own interpolation error, measured 10x (1e-6)
     and 25x (1e-8) larger."""
     A = np.array([[0.0, 1.0], [-9.0, 0.0]])
-    stop = [_Event([1.0, 0.0], -0.5, True, 1)]
+    stop = [Event([1.0, 0.0], -0.5, True, 1)]
 
     def state_error(tol, refine):
         sol = _radau5.solve_linear(A, (0, 3), np.array([1.0, 0.0]), rtol=tol, atol=tol,
@@ -179,7 +174,7 @@ def test_stepping_to_an_event_backwards_and_with_t_eval():
     y0 = np.array([np.cos(9.0), -3 * np.sin(9.0)])
     t_eval = np.linspace(3.0, 0.0, 31)
     sol = _radau5.solve_linear(A, (3.0, 0.0), y0, rtol=1e-8, atol=1e-8, t_eval=t_eval,
-                               events=[_Event([1.0, 0.0], -0.5, True, 0)])
+                               events=[Event([1.0, 0.0], -0.5, True, 0)])
     assert sol.status == 1
     t = sol.t_events[0][0]
     assert 2.4 < t < 2.5 and np.all(sol.t > t)

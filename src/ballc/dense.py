@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 
-class Radau5Interpolant:
+class CompiledInterpolant:
     """The compiled integrator's dense output of one segment: per step (t_old, t_new),
     y_old and the step's terms (rows of N_STATES), x = (t - t_old) / (t_new - t_old).
 

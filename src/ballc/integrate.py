@@ -47,7 +47,7 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
                                    events=events, max_nfev=max_nfev, first_step=first_step,
                                    dense_output=dense_output, method=method)
         if dense_output:
-            sol.interpolant = dense.Radau5Interpolant(*sol.dense)
+            sol.interpolant = dense.CompiledInterpolant(*sol.dense)
         return sol
     options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
     if first_step is not None:
@@ -97,29 +97,37 @@ TIGHT_ATOL = 1e-10
 
 def failure_hint(scene, in_contact, atol=None):
     """Why a contact segment may defeat the integrator, when the cause is one of the
-    usual ones: the seed's regularised Coulomb law ("max", "smooth") with a small v_s;
-    or an absolute tolerance below the rounding of the contact depth r - z (a stiff ball
+    usual ones (:func:`_tight_atol_hint`, :func:`_regularised_friction_hint`); "" out of
+    contact."""
+    if not any(in_contact.values()):
+        return ""
+    return _tight_atol_hint(atol) + _regularised_friction_hint(scene)
+
+
+def _tight_atol_hint(atol):
+    """An absolute tolerance below the rounding of the contact depth r - z (a stiff ball
     at rest: z ~ r, so r - z keeps few digits, and the Hertz force's rounding noise
     keeps the Newton iteration from converging to a centre height or vertical velocity
     within atol; measured: a steel ball, E = 2e11 Pa, at rest, crawled with atol = 1e-12
     and ran with atol = 1e-10 on z or vz alone, docs/limits.md)."""
-    if not any(in_contact.values()):
+    if atol is None or float(np.min(atol)) >= TIGHT_ATOL:
         return ""
-    if atol is not None and float(np.min(atol)) < TIGHT_ATOL:
-        tight = (f" (in contact with atol = {float(np.min(atol)):g}: so tight an absolute "
-                 "tolerance on the centre's height and vertical velocity can be below the "
-                 "rounding noise of the contact depth r - z, most of all for a hard ball "
-                 f"at rest; try atol >= {TIGHT_ATOL:g} (one number, or per state: "
-                 "ballc.STATE_NAMES))")
-    else:
-        tight = ""
+    return (f" (in contact with atol = {float(np.min(atol)):g}: so tight an absolute "
+            "tolerance on the centre's height and vertical velocity can be below the "
+            "rounding noise of the contact depth r - z, most of all for a hard ball "
+            f"at rest; try atol >= {TIGHT_ATOL:g} (one number, or per state: "
+            "ballc.STATE_NAMES))")
+
+
+def _regularised_friction_hint(scene):
+    """The seed's regularised Coulomb law ("max", "smooth") with a small v_s."""
     if scene.tangential_model not in ("friction", "mixture"):
-        return tight
+        return ""
     if scene.friction_coefficient == 0 or scene.effective_mixture == 1:
-        return tight
+        return ""
     if scene.friction_regularization == "exact":
-        return tight
-    return tight + (f" (in contact with regularised Coulomb friction: below the regularisation "
+        return ""
+    return (f" (in contact with regularised Coulomb friction: below the regularisation "
             f"speed {scene.friction_regularization_speed:g} m/s friction is a viscous law "
             "of coefficient mu F_n / v_s, too stiff to resolve for hard materials or loose "
             "tolerances; use friction_regularization='exact' (the default), or tighter rtol)")
