@@ -255,13 +255,7 @@ def run_radau5(segment, system, tol, method="radau5"):
 
 def run_dop853(segment, system, tol):
     """ballc's compiled DOP853 (explicit, order 8) in radau5's loop: no Jacobian, no LU."""
-    sol = _radau5.solve_system(segment.params, segment.latch, segment.flags,
-                               (segment.t0, segment.t1), segment.y0, rtol=tol, atol=tol,
-                               method="dop853")
-    if sol.status != 0:
-        raise RuntimeError(sol.message)
-    return sol.y[:, -1], {"nfev": sol.nfev, "njev": sol.njev, "nstep": sol.nstep,
-                          "nlu": sol.nlu}
+    return run_radau5(segment, system, tol, method="dop853")
 
 
 def cvode_callbacks(system):
