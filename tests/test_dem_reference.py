@@ -130,3 +130,37 @@ def test_convergence_cap_raises():
         dem_impact_converged(**BALL, kappa=1.0, mu=1.5, velocity=(1.0, 0.0, -3.0),
                              angular_velocity=(0.0, 0.0, 0.0), rel_tol=1e-12,
                              steps_per_contact=500, max_steps_per_contact=2000)
+
+
+# ---------------------------------------------------------------- validation/dem_agreement
+def test_agreement_mapping_and_random_impacts():
+    from types import SimpleNamespace
+
+    from validation.dem_agreement import (hunt_crossley_chi, random_impacts,
+                                          reference_parameters)
+    for e in (0.2, 0.9, 0.999):
+        assert hunt_crossley_chi(e) == pytest.approx(chi_of_restitution(e), rel=1e-9)
+    assert hunt_crossley_chi(1.0) == 0.0
+    # a scene of today's ballc (no damping fields): zero damping, chi from c_tau
+    old = SimpleNamespace(gravity=0.0, inertia=(I, I, I), mass=M, observer_mass=0.0,
+                          radius=R, hertz_stiffness=K0, tangential_stiffness_ratio=0.5,
+                          friction_coefficient=0.3, c_tau=0.9)
+    p = reference_parameters(old)
+    assert (p["normal_damping"], p["gamma"], p["gamma_t"]) == ("hunt_crossley", 0.0, 0.0)
+    assert p["chi"] == pytest.approx(0.15) and p["k0"] == K0 and p["inertia"] == I
+    new = SimpleNamespace(**vars(old), normal_damping="viscoelastic", damping_ratio=0.2,
+                          tangential_damping_ratio=0.3, restitution=None)
+    p = reference_parameters(new)
+    assert (p["normal_damping"], p["gamma"], p["gamma_t"]) == ("viscoelastic", 0.2, 0.3)
+    with pytest.raises(ValueError, match="isotropic"):
+        reference_parameters(SimpleNamespace(**{**vars(old), "inertia": (I, I, 2 * I)}))
+
+    impacts = random_impacts(50, seed=3)
+    assert impacts == random_impacts(50, seed=3)
+    for d in impacts:
+        v, w = np.array(d["velocity"]), np.array(d["angular_velocity"])
+        angle = np.degrees(np.arccos(-v[2] / np.linalg.norm(v)))
+        assert 5 <= angle <= 85 and np.linalg.norm(w) * d["radius"] <= 2 * 3.9 + 1e-12
+        assert 0.1 <= d["tangential_stiffness_ratio"] <= 1.2
+        assert 0.05 <= d["friction_coefficient"] <= 1.5
+        assert d["gravity"] == 0.0 and d["observer_mass"] == 0.0 and d["c_tau"] == 1.0
