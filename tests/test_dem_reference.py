@@ -125,6 +125,18 @@ def test_convergence_estimate_holds(rng, damping):
     assert rebound_difference(conv, finer, R, 3.9) <= tol
 
 
+@pytest.mark.parametrize("damping", [{}, dict(chi=0.3, gamma_t=0.25)])
+def test_midpoint_stiffness_converges_to_the_same_law(rng, damping):
+    # two quadratures of the loading increment -k_t v_t dt, one limit
+    tol = 1e-5
+    for _ in range(3):
+        case = random_oblique(rng)
+        dem = dem_impact_converged(**BALL, **case, **damping, rel_tol=tol)
+        mid = dem_impact_converged(**BALL, **case, **damping, rel_tol=tol,
+                                   midpoint_stiffness=True)
+        assert rebound_difference(dem, mid, R, 3.9) <= 2 * tol
+
+
 def test_convergence_cap_raises():
     with pytest.raises(RuntimeError, match="no convergence"):
         dem_impact_converged(**BALL, kappa=1.0, mu=1.5, velocity=(1.0, 0.0, -3.0),

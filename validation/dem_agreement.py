@@ -73,10 +73,11 @@ def _rebound(velocity, angular_velocity, radius):
     return v, v + np.cross(w, [0.0, 0.0, -radius])
 
 
-def compare(scene_kwargs_list, rel_tol=1e-5):
+def compare(scene_kwargs_list, rel_tol=1e-5, **reference_options):
     """Per impact: max |ballc - reference| of the rebound centre and contact-point
     velocities / impact speed (1), as an array.  The reference is converged to
-    ``rel_tol`` of the impact speed (dem_impact_converged)."""
+    ``rel_tol`` of the impact speed (dem_impact_converged, which gets
+    ``reference_options``, e.g. midpoint_stiffness=True)."""
     import ballc
     errors = []
     for kwargs in scene_kwargs_list:
@@ -87,7 +88,8 @@ def compare(scene_kwargs_list, rel_tol=1e-5):
                              "is the compliant law's")
         hit = ballc.impact(scene, v_in, w_in)
         ref = dem_impact_converged(**reference_parameters(scene), velocity=v_in,
-                                   angular_velocity=w_in, rel_tol=rel_tol)
+                                   angular_velocity=w_in, rel_tol=rel_tol,
+                                   **reference_options)
         ours = _rebound(hit.velocity_after, hit.angular_velocity_after, scene.radius)
         theirs = _rebound(ref["velocity_after"], ref["angular_velocity_after"],
                           scene.radius)

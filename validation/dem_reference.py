@@ -50,14 +50,18 @@ def hertz_contact_time(mass, k0, speed):
 
 def dem_impact(*, mass, radius, inertia, k0, kappa, mu, velocity,
                angular_velocity=(0.0, 0.0, 0.0), normal_damping="hunt_crossley",
-               chi=0.0, gamma=0.0, gamma_t=0.0, steps_per_contact=20000):
+               chi=0.0, gamma=0.0, gamma_t=0.0, steps_per_contact=20000,
+               midpoint_stiffness=False):
     """One impact on the floor, stepped explicitly; see the module docstring.
 
     Parameters: mass m* (kg), radius R (m), inertia I (kg m^2, scalar), k0 (N/m^1.5),
     kappa = k_t / k_n (1), mu (1), velocity and angular_velocity at first touch (m/s,
     rad/s; velocity[2] < 0), normal_damping "hunt_crossley" (uses chi) or "viscoelastic"
     (uses gamma), gamma_t the tangential damping ratio, steps_per_contact N
-    (dt = hertz_contact_time / N).
+    (dt = hertz_contact_time / N).  ``midpoint_stiffness``: while the contact loads, take
+    the k_t of the increment F_el -= k_t v_t dt at the step's mean penetration instead of
+    the new one (the DEM codes'); the same law, but second order instead of first in the
+    sticking phase (about 100 times smaller errors at the same N for high mu).
 
     Returns a dict: velocity_after, angular_velocity_after (3-arrays), contact_time (s,
     rho's zero crossing interpolated linearly), max_penetration (m, sampled at the
@@ -108,7 +112,9 @@ def dem_impact(*, mass, radius, inertia, k0, kappa, mu, velocity,
         if rho < rho_prev:
             scale = math.sqrt(rho / rho_prev)
             fx *= scale; fy *= scale
-        fx -= kt * ux * dt; fy -= kt * uy * dt
+        kdt = dt * (kappa * 1.5 * k0 * math.sqrt(0.5 * (rho + rho_prev))
+                    if midpoint_stiffness and rho >= rho_prev else kt)
+        fx -= kdt * ux; fy -= kdt * uy
         cap = mu * Fn
         fel = math.hypot(fx, fy)
         if fel > cap:
@@ -149,6 +155,9 @@ def dem_impact_converged(*, rel_tol=1e-4, steps_per_contact=2000, max_steps_per_
 
     Returns the finer run's dict plus ``error_estimate`` (that difference / speed, 1) and
     ``steps_per_contact``.  RuntimeError if N would exceed ``max_steps_per_contact``.
+    An estimate, not a bound: over 90 random oblique spinning impacts at rel_tol 1e-5 the
+    error against a 16 times finer run reached 1.2 times it (viscoelastic damping, whose
+    c_n ~ rho^(1/4) makes the convergence irregular).  ``kwargs`` go to dem_impact.
     """
     speed = float(np.linalg.norm(kwargs["velocity"]))
     n = steps_per_contact
