@@ -66,14 +66,13 @@ def _frames(text: str) -> int:
 
 
 def _workers(text: str) -> int:
+    """argparse type of --workers: ballc.sweep's own rule (a whole number >= 1)."""
+    from .sweep import check_workers
     try:
-        workers = int(text)
-    except ValueError:
-        workers = 0
-    if workers < 1:
+        return check_workers(int(text))
+    except (ValueError, SceneError):
         raise argparse.ArgumentTypeError(f"workers = {text!r} is not allowed: must be a "
-                                         "whole number >= 1")
-    return workers
+                                         "whole number >= 1") from None
 
 
 def write_outputs(result, out: Path, *, animate: bool, frames: int,
@@ -246,7 +245,7 @@ def _run(args) -> int:
 def _sweep(args) -> int:
     from .sweep import load_sweep_file, run_sweep_file
     path = _scene_file(args.file)
-    load_sweep_file(path)             # its errors before the output folder is made
+    load_sweep_file(path)             # all its errors before the output folder is made
     out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
     return run_sweep_file(path, out=out, workers=args.workers, scheduler=args.scheduler)
 
