@@ -91,14 +91,17 @@ def plot_energy(result, ax=None, figsize=(10, 5)):
     return fig, ax
 
 
+#: What a contact point is, in every figure, the animation and contacts.csv.
+CONTACT_POINT = "the centre's (x, y) at maximum penetration"
+
+
 def contact_points(result) -> np.ndarray:
-    """(k, 3) where each contact started: the point of the plane under/over the centre (m)."""
+    """(k, 3) the contact points (m): each contact's ``contact_point`` -- the centre's
+    (x, y) at maximum penetration, as contacts.csv's contact_point_x/y -- on its plane."""
     points = np.empty((len(result.contacts), 3))
     for i, contact in enumerate(result.contacts):
-        x = np.interp(contact.t_start, result.t, result.position[0])
-        y = np.interp(contact.t_start, result.t, result.position[1])
         z = 0.0 if contact.plane == "floor" else result.scene.ceiling_height
-        points[i] = (x, y, z)
+        points[i] = (*contact.contact_point, z)
     return points
 
 
@@ -136,7 +139,8 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title("Contact points, top view\n" + scene_title(result.scene))
+    ax.set_title(f"Contact points ({CONTACT_POINT}), top view\n"
+                 + scene_title(result.scene), fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize="small")
     return fig, ax

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from . import _core, events as ev, layout, modes, outcome, stickslip
+from ._format import plain
 from .dense import PiecewiseSolution
 from .integrate import failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
@@ -41,17 +42,17 @@ def check_initial_state(scene, y0):
     try:
         y = np.array(y0, dtype=float)
     except (TypeError, ValueError):
-        raise SceneError(f"y0 = {y0!r} is not allowed: must be {_core.N_STATES} numbers "
+        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {_core.N_STATES} numbers "
                          f"({', '.join(_core.STATE_NAMES)})") from None
     if y.shape != (_core.N_STATES,) or not np.all(np.isfinite(y)):
-        raise SceneError(f"y0 = {y0!r} is not allowed: must be {_core.N_STATES} finite "
+        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {_core.N_STATES} finite "
                          f"numbers ({', '.join(_core.STATE_NAMES)})")
     size = np.linalg.norm(y[_QUATERNION])
     if not size > 0:
         raise SceneError("y0 is not allowed: its quaternion (qw, qx, qy, qz) is zero")
     y[_QUATERNION] /= size
     if not 0 < y[_STATE["z"]] < scene.ceiling_height:
-        raise SceneError(f"y0 is not allowed: z = {y[_STATE['z']]!r} must be between the "
+        raise SceneError(f"y0 is not allowed: z = {plain(y[_STATE['z']])} must be between the "
                          f"planes, 0 < z < {scene.ceiling_height}")
     return y
 
