@@ -56,7 +56,7 @@ def run_map(mixtures, mus, tol, workers):
     cpu = (after.children_user - before.children_user + after.children_system
            - before.children_system + after.user - before.user)
     shape = (len(mixtures), len(mus))
-    came = table["came_back"].to_numpy(dtype=float).reshape(shape)
+    came = table["came_back"].to_numpy(dtype=float, na_value=np.nan).reshape(shape)
     status = table["status"].to_numpy(dtype=float).reshape(shape)
     return came, status, wall, cpu
 

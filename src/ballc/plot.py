@@ -17,7 +17,14 @@ ENERGY_ORDER = ("kinetic", "potential", "spring")
 #: throw's omega_x and omega_y) stay visible on top of each other.
 COMPONENT_STYLES = ("-", "--", ":")
 #: Sweep map colours of "came back": yes, no, and no answer (failed run, NaN).
-CAME_BACK_COLOURS = {"yes": "#1a9850", "no": "#d73027", "none": "0.85"}
+CAME_BACK_COLOURS = {"yes": "#1a9850", "no": "#d73027", "undetermined": "#fee08b",
+                     "none": "0.85"}
+
+
+def _verdict_value(value) -> float:
+    """came_back as a cell value: 1 yes, 0 no, 0.5 undetermined (None, NaN, <NA>)."""
+    import pandas as pd
+    return 0.5 if pd.isna(value) else float(bool(value))
 
 
 def _pyplot():
@@ -177,8 +184,10 @@ def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
                    figsize=(8, 6)):
     """Heat map of ``value`` over a two-parameter sweep table (``ballc.sweep``).
 
-    Each cell is one scene; for "came_back" the colour says yes/no and the text gives
-    the fraction of energy lost (%).  Failed runs (status != 0) are marked with "!".
+    Each cell is one scene; for "came_back" the colour says yes / no / undetermined
+    (fewer completed contacts than the criterion needs, or a run that raised) and the
+    text gives the fraction of energy lost (%).  Failed runs (status != 0) are marked
+    with "!"; a combination missing from the table is grey.
     """
     plt = _pyplot()
     fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
@@ -186,12 +195,14 @@ def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
     xs = sorted(table[x].unique())
     ys = sorted(table[y].unique())
     grid = np.full((len(ys), len(xs)), np.nan)
-    for _, row in table.iterrows():
-        grid[ys.index(row[y]), xs.index(row[x])] = float(row[value])
     boolean = value == "came_back"
-    if boolean:      # two colours and a legend: yes / no is not a continuous quantity
+    for _, row in table.iterrows():
+        grid[ys.index(row[y]), xs.index(row[x])] = (_verdict_value(row[value]) if boolean
+                                                    else float(row[value]))
+    if boolean:      # three colours and a legend: a verdict is not a continuous quantity
         from matplotlib.colors import ListedColormap
-        cmap = ListedColormap([CAME_BACK_COLOURS["no"], CAME_BACK_COLOURS["yes"]]
+        cmap = ListedColormap([CAME_BACK_COLOURS["no"], CAME_BACK_COLOURS["undetermined"],
+                               CAME_BACK_COLOURS["yes"]]
                               ).with_extremes(bad=CAME_BACK_COLOURS["none"])
     else:
         cmap = plt.get_cmap("viridis")
@@ -212,8 +223,11 @@ def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
         from matplotlib.patches import Patch
         handles = [Patch(facecolor=CAME_BACK_COLOURS["yes"], label="came back"),
                    Patch(facecolor=CAME_BACK_COLOURS["no"], label="did not come back")]
+        if (grid == 0.5).any():
+            handles.append(Patch(facecolor=CAME_BACK_COLOURS["undetermined"],
+                                 label="undetermined\n(fewer than 3 contacts)"))
         if np.isnan(grid).any():
-            handles.append(Patch(facecolor=CAME_BACK_COLOURS["none"], label="no answer"))
+            handles.append(Patch(facecolor=CAME_BACK_COLOURS["none"], label="no run"))
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1),
                   title="x-velocity reversed\nafter 3 contacts?", fontsize="small")
         ax.set_title("Does the throw come back?  (cell text: energy lost; !: run failed)")

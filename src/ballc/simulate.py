@@ -477,6 +477,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                               for k in user_y],
                     sol=PiecewiseSolution(pieces) if options.dense_output else None)
     outcome.summarize_contact_forces(result)
+    result.message += outcome.tolerance_warning(options.rtol, options.atol)
     result.message += outcome.balance_warning(result, options.rtol)
     result.message += outcome.stiffness_note(stiff_at)
     return result

@@ -18,7 +18,7 @@ import os
 import sys
 from pathlib import Path
 
-from .outcome import summary
+from .outcome import CAME_BACK_AFTER_CONTACTS, summary
 from .scene import Scene, SceneError, read_toml, reject_unknown_keys
 
 #: Columns every row has besides the swept parameters (see ballc.outcome.summary).
@@ -148,7 +148,9 @@ def sweep(base_scene: Scene, parameters: dict, t_end: float, *, outputs=None,
     -------
     pandas.DataFrame
         One row per combination, in ``itertools.product`` order: the swept values, then
-        contacts, came_back, first_reversal_time (s), energies (J), t_final (s), status,
+        contacts, came_back (pandas' nullable boolean: True, False, or <NA> when
+        undetermined -- fewer completed contacts than the criterion needs -- or when
+        the run raised), first_reversal_time (s), energies (J), t_final (s), status,
         message, and the extra outputs.
     """
     import pandas as pd
@@ -167,7 +169,10 @@ def sweep(base_scene: Scene, parameters: dict, t_end: float, *, outputs=None,
         rows = [_run_one(*task) for task in _bar(tasks, progress, len(tasks))]
     else:
         rows = _on_local_pool(tasks, workers, progress)
-    return pd.DataFrame(rows)
+    table = pd.DataFrame(rows)
+    # three-valued: True, False, <NA> (undetermined, or the run raised)
+    table["came_back"] = table["came_back"].astype("boolean")
+    return table
 
 
 def _bar(iterable, progress, total):
@@ -314,8 +319,10 @@ def run_sweep_file(path, *, out=None, workers=None, scheduler=None) -> int:
         fig, _ = plot_sweep_map(table, x=names[1], y=names[0])
         fig.savefig(out / "came_back.png", dpi=100)
         written.append(out / "came_back.png")
-    came = int((table["came_back"] == True).sum())   # noqa: E712 (NaN for failed runs)
-    print(f"{came} of {len(table)} scenes came back; "
+    verdicts = table["came_back"]
+    print(f"{int(verdicts.eq(True).sum())} of {len(table)} scenes came back, "
+          f"{int(verdicts.eq(False).sum())} did not, {int(verdicts.isna().sum())} "
+          f"undetermined (fewer than {CAME_BACK_AFTER_CONTACTS} completed contacts); "
           f"{int((table['status'] != 0).sum())} did not reach t_end")
     print("wrote " + ", ".join(str(p) for p in written))
     return 0
