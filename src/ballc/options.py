@@ -102,9 +102,12 @@ def check_t_eval(t_eval, t_end):
     if t_eval is None:
         return None
     given = t_eval
-    if not _is_number_like(t_eval):
+    if not _is_number_like(t_eval) and np.size(t_eval) != 0:
         raise SceneError(f"t_eval = {plain(given)} is not allowed: must be numbers")
     t_eval = np.asarray(t_eval, dtype=float)
+    if t_eval.size == 0:
+        raise SceneError(f"t_eval = {plain(given)} is not allowed: must hold at least one "
+                         "time (None: every solver step and event)")
     if t_eval.ndim != 1 or not np.all(np.isfinite(t_eval)) or np.any(
             np.diff(t_eval) <= 0) or t_eval.size and (t_eval[0] < 0 or t_eval[-1] > t_end):
         raise SceneError(f"t_eval = {plain(given)} is not allowed: must be a 1-D, strictly "
@@ -113,8 +116,8 @@ def check_t_eval(t_eval, t_end):
 
 
 def check_events(events) -> tuple:
-    """User event functions g(t, y) with solve_ivp's optional ``terminal`` (bool) and
-    ``direction`` (number) attributes."""
+    """User event functions g(t, y) with solve_ivp's optional ``terminal`` (a bool, or
+    an integer k: stop at the k-th occurrence) and ``direction`` (number) attributes."""
     if events is None:
         return ()
     if callable(events):
@@ -128,6 +131,13 @@ def check_events(events) -> tuple:
         if not callable(event):
             raise SceneError(f"events[{k}] = {plain(event)} is not allowed: must be a callable "
                              "g(t, y) (with optional terminal and direction attributes)")
+        terminal = getattr(event, "terminal", False)
+        try:
+            _core.terminal_count(terminal)
+        except ValueError:
+            raise SceneError(f"events[{k}].terminal = {plain(terminal)} is not allowed: must "
+                             "be True, False or a whole number k >= 0 (stop at the k-th "
+                             "occurrence)") from None
         direction = getattr(event, "direction", 0)
         if not _is_number_like(direction) or np.ndim(direction) != 0:
             raise SceneError(f"events[{k}].direction = {plain(direction)} is not allowed: must "

@@ -23,6 +23,7 @@ from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (MET
 from .progress import progress_bar
 from .result import Contact, Result
 from .samples import Samples
+from .user_events import UserEvents
 from .scene import Scene, SceneError
 
 PLANES = layout.PLANES
@@ -368,7 +369,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         samples.add(t_eval[keep], np.repeat(run.y[:, None], keep.sum(), axis=1), run.flags(),
                     run.latch)
     skip = 1 if t_eval is None else 0   # a segment's first sample is its start, already stored
-    user = list(options.events)
+    users = UserEvents(options.events)
+    user = users.events
     user_t = [[] for _ in user]
     user_y = [[] for _ in user]
     pieces = []
@@ -390,7 +392,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
         remaining = None if options.max_nfev is None else max(options.max_nfev - nfev, 1)
-        events = [event for _, _, event in driver_events] + user
+        events = [event for _, _, event in driver_events] + users.for_segment()
         sol = integrate_segment(system, run.t, t_end, run.y, events,
                                 method=options.method, rtol=options.rtol, atol=options.atol,
                                 t_eval=segment_eval, max_step=options.max_step,
@@ -418,8 +420,10 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                 plane = driver_events[i][1]
                 for yy in y_events[i]:
                     record_depth(run.open[plane], ev.penetration(plane, scene)(0, yy), yy)
-            elif getattr(events[i], "terminal", False) and hits[-1] < t_fired:
+            elif 0 < _core.terminal_count(events[i].terminal) <= len(hits) \
+                    and hits[-1] < t_fired:   # stopped at its last occurrence left
                 fired, t_fired = i, float(hits[-1])
+        users.count(t_events[n_driver:])
         for k in range(len(user)):
             user_t[k].append(np.asarray(t_events[n_driver + k], dtype=float))
             user_y[k].append(np.asarray(y_events[n_driver + k], dtype=float).reshape(
