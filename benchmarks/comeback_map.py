@@ -56,7 +56,7 @@ def run_map(mixtures, mus, tol, workers):
     cpu = (after.children_user - before.children_user + after.children_system
            - before.children_system + after.user - before.user)
     shape = (len(mixtures), len(mus))
-    came = table["came_back"].to_numpy(dtype=float).reshape(shape)
+    came = table["came_back"].to_numpy(dtype=float, na_value=np.nan).reshape(shape)
     status = table["status"].to_numpy(dtype=float).reshape(shape)
     return came, status, wall, cpu
 
@@ -71,14 +71,17 @@ def plot(mixtures, mus, came, status, tol, wall, path):
     from ballc.plot import CAME_BACK_COLOURS
 
     fig, ax = plt.subplots(figsize=(8.2, 6.0), constrained_layout=True)
-    cmap = ListedColormap([CAME_BACK_COLOURS["no"], CAME_BACK_COLOURS["yes"]]
-                          ).with_extremes(bad=CAME_BACK_COLOURS["none"])
+    cmap = ListedColormap([CAME_BACK_COLOURS["no"], CAME_BACK_COLOURS["undetermined"],
+                           CAME_BACK_COLOURS["yes"]])
     dx, dy = (mus[1] - mus[0]) / 2, (mixtures[1] - mixtures[0]) / 2
-    ax.imshow(np.ma.masked_invalid(came), origin="lower", cmap=cmap, vmin=0, vmax=1,
+    ax.imshow(np.where(np.isnan(came), 0.5, came), origin="lower", cmap=cmap, vmin=0, vmax=1,
               aspect="auto", interpolation="nearest",
               extent=(mus[0] - dx, mus[-1] + dx, mixtures[0] - dy, mixtures[-1] + dy))
     handles = [Patch(facecolor=CAME_BACK_COLOURS["yes"], label="came back"),
                Patch(facecolor=CAME_BACK_COLOURS["no"], label="did not come back")]
+    if np.isnan(came).any():
+        handles.append(Patch(facecolor=CAME_BACK_COLOURS["undetermined"],
+                             label="undetermined\n(fewer than 3 contacts)"))
     stopped = status != 0
     if stopped.any():
         m_i, mu_i = np.nonzero(stopped)

@@ -5,7 +5,8 @@ Does the seed throw come back? A mixture x mu map
 Runs the seed scene for every combination of 7 ``mixture`` values and 6 friction
 coefficients ``mu`` (42 scenes of 1.2 s: enough for the floor-ceiling-floor sequence)
 with :func:`ballc.sweep`, on all local cores or on a Dask cluster, and draws whether
-the ball came back as a two-colour map.  Under ten seconds on 2 cores.
+the ball came back as a map (came back, did not, or undetermined: fewer than the three
+contacts the criterion needs).  Under ten seconds on 2 cores.
 
 Run it on its own::
 

@@ -557,17 +557,18 @@ def _result(thrown_vx, contacts):
     (-5.0, [(0.2, 2.6), (0.6, -2.2), (1.0, 1.5), (1.4, -3.0)], 3, True),  # 4th ignored
     (5.0, [(0.2, 2.6), (0.6, -2.2), (1.0, -1.5)], 3, True),     # thrown the other way
     (5.0, [(0.2, 2.6), (0.6, -2.2), (1.0, 1.5)], 3, False),
-    (-5.0, [(0.2, -2.6), (0.6, 2.2)], 3, True),                 # 2 completed: last decides
-    (-5.0, [(0.2, -2.6), (0.6, 2.2), (np.nan, -9.0)], 3, True),  # open contact skipped
+    (-5.0, [(0.2, -2.6), (0.6, 2.2)], 3, None),                 # 2 completed: undetermined
+    (-5.0, [(0.2, -2.6), (0.6, 2.2), (np.nan, -9.0)], 3, None),  # open contact: not completed
+    (-5.0, [(0.2, -2.6), (0.6, 2.2), (np.nan, -9.0), (1.4, 1.0)], 3, True),  # open skipped
     (-5.0, [(0.2, 2.6), (np.nan, -9.0), (0.9, -1.0)], 2, False),  # NaN in the middle
-    (-5.0, [], 3, False),                                        # no contact
-    (0.0, [(0.2, -2.6), (0.6, 2.2), (1.0, 1.5)], 3, False),      # thrown straight
+    (-5.0, [], 3, None),                                         # no contact
+    (0.0, [(0.2, -2.6), (0.6, 2.2), (1.0, 1.5)], 3, None),       # thrown straight: no "back"
     (-5.0, [(0.2, -2.6), (0.6, 2.2), (1.0, 0.0)], 3, False),     # stopped is not back
     (-5.0, [(0.2, 2.6), (0.6, -2.2), (1.0, -1.5)], 1, True),     # after_contacts = 1
 ])
 def test_came_back_follows_its_definition(thrown, contacts, after, expected):
     """outcome.came_back's docstring: after the first ``after_contacts`` completed
-    contacts (t_end finite) the x-velocity is opposite to the throw's; with fewer
-    completed contacts the last completed one decides; none, or a throw without
-    x-velocity, is not "came back".  A zero x-velocity is not opposite."""
+    contacts (t_end finite) the x-velocity is opposite to the throw's (True) or not
+    (False; a zero x-velocity is not opposite); with fewer completed contacts, or a
+    throw without x-velocity, the verdict is undetermined (None)."""
     assert came_back(_result(thrown, contacts), after_contacts=after) is expected

@@ -133,3 +133,93 @@ def test_start_from_a_full_state_or_a_quaternion():
         ballc.simulate(scene, 0.3, y0=np.zeros(len(ballc.STATE_NAMES)))
     with pytest.raises(ballc.SceneError, match="y0"):
         ballc.simulate(scene, 0.3, y0=[1.0, 2.0])
+
+
+# --- issue 21, item 4: the remaining gaps ---
+
+def test_an_empty_t_eval_is_a_clear_error():
+    """t_eval=[] raised a bare IndexError from the post-processing."""
+    with pytest.raises(ballc.SceneError, match=r"t_eval = \[\] is not allowed: must hold "
+                                               "at least one time"):
+        ballc.simulate(ballc.Scene(), 0.5, t_eval=[])
+
+
+@pytest.mark.parametrize("method, exact_flight", [("radau5", True), ("radau5", False),
+                                                  ("dop853", False), ("RK45", False)])
+@pytest.mark.parametrize("terminal", [2, 3])
+def test_terminal_k_stops_at_the_kth_occurrence(method, exact_flight, terminal):
+    """As scipy >= 1.12: terminal = k stops at the k-th occurrence, counted over the
+    whole run (here each falling crossing of z = 4 m is in another flight segment),
+    with a function of the user's and with a LinearEvent (closed form in exact flight)."""
+    scene = ballc.Scene(observer_mass=0.0)
+
+    def below(t, y):
+        return y[Z] - 4.0
+    below.direction, below.terminal = -1, terminal
+    linear = ballc.events.LinearEvent.of_state("z", offset=-4.0, terminal=terminal,
+                                               direction=-1)
+    free = ballc.simulate(scene, 5.0, events=lambda t, y: y[Z] - 4.0, method=method,
+                          exact_flight=exact_flight, rtol=1e-9, atol=1e-9)
+    falling = free.t_events[0][free.y_events[0][:, VZ] < 0]
+    assert len(falling) >= 3
+    for event in (below, linear):
+        result = ballc.simulate(scene, 5.0, events=event, method=method,
+                                exact_flight=exact_flight, rtol=1e-9, atol=1e-9)
+        assert result.status == 1 and len(result.t_events[0]) == terminal
+        np.testing.assert_allclose(result.t_events[0], falling[:terminal], rtol=1e-7)
+        assert result.t[-1] == pytest.approx(falling[terminal - 1], rel=1e-7)
+
+
+@pytest.mark.parametrize("method", ["radau5", "dop853", "RK45"])
+def test_terminal_k_counts_occurrences_within_one_segment(method):
+    """cos(100 t) = 0 three times in the first flight segment (t < 0.155 s)."""
+    def g(t, y):
+        return math.cos(100 * t)
+    g.terminal = 3
+    result = ballc.simulate(ballc.Scene(), 1.0, events=g, method=method, rtol=1e-9,
+                            atol=1e-9, max_step=0.005)
+    expected = np.pi * np.array([1, 3, 5]) / 200
+    np.testing.assert_allclose(result.t_events[0], expected, rtol=1e-8)
+    assert result.status == 1 and result.t[-1] == pytest.approx(expected[-1], rel=1e-8)
+
+
+@pytest.mark.parametrize("terminal", [1.5, -1, "yes"])
+def test_a_bad_terminal_is_named(terminal):
+    def g(t, y):
+        return y[Z] - 4.0
+    g.terminal = terminal
+    with pytest.raises(ballc.SceneError, match=r"events\[0\].terminal = "):
+        ballc.simulate(ballc.Scene(), 0.5, events=g)
+
+
+@pytest.mark.parametrize("method", ["radau5", "RK45"])
+def test_an_event_returning_nan_raises(method):
+    """It was silently never triggered."""
+    def g(t, y):
+        return math.nan if t > 0.05 else 1.0
+    with pytest.raises(ValueError, match=r"events\[0\] returned nan at t = .* finite number"):
+        ballc.simulate(ballc.Scene(), 0.5, events=[g], method=method)
+
+
+def test_a_result_is_read_like_scipys_oderesult():
+    """scipy's OdeResult is a dict: r['t'] as well as r.t."""
+    result = ballc.simulate(ballc.Scene(), 0.3, dense_output=True)
+    for key in ("t", "y", "sol", "t_events", "y_events", "nfev", "status", "message",
+                "success"):
+        assert result[key] is getattr(result, key) or result[key] == getattr(result, key)
+        assert key in result
+    assert set(dict(result)) == set(result.keys())
+    with pytest.raises(KeyError, match="result.position"):
+        result["position"]
+
+
+def test_sol_takes_arrays_of_any_shape():
+    """sol on a 2-D array raised IndexError: it gives (N_STATES,) + t.shape, each
+    column the state at that time."""
+    result = ballc.simulate(ballc.Scene(), 1.2, dense_output=True)
+    times = np.array([[0.1, 0.2, 0.3], [0.6, 0.9, 1.1]])
+    values = result.sol(times)
+    assert values.shape == (len(ballc.STATE_NAMES), 2, 3)
+    for index in np.ndindex(times.shape):
+        np.testing.assert_array_equal(values[(slice(None),) + index], result.sol(times[index]))
+    assert result.sol(np.empty((0,))).shape == (len(ballc.STATE_NAMES), 0)

@@ -86,3 +86,75 @@ def test_dask_worker_processes_give_the_same_bits():
             there = ballc.sweep(BASE, grid, 1.2, client=client)
     pd.testing.assert_frame_equal(there, here, check_exact=True)
     assert (here["status"] == 0).all()
+
+
+# --- issue 21, item 2: everything is checked before anything runs ---
+
+def test_a_single_value_is_one_value():
+    """{"mixture": 0.3} (a number, not a list) is the one value 0.3, as is a string."""
+    table = ballc.sweep(BASE, {"mixture": 0.3, "tangential_model": "friction"}, 0.2, workers=1)
+    assert len(table) == 1
+    assert table["mixture"].iloc[0] == 0.3 and table["tangential_model"].iloc[0] == "friction"
+
+
+@pytest.mark.parametrize("options, named", [
+    ({"t_end": -1}, "t_end = -1"),
+    ({"rtoll": 1e-3}, "did you mean 'rtol'"),
+    ({"rtol": -1e-6}, "rtol = -1e-06"),
+    ({"method": "radau"}, "method = 'radau'"),
+    ({"workers": 0}, "workers = 0"),
+    ({"workers": 1.5}, "workers = 1.5"),
+])
+def test_t_end_workers_and_simulate_options_fail_before_any_run(options, named, monkeypatch):
+    """Before: t_end = -1 and rtoll = 1e-3 returned rows of status -1, workers = 0 ran
+    on all cores.  Now each raises before the first run."""
+    import importlib
+    sweep_module = importlib.import_module("ballc.sweep")
+
+    def no_run(*args):
+        raise AssertionError("a run started")
+    monkeypatch.setattr(sweep_module, "_run_one", no_run)
+    arguments = {"t_end": 1.2, "workers": 1, **options}
+    with pytest.raises(ballc.SceneError, match=named.replace("(", r"\(")):
+        ballc.sweep(BASE, {"mixture": [0.1, 0.2]}, **arguments)
+
+
+@pytest.mark.parametrize("text, named", [
+    ("t_end = -1\n[parameters]\nmixture = 0.3\n", "t_end = -1"),
+    ("t_end = 0.2\n[parameters]\nmixture = [0.3, 2.0]\n", "mixture = 2.0"),
+    ("t_end = 0.2\n[parameters]\nmixture = 0.3\n[simulate]\nrtoll = 1e-3\n", "did you mean 'rtol'"),
+    ("t_end = 0.2\n[parameters]\nmixture = 0.3\n[simulate]\nrtol = 2e-20\n", "rtol = 2e-20"),
+    ("t_end = 0.2\nworkers = 0\n[parameters]\nmixture = 0.3\n", "workers = 0"),
+])
+def test_an_invalid_sweep_file_makes_no_output_folder(tmp_path, capsys, text, named):
+    from ballc.cli import main
+    (tmp_path / "s.toml").write_text(text)
+    out = tmp_path / "out"
+    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert named in captured.err and "s.toml" in captured.err
+    assert captured.out == "" and not out.exists()
+
+
+def test_a_sweep_file_runs_its_simulate_table_and_one_value(tmp_path, capsys):
+    """[simulate] options reach every run (they were accepted and ignored before), and
+    a scalar parameter is one run."""
+    from ballc.cli import main
+    (tmp_path / "s.toml").write_text(
+        "t_end = 0.3\n[parameters]\nmixture = 0.3\n[simulate]\nrtol = 1e-3\natol = 1e-3\n")
+    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o")]) == 0
+    assert "1 run of 0.3 s over mixture on 1 local process" in capsys.readouterr().out
+    table = pd.read_csv(tmp_path / "o" / "sweep.csv")
+    one = ballc.simulate(BASE.replace(mixture=0.3), 0.3, rtol=1e-3, atol=1e-3)
+    assert len(table) == 1 and table["energy_final"].iloc[0] == pytest.approx(
+        float(one.energy["total"][-1]), rel=1e-12)
+
+
+def test_workers_is_one_rule_in_python_and_on_the_command_line(tmp_path, capsys):
+    from ballc.cli import main
+    with pytest.raises(ballc.SceneError, match="workers = 0"):
+        ballc.sweep(BASE, {"mixture": 0.3}, 0.2, workers=0)
+    (tmp_path / "s.toml").write_text("t_end = 0.2\n[parameters]\nmixture = 0.3\n")
+    with pytest.raises(SystemExit) as exit_:
+        main(["sweep", str(tmp_path / "s.toml"), "--workers", "0"])
+    assert exit_.value.code == 2 and "workers = '0'" in capsys.readouterr().err

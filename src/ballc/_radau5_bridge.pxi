@@ -283,6 +283,24 @@ def _options(n, t0, t1, rtol, atol, max_step, t_eval, first_step):
     return t0, t1, rtol, atol_v, max_step, t_eval, first
 
 
+def terminal_count(terminal) -> int:
+    """An event's ``terminal`` as solve_ivp (scipy >= 1.12) reads it: False, None or 0
+    -> 0 (not terminal); True -> 1 (stop at the first occurrence); an integer k > 0 ->
+    k (stop at the k-th)."""
+    if terminal is None or terminal is False:
+        return 0
+    if terminal is True:
+        return 1
+    try:
+        count = int(terminal)
+    except (TypeError, ValueError):
+        count = -1
+    if count != terminal or count < 0:
+        raise ValueError(f"terminal = {terminal!r} is not allowed: must be a boolean or an "
+                         "integer >= 0 (stop at that occurrence)")
+    return count
+
+
 def _event_arrays(events, int n):
     """Linear events (``coefficients``, ``offset``), stick-release events
     (``stick_plane``, ``offset``: g = mu N - |lambda| + offset, evaluated in C) and, for
@@ -322,7 +340,7 @@ def _event_arrays(events, int n):
             raise TypeError(f"events[{k}] = {e!r} is neither a linear event (`coefficients` "
                             "and `offset`: g(y) = coefficients . y + offset), a stick-release "
                             "event (`stick_plane`) nor a callable g(t, y)")
-        iv[0, k] = bool(getattr(e, "terminal", False))
+        iv[0, k] = terminal_count(getattr(e, "terminal", False))
         dirn = float(getattr(e, "direction", 0))
         iv[1, k] = (dirn > 0) - (dirn < 0)
         rearm = getattr(e, "rearm", None)

@@ -116,6 +116,7 @@ typedef struct {
     /* events */
     double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */
     int *active;
+    int *ev_count;                      /* occurrences of each event in this call */
     size_t cap_out, cap_hits, cap_dense;
 } solver_t;
 
@@ -907,7 +908,10 @@ static double event_root(solver_t *s, int e)
 
 /* ivp.find_active_events + handle_events after a step.  Returns 1 when a terminal
  * event stopped the integration (then *t_stop is its time), 0 otherwise, -1 on
- * out of memory, -2 when the dense output cannot be computed (message set). */
+ * out of memory, -2 when the dense output cannot be computed (message set).  As
+ * solve_ivp (scipy >= 1.12): every event that changed sign in the step counts one
+ * occurrence, and an event with ev_terminal = k > 0 stops the integration at its k-th
+ * occurrence (the earliest such root of the step when several reach theirs). */
 static int handle_events(solver_t *s, double *t_stop)
 {
     const radau5_problem *p = s->p;
@@ -922,8 +926,10 @@ static int handle_events(solver_t *s, double *t_stop)
     if (m == 0) return 0;
     if (prepare_dense(s) != 0) return -2;
     for (int i = 0; i < m; i++) {
-        s->roots[i] = event_root(s, s->active[i]);
-        if (p->ev_terminal[s->active[i]]) terminate = 1;
+        int e = s->active[i];
+        s->roots[i] = event_root(s, e);
+        s->ev_count[e]++;
+        if (p->ev_terminal[e] > 0 && s->ev_count[e] >= p->ev_terminal[e]) terminate = 1;
     }
     if (terminate) {
         /* order by time (in the direction of integration), keep up to the first terminal */
@@ -939,11 +945,13 @@ static int handle_events(solver_t *s, double *t_stop)
             s->active[j + 1] = a;
             s->roots[j + 1] = rt;
         }
-        for (int i = 0; i < m; i++)
-            if (p->ev_terminal[s->active[i]]) {
+        for (int i = 0; i < m; i++) {
+            int e = s->active[i];
+            if (p->ev_terminal[e] > 0 && s->ev_count[e] >= p->ev_terminal[e]) {
                 m = i + 1;
                 break;
             }
+        }
     }
     for (int i = 0; i < m; i++) {
         dense(s, s->roots[i], s->tmp);
@@ -1099,7 +1107,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
          + (size_t)n * (DOP853_STAGES_EXTENDED + DOP853_DENSE_TERMS);   /* K, F */
     double *dblock = calloc(nd, sizeof(double));
     cplx *cblock = calloc((size_t)n * n + 2 * (size_t)n, sizeof(cplx));
-    int *iblock = calloc(5 * (size_t)n + 2 * (size_t)m + 3 + (size_t)n * n, sizeof(int));
+    int *iblock = calloc(5 * (size_t)n + 3 * (size_t)m + 3 + (size_t)n * n, sizeof(int));
     int rc = 0;
     if (!dblock || !cblock || !iblock) goto oom;
     double *d = dblock;
@@ -1120,7 +1128,8 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n; s.xcc = s.ctmp + n;
     s.piv_real = iblock; s.piv_complex = iblock + n;
     s.active = iblock + 2 * n;
-    s.cidx = iblock + 2 * n + 2 * m; s.oidx = s.cidx + n;
+    s.ev_count = iblock + 2 * n + 2 * m;   /* zero: calloc */
+    s.cidx = s.ev_count + m; s.oidx = s.cidx + n;
     s.joc_start = s.oidx + n; s.joc_col = s.joc_start + n + 1;
 
     s.t = p->t0;

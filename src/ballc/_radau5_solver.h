@@ -74,7 +74,8 @@ typedef struct {
     const double *ev_offset;  /*   g_k(t, y) = ev_fun(ctx, k, t, y) + offset[k] */
     const int *ev_nonlinear;  /* may be NULL: all linear */
     radau5_event_fun ev_fun;  /* may be NULL when no event is non-linear */
-    const int *ev_terminal;   /* nonzero: stop at the first occurrence */
+    const int *ev_terminal;   /* k > 0: stop at the k-th occurrence in this call;
+                               * 0: not terminal */
     const int *ev_direction;  /* +1 rising only, -1 falling only, 0 both */
     int dense_output;         /* nonzero: keep every step's interpolant (dense_t, dense_c) */
     int controller;           /* RADAU5_CTRL_* bits (internal; 0: scipy's step control) */

@@ -121,7 +121,8 @@ def animate(result, path=None, *, frames: int = DEFAULT_FRAMES, fps: int = 20, d
     from matplotlib.lines import Line2D
     legend = [Line2D([], [], ls="", marker="o", color="red", ms=6, label="the observer"),
               Line2D([], [], ls="", marker="o", color=cmap(0.5), ms=7,
-                     label="contact point (colour: time,\ndark early, light late)"),
+                     label="contact point: centre at max. penetration\n"
+                           "(colour: time, dark early, light late)"),
               Line2D([], [], color="green", lw=0.8, ls="--",
                      label="contact points in order"),
               Line2D([], [], ls="", marker=r"$\uparrow$", color="red", ms=10,

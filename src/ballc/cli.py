@@ -7,12 +7,15 @@
 
 Every option, the scene file and the output folder are checked before anything is
 simulated or written.  An expected error (invalid scene or option, unreadable file,
-output folder that cannot be made) is one line on stderr and exit code 2.
+output folder that cannot be made) is one line on stderr and exit code 2.  When the
+reader of the output goes away (``ballc run ... | head``) the command ends quietly with
+exit code 141 (128 + SIGPIPE, what a shell reports for a program ended by a broken pipe).
 """
 from __future__ import annotations
 
 import argparse
 import inspect
+import os
 import sys
 import tempfile
 import time
@@ -66,14 +69,13 @@ def _frames(text: str) -> int:
 
 
 def _workers(text: str) -> int:
+    """argparse type of --workers: ballc.sweep's own rule (a whole number >= 1)."""
+    from .sweep import check_workers
     try:
-        workers = int(text)
-    except ValueError:
-        workers = 0
-    if workers < 1:
+        return check_workers(int(text))
+    except (ValueError, SceneError):
         raise argparse.ArgumentTypeError(f"workers = {text!r} is not allowed: must be a "
-                                         "whole number >= 1")
-    return workers
+                                         "whole number >= 1") from None
 
 
 def write_outputs(result, out: Path, *, animate: bool, frames: int,
@@ -246,9 +248,51 @@ def _run(args) -> int:
 def _sweep(args) -> int:
     from .sweep import load_sweep_file, run_sweep_file
     path = _scene_file(args.file)
-    load_sweep_file(path)             # its errors before the output folder is made
+    load_sweep_file(path)             # all its errors before the output folder is made
     out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
     return run_sweep_file(path, out=out, workers=args.workers, scheduler=args.scheduler)
+
+
+#: Options that take a number: "--rtol -1e-6" is joined into "--rtol=-1e-6", since
+#: argparse takes "-1e-6" for an option (it knows only negative numbers like -1, -0.5).
+NUMBER_OPTIONS = ("--t-end", "--rtol", "--atol", "--frames", "--workers")
+#: Exit code when stdout's reader went away (a broken pipe): 128 + SIGPIPE.
+BROKEN_PIPE = 141
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def join_negative_numbers(argv: list) -> list:
+    """``argv`` with every NUMBER_OPTIONS option followed by a negative number (-1e-6,
+    -inf) written as one "--option=value" argument, so that ballc's own check rejects
+    the value (naming it and what is allowed) instead of argparse the option."""
+    joined, i = [], 0
+    while i < len(argv):
+        arg = argv[i]
+        if (arg in NUMBER_OPTIONS and i + 1 < len(argv) and argv[i + 1].startswith("-")
+                and _is_number(argv[i + 1])):
+            joined.append(f"{arg}={argv[i + 1]}")
+            i += 2
+        else:
+            joined.append(arg)
+            i += 1
+    return joined
+
+
+def _quiet_stdout() -> None:
+    """After a broken pipe: send what is left of stdout to /dev/null, so that Python's
+    own flush at exit does not report the broken pipe again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 def _one_line(error: BaseException) -> str:
@@ -310,9 +354,15 @@ def main(argv=None) -> int:
                        help="Dask scheduler address (tcp://host:8786): run on that cluster")
     sweep.set_defaults(run=_sweep)
 
-    args = parser.parse_args(argv)
+    args = parser.parse_args(join_negative_numbers(sys.argv[1:] if argv is None else list(argv)))
     try:
-        return args.run(args)
+        try:
+            return args.run(args)
+        finally:
+            sys.stdout.flush()      # a broken pipe shows here at the latest
+    except BrokenPipeError:
+        _quiet_stdout()
+        return BROKEN_PIPE
     except (CommandError, SceneError, OSError, ValueError) as error:
         # expected: invalid input or an unusable path.  Anything else is a bug: traceback.
         print(f"ballc {args.command}: error: {_one_line(error)}", file=sys.stderr)

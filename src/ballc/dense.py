@@ -7,6 +7,14 @@ methods: their ``OdeSolution``).  :class:`PiecewiseSolution` joins them the way
 scipy's ``OdeSolution`` joins steps: ``sol(t)`` for a scalar t gives the state
 (N_STATES,), for an array of times (N_STATES, len(t)).  At an event time shared by
 two segments the later segment is used (the state after a latch or a projection).
+
+Like scipy's own solution across solve_ivp's events, sol(t) is continuous within a
+segment but may jump at a mode change (a contact start or end, stick <-> slip): the
+later segment starts from the event state the driver computed -- a step taken to the
+event's time, and at a stick start that state projected onto zero slip -- while the
+earlier segment's interpolant ends at its own value there.  The two agree to the
+integration tolerance, not exactly (seed, 5 s, rtol 1e-10: 4.2e-9 rad/s in
+omega_y at the slip -> stick change at t = 2.6973 s).
 """
 from __future__ import annotations
 
@@ -64,9 +72,12 @@ class PiecewiseSolution:
         self._ends = np.array([b for _, b, _ in self.pieces])
 
     def __call__(self, t):
+        """The state at ``t`` (s): (N_STATES,) for a scalar, (N_STATES, len(t)) for a
+        1-D array as scipy's OdeSolution, and (N_STATES,) + t.shape for any other
+        array (numpy's rule; scipy's OdeSolution fails on them)."""
         t = np.asarray(t, dtype=float)
         scalar = t.ndim == 0
-        tt = np.atleast_1d(t)
+        tt = t.ravel()
         if not self.pieces:
             raise ValueError("no dense output: the run integrated nothing")
         if np.any((tt < self.t_min) | (tt > self.t_max)) or not np.all(np.isfinite(tt)):
@@ -82,7 +93,10 @@ class PiecewiseSolution:
             if out is None:
                 out = np.empty((values.shape[0], tt.size))
             out[:, mask] = values
-        return out[:, 0] if scalar else out
+        if out is None:    # no times: (N_STATES, 0), as scipy
+            first = np.asarray(self.pieces[0][2](np.array([self.t_min])))
+            out = np.empty((first.reshape(first.shape[0], -1).shape[0], 0))
+        return out[:, 0] if scalar else out.reshape((out.shape[0],) + t.shape)
 
     def __repr__(self):
         return (f"PiecewiseSolution({len(self.pieces)} segments over "

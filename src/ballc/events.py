@@ -44,7 +44,9 @@ class LinearEvent:
             raise ValueError(f"coefficients must have shape ({_core.N_STATES},), "
                              f"got {self.coefficients.shape}")
         self.offset = float(offset)
-        self.terminal = bool(terminal)
+        # solve_ivp's: a bool, or k > 0: stop at the k-th occurrence
+        self.terminal = terminal if isinstance(terminal, bool) else _core.terminal_count(
+            terminal)
         self.direction = direction
         self.rearm = None
         nonzero = np.flatnonzero(self.coefficients)
@@ -78,7 +80,8 @@ class LinearEvent:
         event.coefficients, event._index, event._scale = (self.coefficients, self._index,
                                                           self._scale)
         event.offset = self.offset + float(delta)
-        event.terminal = bool(terminal)
+        event.terminal = terminal if isinstance(terminal, bool) else _core.terminal_count(
+            terminal)
         event.direction = direction
         event.rearm = None
         return event

@@ -189,13 +189,19 @@ def propagate(system, t0, t1, y0, events, *, t_eval=None, max_step=np.inf,
     flight = FreeFlight(t0, y0, gravity)
     span = t1 - t0
     hits = []                     # (s, event index)
+    counts = [_core.terminal_count(event.terminal) for event in events]
     for k, event in enumerate(events):
         roots = crossings(*flight.event_polynomial(event), event.direction, span)
-        if event.terminal:
-            roots = roots[:1]
+        if counts[k]:             # terminal at its counts[k]-th occurrence
+            roots = roots[:counts[k]]
         hits += [(s, k) for s in roots]
     hits.sort()
-    stop = next(((s, k) for s, k in hits if events[k].terminal), None)
+    seen, stop = [0] * len(events), None
+    for s, k in hits:
+        seen[k] += 1
+        if counts[k] and seen[k] >= counts[k]:
+            stop = (s, k)
+            break
     if stop is not None:
         hits = [h for h in hits if h <= stop]
         t_stop = min(t0 + stop[0], t1)

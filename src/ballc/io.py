@@ -105,13 +105,53 @@ def read(path) -> tuple[dict, dict, dict]:
     if path.suffix == ".nc":
         header, arrays, contacts = _read_dataset(path)
     else:
-        with np.load(path, allow_pickle=False) as data:
-            header = json.loads(str(data["header"]))
-            contacts = {k[len("contact_"):]: data[k] for k in data.files
-                        if k.startswith("contact_")}
-            arrays = {k: data[k] for k in ("t", "y", "state_names", "flags", "latch")}
+        header, arrays, contacts = _read_npz(path)
     _check_provenance(path, json.loads(header["provenance"]), arrays["state_names"])
     return header, arrays, contacts
+
+
+#: The arrays every ballc .npz holds (besides contact_* and latch_names).
+NPZ_ARRAYS = ("header", "t", "y", "state_names", "flags", "latch")
+#: The keys of a file's header.
+HEADER_KEYS = ("scene", "provenance", "status", "message", "nfev", "njev", "nlu")
+
+
+def _not_a_result(path, why: str) -> ValueError:
+    return ValueError(f"cannot load {str(path)!r}: it is not a ballc result file ({why}); "
+                      "ballc.load reads the .npz or .nc files that Result.save and `ballc run` "
+                      f"(result.npz) write, with the arrays {', '.join(NPZ_ARRAYS)}")
+
+
+def _read_npz(path):
+    try:
+        data = np.load(path, allow_pickle=False)
+    except FileNotFoundError:
+        raise
+    except (OSError, ValueError, EOFError) as error:    # not a .npz (pickle, text, empty)
+        raise _not_a_result(path, "not an .npz archive") from None
+    if not isinstance(data, np.lib.npyio.NpzFile):      # a single .npy array
+        raise _not_a_result(path, "it holds one array, not an .npz archive")
+    with data:
+        missing = [name for name in NPZ_ARRAYS if name not in data.files]
+        if missing:
+            found = ", ".join(data.files[:8]) + (", ..." if len(data.files) > 8 else "")
+            raise _not_a_result(path, f"it has no {', '.join(missing)}; it holds: "
+                                f"{found or 'nothing'}")
+        header = _header_of(path, str(data["header"]))
+        contacts = {k[len("contact_"):]: data[k] for k in data.files
+                    if k.startswith("contact_")}
+        arrays = {k: data[k] for k in NPZ_ARRAYS[1:]}
+    return header, arrays, contacts
+
+
+def _header_of(path, text: str) -> dict:
+    try:
+        header = json.loads(text)
+    except ValueError:
+        header = None
+    if not isinstance(header, dict) or any(key not in header for key in HEADER_KEYS):
+        raise _not_a_result(path, f"its header is not ballc's: {text[:60]!r}")
+    return header
 
 
 def _to_dataset(result):
@@ -136,6 +176,10 @@ def _read_dataset(path):
     import xarray as xr
     with xr.open_dataset(path) as ds:
         ds.load()
+        missing = [k for k in ("y", "time", "state") if k not in ds.variables] + [
+            k for k in HEADER_KEYS if k not in ds.attrs]
+        if missing:
+            raise _not_a_result(path, f"it has no {', '.join(missing)}")
         arrays = {"t": ds["time"].values.astype(float), "y": ds["y"].values.astype(float),
                   "state_names": ds["state"].values.astype(str),
                   "flags": ds["flags"].values.astype(np.int32) if "flags" in ds else np.zeros(0),

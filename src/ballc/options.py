@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
+from ._format import plain
 from .scene import Scene, SceneError
 
 SCIPY_METHODS = ("Radau", "BDF", "LSODA", "DOP853", "RK45", "RK23")
@@ -59,10 +60,10 @@ def _is_number_like(value) -> bool:
 
 def _positive_number(name, value, allow_inf=False, hint="a number > 0") -> float:
     if not _is_number_like(value) or np.ndim(value) != 0:
-        raise SceneError(f"{name} = {value!r} is not allowed: must be {hint}")
+        raise SceneError(f"{name} = {plain(value)} is not allowed: must be {hint}")
     number = float(value)
     if not (number > 0 and (math.isfinite(number) or allow_inf and number == math.inf)):
-        raise SceneError(f"{name} = {value!r} is not allowed: must be {hint}")
+        raise SceneError(f"{name} = {plain(value)} is not allowed: must be {hint}")
     return number
 
 
@@ -71,27 +72,27 @@ def check_method(method) -> str:
         return method
     close = difflib.get_close_matches(str(method), METHODS, n=1, cutoff=0.5) or [
         m for m in METHODS if m.lower() == str(method).lower()]
-    hint = f" (did you mean {close[0]!r}?)" if close else ""
-    raise SceneError(f"method = {method!r} is not allowed: must be one of {METHODS}{hint}")
+    hint = f" (did you mean {plain(close[0])}?)" if close else ""
+    raise SceneError(f"method = {plain(method)} is not allowed: must be one of {METHODS}{hint}")
 
 
 def check_tolerances(rtol, atol):
     """(rtol, atol) as float and float-or-array, or SceneError naming the bad one."""
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not _is_number_like(value):
-            raise SceneError(f"{name} = {value!r} is not allowed: must be a number "
+            raise SceneError(f"{name} = {plain(value)} is not allowed: must be a number "
                              "(atol: or one per state)")
         array = np.asarray(value, dtype=float)
         if not (np.all(np.isfinite(array)) and np.all(array > 0)):
-            raise SceneError(f"{name} = {value!r} is not allowed: must be finite and > 0")
+            raise SceneError(f"{name} = {plain(value)} is not allowed: must be finite and > 0")
     if np.ndim(rtol) != 0:
-        raise SceneError(f"rtol = {rtol!r} is not allowed: must be a single number")
+        raise SceneError(f"rtol = {plain(rtol)} is not allowed: must be a single number")
     if float(rtol) < MIN_RTOL:
-        raise SceneError(f"rtol = {rtol!r} is not allowed: must be >= 100 machine "
+        raise SceneError(f"rtol = {plain(rtol)} is not allowed: must be >= 100 machine "
                          f"epsilons = {MIN_RTOL:.3g}")
     n = _core.N_STATES
     if np.ndim(atol) > 1 or np.ndim(atol) == 1 and np.size(atol) != n:
-        raise SceneError(f"atol = {atol!r} is not allowed: must be a number or one per "
+        raise SceneError(f"atol = {plain(atol)} is not allowed: must be a number or one per "
                          f"state ({n}: {', '.join(_core.STATE_NAMES)})")
     atol = float(atol) if np.ndim(atol) == 0 else np.array(atol, dtype=float)
     return float(rtol), atol
@@ -101,19 +102,22 @@ def check_t_eval(t_eval, t_end):
     if t_eval is None:
         return None
     given = t_eval
-    if not _is_number_like(t_eval):
-        raise SceneError(f"t_eval = {given!r} is not allowed: must be numbers")
+    if not _is_number_like(t_eval) and np.size(t_eval) != 0:
+        raise SceneError(f"t_eval = {plain(given)} is not allowed: must be numbers")
     t_eval = np.asarray(t_eval, dtype=float)
+    if t_eval.size == 0:
+        raise SceneError(f"t_eval = {plain(given)} is not allowed: must hold at least one "
+                         "time (None: every solver step and event)")
     if t_eval.ndim != 1 or not np.all(np.isfinite(t_eval)) or np.any(
             np.diff(t_eval) <= 0) or t_eval.size and (t_eval[0] < 0 or t_eval[-1] > t_end):
-        raise SceneError(f"t_eval = {given!r} is not allowed: must be a 1-D, strictly "
+        raise SceneError(f"t_eval = {plain(given)} is not allowed: must be a 1-D, strictly "
                          f"increasing sequence within [0, t_end = {t_end}]")
     return t_eval
 
 
 def check_events(events) -> tuple:
-    """User event functions g(t, y) with solve_ivp's optional ``terminal`` (bool) and
-    ``direction`` (number) attributes."""
+    """User event functions g(t, y) with solve_ivp's optional ``terminal`` (a bool, or
+    an integer k: stop at the k-th occurrence) and ``direction`` (number) attributes."""
     if events is None:
         return ()
     if callable(events):
@@ -121,15 +125,22 @@ def check_events(events) -> tuple:
     try:
         events = tuple(events)
     except TypeError:
-        raise SceneError(f"events = {events!r} is not allowed: must be a callable "
+        raise SceneError(f"events = {plain(events)} is not allowed: must be a callable "
                          "g(t, y) or a sequence of them") from None
     for k, event in enumerate(events):
         if not callable(event):
-            raise SceneError(f"events[{k}] = {event!r} is not allowed: must be a callable "
+            raise SceneError(f"events[{k}] = {plain(event)} is not allowed: must be a callable "
                              "g(t, y) (with optional terminal and direction attributes)")
+        terminal = getattr(event, "terminal", False)
+        try:
+            _core.terminal_count(terminal)
+        except ValueError:
+            raise SceneError(f"events[{k}].terminal = {plain(terminal)} is not allowed: must "
+                             "be True, False or a whole number k >= 0 (stop at the k-th "
+                             "occurrence)") from None
         direction = getattr(event, "direction", 0)
         if not _is_number_like(direction) or np.ndim(direction) != 0:
-            raise SceneError(f"events[{k}].direction = {direction!r} is not allowed: must "
+            raise SceneError(f"events[{k}].direction = {plain(direction)} is not allowed: must "
                              "be a number (its sign: +1 rising, -1 falling, 0 both)")
     return events
 
@@ -149,17 +160,17 @@ def check_options(scene, t_end, method="radau5", rtol=1e-10, atol=1e-10, max_ste
         first_step = _positive_number("first_step", first_step,
                                       hint=f"None or a number in (0, t_end = {t_end}]")
         if first_step > t_end:
-            raise SceneError(f"first_step = {first_step!r} is not allowed: must be None or "
+            raise SceneError(f"first_step = {plain(first_step)} is not allowed: must be None or "
                              f"a number in (0, t_end = {t_end}]")
     if max_nfev is not None and (isinstance(max_nfev, (bool, np.bool_)) or not isinstance(
             max_nfev, (int, np.integer)) or max_nfev <= 0):
-        raise SceneError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
+        raise SceneError(f"max_nfev = {plain(max_nfev)} is not allowed: must be None or an "
                          "integer > 0")
     if not isinstance(dense_output, (bool, np.bool_)):
-        raise SceneError(f"dense_output = {dense_output!r} is not allowed: must be True "
+        raise SceneError(f"dense_output = {plain(dense_output)} is not allowed: must be True "
                          "or False")
     if not isinstance(exact_flight, (bool, np.bool_)):
-        raise SceneError(f"exact_flight = {exact_flight!r} is not allowed: must be True "
+        raise SceneError(f"exact_flight = {plain(exact_flight)} is not allowed: must be True "
                          "or False")
     return Options(t_end=t_end, method=method, rtol=rtol, atol=atol, max_step=max_step,
                    first_step=first_step, t_eval=check_t_eval(t_eval, t_end),

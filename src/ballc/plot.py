@@ -17,7 +17,14 @@ ENERGY_ORDER = ("kinetic", "potential", "spring")
 #: throw's omega_x and omega_y) stay visible on top of each other.
 COMPONENT_STYLES = ("-", "--", ":")
 #: Sweep map colours of "came back": yes, no, and no answer (failed run, NaN).
-CAME_BACK_COLOURS = {"yes": "#1a9850", "no": "#d73027", "none": "0.85"}
+CAME_BACK_COLOURS = {"yes": "#1a9850", "no": "#d73027", "undetermined": "#fee08b",
+                     "none": "0.85"}
+
+
+def _verdict_value(value) -> float:
+    """came_back as a cell value: 1 yes, 0 no, 0.5 undetermined (None, NaN, <NA>)."""
+    import pandas as pd
+    return 0.5 if pd.isna(value) else float(bool(value))
 
 
 def _pyplot():
@@ -91,14 +98,17 @@ def plot_energy(result, ax=None, figsize=(10, 5)):
     return fig, ax
 
 
+#: What a contact point is, in every figure, the animation and contacts.csv.
+CONTACT_POINT = "the centre's (x, y) at maximum penetration"
+
+
 def contact_points(result) -> np.ndarray:
-    """(k, 3) where each contact started: the point of the plane under/over the centre (m)."""
+    """(k, 3) the contact points (m): each contact's ``contact_point`` -- the centre's
+    (x, y) at maximum penetration, as contacts.csv's contact_point_x/y -- on its plane."""
     points = np.empty((len(result.contacts), 3))
     for i, contact in enumerate(result.contacts):
-        x = np.interp(contact.t_start, result.t, result.position[0])
-        y = np.interp(contact.t_start, result.t, result.position[1])
         z = 0.0 if contact.plane == "floor" else result.scene.ceiling_height
-        points[i] = (x, y, z)
+        points[i] = (*contact.contact_point, z)
     return points
 
 
@@ -136,7 +146,8 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title("Contact points, top view\n" + scene_title(result.scene))
+    ax.set_title(f"Contact points ({CONTACT_POINT}), top view\n"
+                 + scene_title(result.scene), fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize="small")
     return fig, ax
@@ -173,8 +184,10 @@ def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
                    figsize=(8, 6)):
     """Heat map of ``value`` over a two-parameter sweep table (``ballc.sweep``).
 
-    Each cell is one scene; for "came_back" the colour says yes/no and the text gives
-    the fraction of energy lost (%).  Failed runs (status != 0) are marked with "!".
+    Each cell is one scene; for "came_back" the colour says yes / no / undetermined
+    (fewer completed contacts than the criterion needs, or a run that raised) and the
+    text gives the fraction of energy lost (%).  Failed runs (status != 0) are marked
+    with "!"; a combination missing from the table is grey.
     """
     plt = _pyplot()
     fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
@@ -182,12 +195,14 @@ def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
     xs = sorted(table[x].unique())
     ys = sorted(table[y].unique())
     grid = np.full((len(ys), len(xs)), np.nan)
-    for _, row in table.iterrows():
-        grid[ys.index(row[y]), xs.index(row[x])] = float(row[value])
     boolean = value == "came_back"
-    if boolean:      # two colours and a legend: yes / no is not a continuous quantity
+    for _, row in table.iterrows():
+        grid[ys.index(row[y]), xs.index(row[x])] = (_verdict_value(row[value]) if boolean
+                                                    else float(row[value]))
+    if boolean:      # three colours and a legend: a verdict is not a continuous quantity
         from matplotlib.colors import ListedColormap
-        cmap = ListedColormap([CAME_BACK_COLOURS["no"], CAME_BACK_COLOURS["yes"]]
+        cmap = ListedColormap([CAME_BACK_COLOURS["no"], CAME_BACK_COLOURS["undetermined"],
+                               CAME_BACK_COLOURS["yes"]]
                               ).with_extremes(bad=CAME_BACK_COLOURS["none"])
     else:
         cmap = plt.get_cmap("viridis")
@@ -208,8 +223,11 @@ def plot_sweep_map(table, x: str, y: str, value: str = "came_back", ax=None,
         from matplotlib.patches import Patch
         handles = [Patch(facecolor=CAME_BACK_COLOURS["yes"], label="came back"),
                    Patch(facecolor=CAME_BACK_COLOURS["no"], label="did not come back")]
+        if (grid == 0.5).any():
+            handles.append(Patch(facecolor=CAME_BACK_COLOURS["undetermined"],
+                                 label="undetermined\n(fewer than 3 contacts)"))
         if np.isnan(grid).any():
-            handles.append(Patch(facecolor=CAME_BACK_COLOURS["none"], label="no answer"))
+            handles.append(Patch(facecolor=CAME_BACK_COLOURS["none"], label="no run"))
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1),
                   title="x-velocity reversed\nafter 3 contacts?", fontsize="small")
         ax.set_title("Does the throw come back?  (cell text: energy lost; !: run failed)")

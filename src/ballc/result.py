@@ -174,6 +174,21 @@ class Result:
         """True only when t_end was reached (status 0)."""
         return self.status == 0
 
+    # scipy's OdeResult is a dict: result["t"] as well as result.t
+    def __getitem__(self, key):
+        if key in ODE_RESULT_KEYS:
+            return getattr(self, key)
+        raise KeyError(f"{key!r}: a Result's items are those of scipy's OdeResult "
+                       f"({', '.join(ODE_RESULT_KEYS)}); the rest are attributes "
+                       f"(result.{key})")
+
+    def __contains__(self, key) -> bool:
+        return key in ODE_RESULT_KEYS
+
+    def keys(self) -> tuple:
+        """The keys of scipy's OdeResult, which ``result[key]`` reads (``dict(result)``)."""
+        return ODE_RESULT_KEYS
+
     @property
     def quaternion(self) -> np.ndarray:
         """(4, n) unit quaternion (qw, qx, qy, qz), ball frame -> inertial."""
@@ -344,6 +359,10 @@ class Result:
                 f"t=[{self.t[0]:g} .. {self.t[-1]:g}] ({self.t.size} points), "
                 f"contacts={len(self.contacts)}, nfev={self.nfev}, njev={self.njev})")
 
+
+#: What ``result[key]`` reads: the items of scipy's OdeResult (a dict).
+ODE_RESULT_KEYS = ("t", "y", "sol", "t_events", "y_events", "nfev", "njev", "nlu",
+                   "status", "message", "success")
 
 #: Contact fields, in the order files store them.
 CONTACT_FIELDS = [f.name for f in fields(Contact)]

@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from . import _core
+from ._format import plain
 from .orientation import quaternion_from_angles_123
 
 #: The values of ``Scene.tangential_model``.
@@ -329,6 +330,9 @@ def read_toml(path) -> dict:
             return tomllib.load(stream)
         except tomllib.TOMLDecodeError as error:
             raise SceneError(f"{path}: not valid TOML: {error}") from None
+        except UnicodeDecodeError as error:
+            raise SceneError(f"{path}: not UTF-8 text, as TOML must be (byte "
+                             f"0x{error.object[error.start]:02x} at offset {error.start})") from None
 
 
 def _toml_value(value) -> str:
@@ -346,7 +350,7 @@ def _toml_value(value) -> str:
 
 def _validate(s: Scene) -> None:
     def fail(name, value, allowed):
-        raise SceneError(f"{name} = {value!r} is not allowed: {allowed}")
+        raise SceneError(f"{name} = {plain(value)} is not allowed: {allowed}")
 
     def finite(name, value):
         # Strings and bools would pass float() but are not numbers (a str field

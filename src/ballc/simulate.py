@@ -16,12 +16,14 @@ import math
 import numpy as np
 
 from . import _core, events as ev, layout, modes, outcome, stickslip
+from ._format import plain
 from .dense import PiecewiseSolution
 from .integrate import failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
 from .result import Contact, Result
 from .samples import Samples
+from .user_events import UserEvents
 from .scene import Scene, SceneError
 
 PLANES = layout.PLANES
@@ -41,17 +43,17 @@ def check_initial_state(scene, y0):
     try:
         y = np.array(y0, dtype=float)
     except (TypeError, ValueError):
-        raise SceneError(f"y0 = {y0!r} is not allowed: must be {_core.N_STATES} numbers "
+        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {_core.N_STATES} numbers "
                          f"({', '.join(_core.STATE_NAMES)})") from None
     if y.shape != (_core.N_STATES,) or not np.all(np.isfinite(y)):
-        raise SceneError(f"y0 = {y0!r} is not allowed: must be {_core.N_STATES} finite "
+        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {_core.N_STATES} finite "
                          f"numbers ({', '.join(_core.STATE_NAMES)})")
     size = np.linalg.norm(y[_QUATERNION])
     if not size > 0:
         raise SceneError("y0 is not allowed: its quaternion (qw, qx, qy, qz) is zero")
     y[_QUATERNION] /= size
     if not 0 < y[_STATE["z"]] < scene.ceiling_height:
-        raise SceneError(f"y0 is not allowed: z = {y[_STATE['z']]!r} must be between the "
+        raise SceneError(f"y0 is not allowed: z = {plain(y[_STATE['z']])} must be between the "
                          f"planes, 0 < z < {scene.ceiling_height}")
     return y
 
@@ -367,7 +369,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         samples.add(t_eval[keep], np.repeat(run.y[:, None], keep.sum(), axis=1), run.flags(),
                     run.latch)
     skip = 1 if t_eval is None else 0   # a segment's first sample is its start, already stored
-    user = list(options.events)
+    users = UserEvents(options.events)
+    user = users.events
     user_t = [[] for _ in user]
     user_y = [[] for _ in user]
     pieces = []
@@ -389,7 +392,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
         remaining = None if options.max_nfev is None else max(options.max_nfev - nfev, 1)
-        events = [event for _, _, event in driver_events] + user
+        events = [event for _, _, event in driver_events] + users.for_segment()
         sol = integrate_segment(system, run.t, t_end, run.y, events,
                                 method=options.method, rtol=options.rtol, atol=options.atol,
                                 t_eval=segment_eval, max_step=options.max_step,
@@ -417,8 +420,10 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                 plane = driver_events[i][1]
                 for yy in y_events[i]:
                     record_depth(run.open[plane], ev.penetration(plane, scene)(0, yy), yy)
-            elif getattr(events[i], "terminal", False) and hits[-1] < t_fired:
+            elif 0 < _core.terminal_count(events[i].terminal) <= len(hits) \
+                    and hits[-1] < t_fired:   # stopped at its last occurrence left
                 fired, t_fired = i, float(hits[-1])
+        users.count(t_events[n_driver:])
         for k in range(len(user)):
             user_t[k].append(np.asarray(t_events[n_driver + k], dtype=float))
             user_y[k].append(np.asarray(y_events[n_driver + k], dtype=float).reshape(
@@ -476,6 +481,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                               for k in user_y],
                     sol=PiecewiseSolution(pieces) if options.dense_output else None)
     outcome.summarize_contact_forces(result)
+    result.message += outcome.tolerance_warning(options.rtol, options.atol)
     result.message += outcome.balance_warning(result, options.rtol)
     result.message += outcome.stiffness_note(stiff_at)
     return result
