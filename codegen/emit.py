@@ -92,6 +92,11 @@ class BallcPrinter(C99CodePrinter):
     """C99 printer with compact Heaviside, exact small integer powers and half-integer
     powers as products with one square root."""
 
+    def __init__(self, settings=None):
+        # no M_SQRT2-style macros: they are not C99 (a constant such as sqrt(2) is
+        # printed as its value instead)
+        super().__init__({"math_macros": {}, **(settings or {})})
+
     def _print_Heaviside(self, expr):
         arg = self._print(expr.args[0])
         h0 = expr.args[1] if len(expr.args) > 1 else sm.S.Half

@@ -98,6 +98,12 @@ def derive(model: Model | None = None):
             dissipation = contact.dissipation_rates(model, plane, law)
             deflection = law.deflection_rate or [0, 0]
             pieces[f"{plane}_{name}"] = sm.Matrix([*(G * f), *f, *dissipation, *deflection])
+            if name in contact.JACOBIAN_FORMS:
+                law = contact.JACOBIAN_FORMS[name](model, plane)
+                f = sm.Matrix([me.dot(law.force, v) for v in (N.x, N.y, N.z)])
+                dissipation = contact.dissipation_rates(model, plane, law)
+                pieces[f"{plane}_{name}_jacobian_form"] = sm.Matrix(
+                    [*(G * f), *f, *dissipation, *law.deflection_rate])
     return model, pieces
 
 
@@ -153,8 +159,11 @@ def build_kernels():
             extra_doc = "latched rhodot^-, d_x, d_y, d_z of this plane"
             kernels.append(Kernel(f"{plane}_{law}", f"{doc} {describe_contact_law_layout()}.",
                                   list(outputs), list(latch), extra_doc))
+            form = pieces.get(f"{plane}_{law}_jacobian_form", outputs)
+            note = "" if form is outputs else " (of the law's Jacobian form, " \
+                "contact.JACOBIAN_FORMS)"
             kernels.append(jacobian_kernel(model, f"{plane}_{law}_jac", f"{doc} d(outputs)/dx "
-                                           f"({len(outputs)}x{n} row-major).", list(outputs),
+                                           f"({len(outputs)}x{n} row-major){note}.", list(form),
                                            latch, extra_doc))
         # Exact (event-driven) Coulomb friction applies the tangential force itself and
         # takes only the friction law's normal share: the law with mu = 0, whose
@@ -277,6 +286,7 @@ def output_kernels(model: Model):
     potential = ball.mass*g*z + observer.mass*g*(z + me.dot(
         model.observer.pos_from(model.centre), N.z))
     energy = [kinetic, potential] + [contact.spring_energy(model, plane) for plane in PLANES]
+    energy += [contact.tangential_spring_energy(model, plane) for plane in PLANES]
 
     kin = []
     for plane in PLANES:
@@ -287,7 +297,8 @@ def output_kernels(model: Model):
     observer_position = [model.state(c) + me.dot(rel, v)
                          for c, v in zip("xyz", (N.x, N.y, N.z))]
     return [
-        Kernel("energy", "Energies (J): kinetic, potential, spring floor, spring ceiling.",
+        Kernel("energy", "Energies (J): kinetic, potential, spring floor, spring ceiling, "
+               "tangential spring floor, tangential spring ceiling (the compliant law's).",
                energy, []),
         Kernel("contact_kinematics", "Per plane (floor, ceiling): rho, rhodot, contact-point"
                " velocity x y z (10).", kin, []),

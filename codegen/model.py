@@ -72,6 +72,12 @@ PARAMETERS = (
      "0: seed's v_t / max(|v_t|, v_s); 1: smooth v_t / sqrt(|v_t|^2 + v_s^2)"),
     ("tangential_stiffness_ratio", "-", "1",
      "compliant model: tangential / normal contact stiffness (Mindlin: 2(1-nu)/(2-nu))"),
+    ("normal_damping_model", "-", "1",
+     "compliant model's normal damping: 0 Hunt-Crossley, 1 viscoelastic"),
+    ("damping_ratio", "-", "1",
+     "compliant model, viscoelastic normal damping: c_n = 2 gamma sqrt(m* k_n)"),
+    ("tangential_damping_ratio", "-", "1",
+     "compliant model's tangential damping: c_t = 2 gamma_t sqrt(m* k_t)"),
 )
 PARAMETER_NAMES = tuple(p[0] for p in PARAMETERS)
 

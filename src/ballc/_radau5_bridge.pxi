@@ -60,6 +60,7 @@ cdef extern from "_radau5_solver.h":
         const int *ev_rearm
         radau5_rearm_fun rearm
         int method
+        int jacobian_ahead
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -490,10 +491,12 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    radau5_event_fun event_fun=NULL, int[::1] event_plane=None,
                    list users=None, bint dense_output=False, controller=None,
                    bint outputs_checked=False, bint refine_events=True,
-                   ball_ctx *ball=NULL, method="radau5"):
-    """``ball``: ballc's system context (solve_system), which re-arms events."""
+                   ball_ctx *ball=NULL, method="radau5", bint jacobian_ahead=False):
+    """``ball``: ballc's system context (solve_system), which re-arms events;
+    ``jacobian_ahead``: radau5_problem.jacobian_ahead."""
     cdef radau5_problem p
     p.method = _method_code(method)
+    p.jacobian_ahead = jacobian_ahead
     cdef int ctrl = _controller_bits(controller)
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
         raise ValueError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
@@ -630,7 +633,8 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes,
                  users, bool(dense_output), controller,
                  True,   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
-                 bool(refine_events), &ctx, method)
+                 bool(refine_events), &ctx, method,
+                 (flags & (BALLC_FLOOR_COMPLIANT | BALLC_CEILING_COMPLIANT)) != 0)
     if errors:
         raise errors[0]
     return sol

@@ -442,6 +442,7 @@ static int step_radau(solver_t *s)
         }
 
         converged = 0;
+        int tried_ahead = 0;
         while (!converged) {
             int lu_ok = 1;
             if (!s->lu_valid) lu_ok = factor(s, h) == 0;
@@ -450,6 +451,28 @@ static int step_radau(solver_t *s)
                                                   &theta);
             if (!lu_ok) n_iter = 0;
             if (!converged) {
+                /* The first step of a segment whose Newton fails with the Jacobian of its
+                 * start: try once more with the Jacobian at the explicit Euler prediction
+                 * of the step's end.  A contact law can be singular where a segment starts
+                 * (the compliant law's yield: stiffness ~ n/t from contact start), where
+                 * the start's Jacobian holds none of the stiffness every later point has;
+                 * halving h then never helps.  Only where the caller asks (problem
+                 * jacobian_ahead: segments with a compliant contact). */
+                if (s->p->jacobian_ahead && s->current_jac && !s->have_sol && !tried_ahead
+                    && h != 0) {
+                    tried_ahead = 1;
+                    for (int c = 0; c < n; c++) err[c] = y[c] + h * s->f[c];
+                    if (call_jac(s, t + h, err) == 0) {
+                        s->lu_valid = 0;
+                        continue;
+                    }
+                    if (call_jac(s, t, y) != 0) {
+                        snprintf(s->r->message, sizeof s->r->message,
+                                 "the Jacobian cannot be evaluated at t = %.17g", t);
+                        return 0;
+                    }
+                    s->lu_valid = 0;
+                }
                 if (s->current_jac) break;
                 if (call_jac(s, t, y) != 0) {
                     snprintf(s->r->message, sizeof s->r->message,

@@ -87,6 +87,9 @@ typedef struct {
     const int *ev_rearm;      /* may be NULL; nonzero: the terminal event may be re-armed */
     radau5_rearm_fun rearm;   /*   by rearm (only where refine_events stepped to its time) */
     int method;               /* RADAU5_METHOD_RADAU (0) or RADAU5_METHOD_DOP853 */
+    int jacobian_ahead;       /* nonzero: a segment's first step whose Newton fails with the
+                               * start's Jacobian retries once with the Jacobian at the
+                               * step's explicit Euler end (the compliant law's contacts) */
 } radau5_problem;
 
 enum { RADAU5_METHOD_RADAU = 0, RADAU5_METHOD_DOP853 = 1 };

@@ -225,8 +225,9 @@ class Result:
     def energy(self) -> dict:
         """name -> (n,) array (J).
 
-        ``kinetic``, ``potential`` (gravity), ``spring`` (Hertz, 2/5 k0 rho^(5/2)) and
-        their sum ``total`` (the seed's total energy); ``dissipated_normal`` and
+        ``kinetic``, ``potential`` (gravity), ``spring`` (Hertz, 2/5 k0 rho^(5/2)),
+        ``tangential_spring`` (the compliant law's, 1/2 k_t |s|^2; 0 for the others) and
+        their sum ``total`` (the seed's total energy, plus the tangential spring's); ``dissipated_normal`` and
         ``dissipated_tangential``: work dissipated by the contact forces since t = 0
         (integrated with the motion; negative where a model injects energy, as dig-in
         does), ``dissipated`` their sum, and ``balance`` = total + dissipated, which
@@ -235,10 +236,12 @@ class Result:
         if self._energy is None:
             e = _core.energies(np.ascontiguousarray(self.y.T), self.scene.parameter_vector())
             spring = e[:, 2] + e[:, 3]
-            total = e[:, 0] + e[:, 1] + spring
+            tangential_spring = e[:, 4] + e[:, 5]
+            total = e[:, 0] + e[:, 1] + spring + tangential_spring
             normal = self.y[_STATE["dissipated_normal"]]
             tangential = self.y[_STATE["dissipated_tangential"]]
             self._energy = {"kinetic": e[:, 0], "potential": e[:, 1], "spring": spring,
+                            "tangential_spring": tangential_spring,
                             "total": total, "dissipated_normal": normal,
                             "dissipated_tangential": tangential,
                             "dissipated": normal + tangential,

@@ -21,6 +21,10 @@ from .orientation import quaternion_from_angles_123
 #: The values of ``Scene.tangential_model``.
 TANGENTIAL_MODELS = ("mixture", "friction", "dig-in", "compliant")
 FRICTION_REGULARIZATIONS = ("exact", "max", "smooth")
+#: The values of ``Scene.normal_damping`` (docs/contact_laws.md).
+NORMAL_DAMPINGS = ("hunt_crossley", "viscoelastic")
+#: c_tau when a scene gives neither c_tau nor restitution (the seed's value).
+DEFAULT_C_TAU = 0.9
 
 #: Scene field -> seed symbol(s).
 SEED_SYMBOLS = {
@@ -72,9 +76,26 @@ class Scene:
     ball_poisson_ratio, plane_poisson_ratio : float
         Poisson ratios of the ball and of the planes (1), in (-1, 0.5].
         Defaults 0.25 and 0.15.
-    c_tau : float
+    c_tau : float, optional
         Hunt-Crossley parameter (1), in (0, 1]: 1 is perfectly elastic; close to the
-        coefficient of restitution of a normal impact for c_tau near 1.  Default 0.9.
+        coefficient of restitution of a normal impact for c_tau near 1.  Default 0.9
+        (the seed's) unless ``restitution`` is given: a scene gives one or the other.
+    restitution : float, optional
+        Coefficient of restitution e of a normal impact (1), in (0, 1], inverted exactly
+        for the normal damping in use (Hunt-Crossley: chi (1 + e) = ln[(1 + chi)/(1 - chi
+        e)], any e > 0, where c_tau only reaches e > 0.4877; viscoelastic: gamma(e) of the
+        dimensionless Hertz impact, :mod:`ballc.restitution`).  Default None (c_tau).
+    normal_damping : str
+        "hunt_crossley" (default, the seed's) or "viscoelastic" (the DEM codes' Hertz
+        viscous damping c_n = 2 gamma sqrt(m* k_n), clamped so the force is never
+        attractive; only with ``tangential_model = "compliant"``).  See
+        docs/contact_laws.md.
+    damping_ratio : float, optional
+        gamma of the viscoelastic normal damping (1), >= 0; or give ``restitution``.
+    tangential_damping_ratio : float, optional
+        gamma_t of the compliant law's tangential damping c_t = 2 gamma_t sqrt(m* k_t)
+        (1), >= 0.  Default (None): the viscoelastic gamma of the scene's normal
+        restitution (Kratos' choice, the same gamma as the normal force).
     friction_coefficient : float
         Coulomb friction coefficient mu (1), >= 0.  Default 0.1.
     mixture : float
@@ -156,7 +177,11 @@ class Scene:
     plane_youngs_modulus: float = 2e10
     ball_poisson_ratio: float = 0.25
     plane_poisson_ratio: float = 0.15
-    c_tau: float = 0.9
+    c_tau: float | None = None
+    restitution: float | None = None
+    normal_damping: str = "hunt_crossley"
+    damping_ratio: float | None = None
+    tangential_damping_ratio: float | None = None
     friction_coefficient: float = 0.1
     mixture: float = 0.375
     tangential_model: str = "mixture"
@@ -196,6 +221,7 @@ class Scene:
                                                        self.plane_poisson_ratio,
                                                        self.ball_youngs_modulus,
                                                        self.plane_youngs_modulus))
+        _resolve_damping(self)
         if self.inertia is None:
             try:
                 i = 0.4 * float(self.mass) * float(self.radius) ** 2
@@ -212,7 +238,10 @@ class Scene:
 
     def to_dict(self) -> dict:
         """Every field by name (SI units), as ``from_dict`` and the TOML files take them."""
-        return asdict(self)
+        values = asdict(self)
+        for name in getattr(self, "_derived", ()):
+            values[name] = None     # computed from another field: not an input
+        return values
 
     @classmethod
     def from_toml(cls, path) -> "Scene":
@@ -231,13 +260,40 @@ class Scene:
     def to_toml(self, path) -> None:
         """Write every field to a TOML file that ``Scene.from_toml`` reads back equal."""
         lines = ["# ballc scene: SI units, fields as in README.md 'Scene fields'"]
-        lines += [f"{name} = {_toml_value(value)}" for name, value in self.to_dict().items()]
+        lines += [f"{name} = {_toml_value(value)}" for name, value in self.to_dict().items()
+                  if value is not None]
         with open(path, "w", encoding="utf-8") as stream:
             stream.write("\n".join(lines) + "\n")
 
     def replace(self, **changes) -> "Scene":
-        """A copy with some fields changed (validated)."""
-        return Scene.from_dict({**self.to_dict(), **changes})
+        """A copy with some fields changed (validated).  Giving one of c_tau,
+        restitution and damping_ratio drops the others (a scene gives one)."""
+        values = self.to_dict()
+        if any(name in changes for name in _DAMPING_INPUTS) or "normal_damping" in changes:
+            keep = "restitution" if "normal_damping" in changes else None
+            for name in _DAMPING_INPUTS:
+                if name != keep:
+                    values[name] = None
+        return Scene.from_dict({**values, **changes})
+
+    @property
+    def normal_restitution(self) -> float:
+        """Coefficient of restitution e of a normal impact with this scene's normal law
+        (1): ``restitution`` if given, else the one its c_tau or damping_ratio gives."""
+        from . import restitution as law
+        if self.restitution is not None:
+            return float(self.restitution)
+        if self.normal_damping == "viscoelastic":
+            return law.viscoelastic_restitution(self.damping_ratio)
+        return law.hunt_crossley_restitution_of_chi(1.5 * (1 - self.c_tau))
+
+    @property
+    def hunt_crossley_chi(self) -> float:
+        """chi of the Hunt-Crossley bracket 1 + chi rhodot / |rhodot^-| (1)."""
+        from . import restitution as law
+        if self.normal_damping == "hunt_crossley" and self.restitution is not None:
+            return law.hunt_crossley_chi_for_restitution(self.restitution)
+        return 1.5 * (1 - (self.c_tau if self.c_tau is not None else 1.0))
 
     @property
     def effective_mixture(self) -> float:
@@ -271,10 +327,14 @@ class Scene:
             "plane_poisson_ratio": self.plane_poisson_ratio,
             "ball_youngs_modulus": self.ball_youngs_modulus,
             "plane_youngs_modulus": self.plane_youngs_modulus,
-            "c_tau": self.c_tau, "friction_coefficient": self.friction_coefficient,
+            "c_tau": 1.0 - self.hunt_crossley_chi / 1.5,
+            "friction_coefficient": self.friction_coefficient,
             "friction_regularization_speed": self.friction_regularization_speed,
             "smooth_friction": float(self.friction_regularization == "smooth"),
             "tangential_stiffness_ratio": self.tangential_stiffness_ratio,
+            "normal_damping_model": float(self.normal_damping == "viscoelastic"),
+            "damping_ratio": self.damping_ratio or 0.0,
+            "tangential_damping_ratio": self.tangential_damping_ratio,
         }
         return np.array([float(values[name]) for name in _core.PARAMETER_NAMES])
 
@@ -284,6 +344,73 @@ class Scene:
                                      self.angular_velocity, self.velocity])
         auxiliary = np.zeros(_core.N_STATES - mechanical.size)   # dissipated work, deflections
         return np.concatenate([mechanical, auxiliary])
+
+
+_DAMPING_INPUTS = ("c_tau", "restitution", "damping_ratio")
+
+
+def _resolve_damping(s: Scene) -> None:
+    """Check that the scene gives one normal damping input, fill in c_tau's default, the
+    viscoelastic gamma of a restitution, and the tangential damping ratio's default."""
+    from . import restitution as law
+    derived = []
+    if s.normal_damping not in NORMAL_DAMPINGS:
+        close = difflib.get_close_matches(str(s.normal_damping), NORMAL_DAMPINGS, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise SceneError(f"normal_damping = {s.normal_damping!r} is not allowed: must be one "
+                         f"of {NORMAL_DAMPINGS}{hint}")
+    given = [name for name in _DAMPING_INPUTS if getattr(s, name) is not None]
+    if len(given) > 1:
+        raise SceneError(f"{' and '.join(given)} are both given: a scene gives one of "
+                         f"{', '.join(_DAMPING_INPUTS)} (replace() drops the others)")
+    if s.restitution is not None:
+        e = s.restitution
+        if isinstance(e, (bool, np.bool_)) or not isinstance(e, (int, float, np.number)) \
+                or not math.isfinite(float(e)) or not 0 < float(e) <= 1:
+            raise SceneError(f"restitution = {_plain(e)} is not allowed: must be a number "
+                             "in (0, 1]")
+        object.__setattr__(s, "restitution", float(e))
+    if s.normal_damping == "viscoelastic":
+        if s.c_tau is not None:
+            raise SceneError("c_tau is given with normal_damping = 'viscoelastic': give "
+                             "restitution or damping_ratio (gamma) instead")
+        if s.restitution is None and s.damping_ratio is None:
+            raise SceneError("normal_damping = 'viscoelastic' needs restitution (e in "
+                             "(0, 1]) or damping_ratio (gamma >= 0)")
+        if s.damping_ratio is not None:
+            _non_negative("damping_ratio", s.damping_ratio)
+        else:
+            object.__setattr__(s, "damping_ratio",
+                               law.viscoelastic_gamma_for_restitution(s.restitution))
+            derived.append("damping_ratio")
+    else:
+        if s.damping_ratio is not None:
+            raise SceneError("damping_ratio (gamma) is the viscoelastic law's: with "
+                             "normal_damping = 'hunt_crossley' give c_tau or restitution")
+        if s.c_tau is None and s.restitution is None:
+            object.__setattr__(s, "c_tau", DEFAULT_C_TAU)
+    if s.tangential_damping_ratio is None:
+        gamma = s.damping_ratio if s.normal_damping == "viscoelastic" else \
+            law.viscoelastic_gamma_for_restitution(s.normal_restitution)
+        object.__setattr__(s, "tangential_damping_ratio", float(gamma))
+        derived.append("tangential_damping_ratio")
+    else:
+        _non_negative("tangential_damping_ratio", s.tangential_damping_ratio)
+    object.__setattr__(s, "_derived", tuple(derived))
+
+
+def _non_negative(name, value):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)) \
+            or not math.isfinite(float(value)) or not float(value) >= 0:
+        raise SceneError(f"{name} = {_plain(value)} is not allowed: must be a finite number "
+                         ">= 0")
+
+
+def _plain(value):
+    """A number as a user wrote it (not np.float64(...)); anything else as repr."""
+    if isinstance(value, (int, float, np.number)) and not isinstance(value, (bool, np.bool_)):
+        return f"{float(value):g}"
+    return repr(value)
 
 
 def mindlin_stiffness_ratio(nu_ball, nu_plane, e_ball, e_plane):
@@ -375,8 +502,11 @@ def _validate(s: Scene) -> None:
     for name in ("ball_poisson_ratio", "plane_poisson_ratio"):
         if not -1 < finite(name, getattr(s, name)) <= 0.5:
             fail(name, getattr(s, name), "must be in (-1, 0.5]")
-    if not 0 < finite("c_tau", s.c_tau) <= 1:
+    if s.c_tau is not None and not 0 < finite("c_tau", s.c_tau) <= 1:
         fail("c_tau", s.c_tau, "must be in (0, 1]")
+    if s.normal_damping == "viscoelastic" and s.tangential_model != "compliant":
+        fail("normal_damping", s.normal_damping, "'viscoelastic' is a part of the compliant "
+             "law: use it with tangential_model = 'compliant'")
     if not 0 <= finite("mixture", s.mixture) <= 1:
         fail("mixture", s.mixture, "must be in [0, 1]")
     if not finite("tangential_stiffness_ratio", s.tangential_stiffness_ratio) > 0:

@@ -1,0 +1,99 @@
+"""The compliant law is passive: random oblique, spinning impacts never gain energy, its
+tangential dissipation rate is >= 0 at every sample, and the energy outputs (Hertz and
+tangential springs included) close the balance.  docs/contact_laws.md has the proof;
+these are its numerical checks (conservation laws: no ballc number is the oracle)."""
+import numpy as np
+import pytest
+
+import ballc
+from ballc import _core
+
+STATE = {name: i for i, name in enumerate(_core.STATE_NAMES)}
+
+
+def random_impact(rng, **damping):
+    """A scene of an oblique, spinning impact on the floor (kappa 0.1..1.2, mu 0.05..1.5,
+    no gravity, no observer) and its incident velocity and spin."""
+    speed = 3.0
+    angle = np.radians(rng.uniform(5, 85))
+    azimuth = rng.uniform(0, 2 * np.pi)
+    velocity = speed * np.array([np.sin(angle) * np.cos(azimuth),
+                                 np.sin(angle) * np.sin(azimuth), -np.cos(angle)])
+    axis = rng.normal(size=3)
+    spin = rng.uniform(0, 2) * speed / 0.01 * axis / np.linalg.norm(axis)
+    scene = ballc.Scene(mass=0.01, radius=0.01, observer_mass=0.0, gravity=0.0,
+                        ceiling_height=1.0, position=(0, 0, 0.5), velocity=(0, 0, -1),
+                        ball_youngs_modulus=1e8, plane_youngs_modulus=1e11,
+                        tangential_model="compliant",
+                        tangential_stiffness_ratio=rng.uniform(0.1, 1.2),
+                        friction_coefficient=rng.uniform(0.05, 1.5), **damping)
+    return scene, velocity, spin
+
+
+def kinetic(scene, v, w):
+    return 0.5 * scene.mass * v @ v + 0.5 * scene.inertia[0] * w @ w
+
+
+def dissipation_rates(result):
+    """(n, 2) normal and tangential dissipation rates (W) at every sample, from the
+    compiled right-hand side with each sample's own latch and flags."""
+    p = result.scene.parameter_vector()
+    rates = []
+    for y, latch, flags in zip(result.y.T, result._latches.T if hasattr(result, "_latches")
+                               else [None] * result.t.size, result._flags
+                               if hasattr(result, "_flags") else [None] * result.t.size):
+        rates.append(_core.rhs(np.ascontiguousarray(y), p, latch, flags)
+                     [[STATE["dissipated_normal"], STATE["dissipated_tangential"]]])
+    return np.array(rates)
+
+
+@pytest.mark.parametrize("damping", [{"c_tau": 1.0}, {"restitution": 0.5},
+                                     {"normal_damping": "viscoelastic", "restitution": 0.3}],
+                         ids=["elastic", "hunt-crossley e=0.5", "viscoelastic e=0.3"])
+def test_random_oblique_spinning_impacts_never_gain_energy(damping):
+    rng = np.random.default_rng(20261125)
+    for _ in range(12):
+        scene, v, w = random_impact(rng, **damping)
+        hit = ballc.impact(scene, v, w, rtol=1e-10)
+        before, after = kinetic(scene, v, w), kinetic(scene, hit.velocity_after,
+                                                     hit.angular_velocity_after)
+        assert after <= before * (1 + 1e-9), (scene, before, after)
+        energy = hit.result.energy
+        tangential = energy["dissipated_tangential"]
+        # the dissipated work never decreases (rate >= 0 at every sample, up to rounding)
+        assert np.all(np.diff(tangential) >= -1e-12 * before), np.diff(tangential).min()
+        assert np.all(np.diff(energy["dissipated_normal"]) >= -1e-12 * before)
+        # the balance closes with every stored energy in it
+        drift = np.abs(energy["balance"] - energy["balance"][0]).max()
+        assert drift < 1e-6 * before, drift
+        assert energy["tangential_spring"].max() > 0
+
+
+def test_tangential_dissipation_rate_is_non_negative_at_every_state():
+    """The rate itself (the kernel's output), at states sampled along random impacts and
+    at random perturbations of them: -F_t.v_t - d/dt(1/2 k_t |s|^2) >= 0."""
+    rng = np.random.default_rng(7)
+    n_checked = 0
+    for _ in range(6):
+        scene, v, w = random_impact(rng, restitution=0.6)
+        hit = ballc.impact(scene, v, w, rtol=1e-8)
+        contact = hit.result.contacts[0]
+        p = scene.parameter_vector()
+        latch = np.zeros(len(_core.LATCH_NAMES))
+        latch[0] = contact.penetration_rate_at_impact
+        latch[1:4] = contact.digin_direction
+        flags = _core.FLAGS["floor_compliant"]
+        inside = hit.result.position[2] < scene.radius
+        for y in hit.result.y.T[inside]:
+            for scale in (0.0, 0.3, 3.0):      # the sample, and its deflection scaled
+                z = y.copy()
+                z[STATE["floor_deflection_x"]:STATE["floor_deflection_y"] + 1] *= 1 + scale
+                z[STATE["omega_x"]:STATE["omega_z"] + 1] += scale * rng.normal(size=3) * 100
+                rates = _core.rhs(np.ascontiguousarray(z), p, latch, flags)
+                force = contact.peak_normal_force * (1 + scene.friction_coefficient)
+                speed = np.abs(z[STATE["vx"]:STATE["vz"] + 1]).max() + \
+                    scene.radius * np.abs(z[STATE["omega_x"]:STATE["omega_z"] + 1]).max()
+                # >= 0 up to rounding of the impact's forces (the law's floors, 1e-12 N)
+                assert rates[STATE["dissipated_tangential"]] >= -1e-12 * force * speed
+                n_checked += 1
+    assert n_checked > 100
