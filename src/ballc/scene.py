@@ -389,6 +389,11 @@ def _resolve_damping(s: Scene) -> None:
                              "normal_damping = 'hunt_crossley' give c_tau or restitution")
         if s.c_tau is None and s.restitution is None:
             object.__setattr__(s, "c_tau", DEFAULT_C_TAU)
+        c = s.c_tau
+        if c is not None and (isinstance(c, (bool, np.bool_, str, bytes))
+                              or not isinstance(c, (int, float, np.number))
+                              or not math.isfinite(float(c)) or not 0 < float(c) <= 1):
+            raise SceneError(f"c_tau = {_plain(c)} is not allowed: must be in (0, 1]")
     if s.tangential_damping_ratio is None:
         gamma = s.damping_ratio if s.normal_damping == "viscoelastic" else \
             law.viscoelastic_gamma_for_restitution(s.normal_restitution)
@@ -409,7 +414,7 @@ def _non_negative(name, value):
 def _plain(value):
     """A number as a user wrote it (not np.float64(...)); anything else as repr."""
     if isinstance(value, (int, float, np.number)) and not isinstance(value, (bool, np.bool_)):
-        return f"{float(value):g}"
+        return repr(float(value)) if not isinstance(value, (int, np.integer)) else str(value)
     return repr(value)
 
 
