@@ -49,8 +49,10 @@ def main(argv=None):
         rows += test_rows
     failed = [r for r in rows if r.status == "FAIL"]
     limits = [r for r in rows if r.status == "LIMIT"]
-    print(f"\n{len(rows) - len(failed) - len(limits)} passed, {len(failed)} failed, "
-          f"{len(limits)} not representable (LIMIT)")
+    reported = [r for r in rows if r.status == "REPORT"]
+    print(f"\n{len(rows) - len(failed) - len(limits) - len(reported)} passed, "
+          f"{len(failed)} failed, {len(limits)} not representable (LIMIT), "
+          f"{len(reported)} reported, not scored (REPORT)")
     return 1 if failed else 0
 
 
