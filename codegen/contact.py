@@ -128,7 +128,7 @@ def deflection_symbols(model: Model, plane: str):
 #: Sharpness n of the compliant model's yield: flow ~ (|F_el| / mu F_n)^n.  Chosen by
 #: measurement against the DEM codes' truncation (validation/dem_reference.py):
 #: see docs/contact_laws.md.
-YIELD_EXPONENT = 32
+YIELD_EXPONENT = 64
 #: The yield's factor r^n is clipped at 256 (r <= 256^(1/n)): beyond it the flow only
 #: needs to pull |F_el| back under the cap (the applied force is capped exactly anyway),
 #: and an unbounded factor would make the end of a contact (where mu F_n -> 0 faster
@@ -186,16 +186,37 @@ def damped_normal(model: Model, rho, rhodot, rate_at_impact):
     return _positive(elastic + damping), stiffness
 
 
+def normal_force_rate(model: Model, plane: str, rho, rhodot, rate_at_impact):
+    """dF_n/dt (N/s) of the damped normal force while it is positive, with the
+    penetration's acceleration taken as the contact's own: rho'' = -F_n/m* + g n_z (exact
+    for a ball in one contact without observer; the yield's shrinking term only)."""
+    elastic, stiffness = hertz_normal(model, rho)
+    f_n, _ = damped_normal(model, rho, rhodot, rate_at_impact)
+    normal, _ = plane_geometry(model, plane)
+    mass = effective_mass(model)
+    accel = -f_n / mass + model.p["gravity"] * me.dot(normal, model.frame.z)
+    rho_floor = sm.Max(_positive(rho), _LENGTH_FLOOR)
+    select = model.p["normal_damping_model"]
+    # Hunt-Crossley: P = F_H (1 + chi rhodot / |v-|)
+    chi = sm.Rational(3, 2) * (1 - model.p["c_tau"]) / sm.Abs(rate_at_impact)
+    hc = stiffness * (1 + chi * rhodot) * rhodot + elastic * chi * accel
+    # viscoelastic: P = F_H + 2 gamma sqrt(m* k_n) rhodot, dk_n/drho = k_n / (2 rho)
+    c_n = 2 * model.p["damping_ratio"] * _sqrt_positive(mass * stiffness)
+    ve = (stiffness + c_n * rhodot / (4 * rho_floor)) * rhodot + c_n * accel
+    return (1 - select) * hc + select * ve
+
+
 def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, slip,
-                        dilute=True):
+                        normal_force_rate, dilute=True):
     """The incremental (passive) Mindlin tangential spring with a Coulomb cap.
 
     Returns (capped elastic force F_e (2), deflection rate s' (2), the rate of the
     spring's stored energy 1/2 k_t |s|^2 (W), k_t).
     k_t = kappa k_n; F_el = -k_t s; s' = v_t - max(rhodot, 0)/(2 rho) s - phi s with the
-    smooth yield phi = r^n max(s.v_t, 0)/|s|^2 + min(r^n, 1) max(-rhodot, 0)/rho,
-    r = k_t |s| / cap (r^n <= 256; the second term follows a cap that shrinks as rho
-    does); the
+    smooth yield phi = x max(s.v_t, 0)/|s|^2 + min(x, 1) max(-d ln(cap/k_t)/dt, 0) with
+    x = max(r^n - 1, 0), r = k_t |s| / cap (r^n <= 256): nothing below the cap (the
+    elastic law exact there), a flow growing from the cap up; the second term follows
+    a cap that shrinks as rho does; the
     applied force F_e = F_el min(1, cap/|F_el|).  ``dilute=False`` leaves the middle
     term out (the Jacobian's form: see JACOBIAN_FORMS).
     """
@@ -208,9 +229,14 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     loading = sm.Max(sx*vx + sy*vy, 0) / sm.Max(size2, _LENGTH_FLOOR2)
     # the DEM codes truncate the stored force to the cap also when the cap shrinks
     # faster than k_t (unloading: cap / k_t ~ rho for Hertz): the second term
-    shrinking = _positive(-rhodot) / sm.Max(_positive(rho), _LENGTH_FLOOR)
-    yielding = ratio2**(YIELD_EXPONENT // 2)
-    flow = yielding * loading + sm.Min(yielding, 1) * shrinking
+    # relative rate of cap / k_t: dF_n/dt / F_n - rhodot / (2 rho) (Hertz undamped:
+    # rhodot / rho)
+    rho_floor = sm.Max(_positive(rho), _LENGTH_FLOOR)
+    relative = normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2)) \
+        - rhodot / (2 * rho_floor)
+    shrinking = _positive(-relative)
+    excess = _positive(ratio2**(YIELD_EXPONENT // 2) - 1)     # 0 below the cap
+    flow = excess * loading + sm.Min(excess, 1) * shrinking
     dilution = _positive(rhodot) / (2 * sm.Max(_positive(rho), _LENGTH_FLOOR)) if dilute \
         else sm.S.Zero
     # the deflection only moves while the contact carries a load (F_n > 0): a contact
@@ -256,8 +282,11 @@ def compliant_model_force(model: Model, plane: str, jacobian_form=False):
     _, _, rho, rhodot = contact_kinematics(model, plane)
     f_n, stiffness = damped_normal(model, rho, rhodot, latch_symbols(model, plane)[0])
     cap = model.p["friction_coefficient"] * f_n
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact)
     capped, rate, storage, k_t = incremental_mindlin(model, plane, stiffness, rho, rhodot,
-                                                     f_n, slip, dilute=not jacobian_form)
+                                                     f_n, slip, f_rate,
+                                                     dilute=not jacobian_form)
     viscous = capacity_damping(model, k_t, cap, capped, slip)
     tangential = [e + v for e, v in zip(capped, viscous)]
     force = f_n*normal + tangential[0]*N.x + tangential[1]*N.y

@@ -226,7 +226,7 @@ class Result:
         """name -> (n,) array (J).
 
         ``kinetic``, ``potential`` (gravity), ``spring`` (Hertz, 2/5 k0 rho^(5/2)),
-        ``tangential_spring`` (the compliant law's, 1/2 k_t |s|^2; 0 for the others) and
+        ``tangential_spring`` (the compliant law's, ``1/2 k_t |s|^2``; 0 for the others) and
         their sum ``total`` (the seed's total energy, plus the tangential spring's); ``dissipated_normal`` and
         ``dissipated_tangential``: work dissipated by the contact forces since t = 0
         (integrated with the motion; negative where a model injects energy, as dig-in
