@@ -9,11 +9,12 @@ from validation.dem_agreement import compare, random_impacts, reference_paramete
 from validation.dem_reference import dem_impact_converged
 
 
-def test_random_impacts_agree_with_the_dem_oracle():
-    # 6 undamped 3-D oblique spinning impacts (seed 1); the correct law's worst error
-    # on them is 0.71 % of the impact speed
-    errors = compare(random_impacts(6, seed=1), rel_tol=1e-4)
-    assert errors.max() < 0.015, errors
+@pytest.mark.parametrize("seed", [0, 1])
+def test_random_impacts_agree_with_the_dem_oracle(seed):
+    # 12 undamped 3-D oblique spinning impacts: the bar is 1 % of the impact
+    # speed; the law's worst measured over 254 such impacts (seeds 0..5) is 0.81 %
+    errors = compare(random_impacts(6, seed=seed), rel_tol=1e-4)
+    assert errors.max() < 0.01, errors
 
 
 def _oblique(**law):
@@ -30,10 +31,10 @@ def _oblique(**law):
                                  dict(c_tau=0.6, tangential_damping_ratio=0.3)],
                          ids=["elastic", "damped"])
 def test_oblique_impact_rebound_spin_matches_the_dem_oracle(law):
-    # correct law: 0.22 % (elastic), 0.002 % (damped)
+    # measured: 3.1e-5 (elastic), 1.4e-5 (damped) relative
     scene = _oblique(**law)
     hit = ballc.impact(scene, scene.velocity, scene.angular_velocity)
     ref = dem_impact_converged(**reference_parameters(scene), velocity=scene.velocity,
                                angular_velocity=scene.angular_velocity, rel_tol=1e-5)
     ours, theirs = hit.angular_velocity_after[1], ref["angular_velocity_after"][1]
-    assert abs(ours - theirs) < 0.005 * abs(theirs), (ours, theirs)
+    assert abs(ours - theirs) < 1e-3 * abs(theirs), (ours, theirs)   # measured 3e-5
