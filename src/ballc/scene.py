@@ -103,9 +103,10 @@ class Scene:
         force = (1 - mixture) friction + mixture dig-in.  Default 0.375.
     tangential_model : str
         "mixture" (default), "friction" (mixture taken as 0), "dig-in" (mixture taken
-        as 1) or "compliant": ballc's tangential-compliance model, an elastic
-        tangential spring of stiffness ``tangential_stiffness_ratio`` times the normal
-        contact stiffness, damped like the normal force, capped at mu F_n.
+        as 1) or "compliant": ballc's passive tangential-compliance model, the DEM
+        codes' incremental Mindlin spring of stiffness ``tangential_stiffness_ratio``
+        times the normal contact stiffness, damped, capped at mu F_n
+        (docs/contact_laws.md).
     friction_regularization_speed : float
         Regularisation speed v_s of the "max" and "smooth" friction laws (m/s), > 0.
         Default 1e-10, as in the seed's code.
@@ -146,7 +147,11 @@ class Scene:
     plane_youngs_modulus               Ep              Pa           2e10
     ball_poisson_ratio                 nyb             1            0.25
     plane_poisson_ratio                nyp             1            0.15
-    c_tau                              ctau            1            0.9
+    c_tau                              ctau            1            0.9 (or restitution)
+    restitution                        (none)          1            None (c_tau)
+    normal_damping                     (none)          (none)       "hunt_crossley"
+    damping_ratio                      (none)          1            None
+    tangential_damping_ratio           (none)          1            from restitution
     friction_coefficient               mu              1            0.1
     mixture                            mixtur          1            0.375
     tangential_model                   (none)          (none)       "mixture"
