@@ -1,7 +1,7 @@
 """Long runs: what the seed scene costs for 10 .. 1e6 s of simulated time (issue 21, item 1).
 
     python -m benchmarks.long_runs [--t-ends 10 100 1000 1e6] [--method radau5]
-                                   [--no-figures] [--scene seed|drop]
+                                   [--no-figures] [--scenes seed drop] [--out FILE]
 
 For each t_end: ``ballc.simulate(scene, t_end)`` with the default options (radau5,
 rtol = atol = 1e-10, exact Coulomb friction, max_nfev = 2e7), timed in wall-clock and
@@ -11,8 +11,11 @@ the last segment, the right-hand-side calls, the samples, the contacts, and the 
 step after the last contact started.  For the largest run, the figures
 (``result.plot()``, ``plot_energy()``, ``plot_observer()``, ``plot_contacts()``, matplotlib
 Agg, not saved) are timed too.  ``--scene drop``: a vertical drop without spin or
-observer (the seed's materials), a ball that truly comes to rest, for the resting end
-state.  Prints the table and writes it to docs/long_runs.md (``--out`` to change).
+observer (the seed's materials), a ball that truly comes to rest.  Each scene is run
+with ``rest=True`` (the default: the resting end state of ballc.resting) and with
+``rest=False`` (the integrator all the way, what the build before ballc.resting did;
+the first 5 s are bit-identical either way), in the same process.  Prints the tables
+and writes them to docs/long_runs.md (``--out`` to change).
 """
 from __future__ import annotations
 
@@ -60,10 +63,10 @@ class Segments:
         SIM.integrate_segment = self.inner
 
 
-def run(scene, t_end, method):
+def run(scene, t_end, method, rest):
     with Segments() as segments:
         wall, cpu = time.perf_counter(), time.process_time()
-        result = ballc.simulate(scene, t_end, method=method, progress=False)
+        result = ballc.simulate(scene, t_end, method=method, progress=False, rest=rest)
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     last = result.contacts[-1].t_start if result.contacts else 0.0
     late = np.diff(result.t[result.t >= last])
@@ -71,7 +74,8 @@ def run(scene, t_end, method):
                 cpu=cpu, segments=segments.count, last_steps=segments.last_steps,
                 nfev=result.nfev, samples=result.t.size, contacts=len(result.contacts),
                 median_step=float(np.median(late)) if late.size else float("nan"),
-                message=result.message.split(". ")[0]), result
+                message=result.message.replace(SIM.SUCCESS, "t_end reached.").replace(
+                    "|", "/")), result
 
 
 def time_figures(result):
@@ -88,36 +92,44 @@ def time_figures(result):
     return times
 
 
+HEADER = ("| t_end (s) | rest | status | reached (s) | wall (s) | CPU (s) | segments | steps of "
+          "last segment | RHS calls | samples | contacts | median step after last contact "
+          "start (s) | message |")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--t-ends", type=float, nargs="+", default=[10, 100, 1000, 1e6])
     parser.add_argument("--method", default="radau5")
-    parser.add_argument("--scene", choices=sorted(SCENES), default="seed")
+    parser.add_argument("--scenes", choices=sorted(SCENES), nargs="+", default=["seed", "drop"])
     parser.add_argument("--no-figures", action="store_true")
     parser.add_argument("--out", type=Path, default=DOCS / "long_runs.md")
     args = parser.parse_args(argv)
-    scene = SCENES[args.scene]()
-    rows, largest = [], None
-    for t_end in args.t_ends:
-        row, result = run(scene, t_end, args.method)
-        rows.append(row)
-        largest = result
-        print(row, flush=True)
-    header = ("| t_end (s) | status | reached (s) | wall (s) | CPU (s) | segments | steps of "
-              "last segment | RHS calls | samples | contacts | median step after last "
-              "contact start (s) | message |")
-    lines = [f"# Long runs ({args.scene} scene, {args.method}, default options)", "",
-             f"Made by `python -m benchmarks.long_runs {' '.join(argv or sys.argv[1:])}`.", "",
-             header, "|" + "---|" * (header.count("|") - 1)]
-    for r in rows:
-        lines.append(f"| {r['t_end']:g} | {r['status']} | {r['reached']:.6g} | {r['wall']:.3g} "
-                     f"| {r['cpu']:.3g} | {r['segments']} | {r['last_steps']} | {r['nfev']} "
-                     f"| {r['samples']} | {r['contacts']} | {r['median_step']:.4g} "
-                     f"| {r['message']} |")
+    command = " ".join(sys.argv[1:] if argv is None else argv)
+    lines = ["# Long runs", "",
+             f"Made by `python -m benchmarks.long_runs {command}`.  What the numbers "
+             "mean: docs/limits.md, \"Long runs\".", ""]
+    largest = None
+    for name in args.scenes:
+        scene = SCENES[name]()
+        lines += [f"## The {name} scene ({args.method}, default options)", "", HEADER,
+                  "|" + "---|" * (HEADER.count("|") - 1)]
+        for t_end in args.t_ends:
+            for rest in (True, False):
+                r, result = run(scene, t_end, args.method, rest)
+                print(name, rest, r, flush=True)
+                if largest is None or result.t.size > largest.t.size:
+                    largest = result
+                lines.append(
+                    f"| {r['t_end']:g} | {rest} | {r['status']} | {r['reached']:.6g} "
+                    f"| {r['wall']:.3g} | {r['cpu']:.3g} | {r['segments']} | {r['last_steps']} "
+                    f"| {r['nfev']} | {r['samples']} | {r['contacts']} | {r['median_step']:.4g} "
+                    f"| {r['message']} |")
+        lines.append("")
     if not args.no_figures and largest is not None:
         times = time_figures(largest)
-        lines += ["", f"Figures of the largest run ({largest.t.size} samples), matplotlib Agg, "
-                  "drawn, not saved:", "", "| figure | wall (s) |", "|---|---|"]
+        lines += [f"Figures of the run with the most samples ({largest.t.size}), matplotlib "
+                  "Agg, drawn, not saved:", "", "| figure | wall (s) |", "|---|---|"]
         lines += [f"| {name}() | {seconds:.3g} |" for name, seconds in times.items()]
         lines.append(f"| all | {sum(times.values()):.3g} |")
     text = "\n".join(lines) + "\n"
