@@ -107,7 +107,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     command = " ".join(sys.argv[1:] if argv is None else argv)
     lines = ["# Long runs", "",
-             f"Made by `python -m benchmarks.long_runs {command}`.  What the numbers "
+             f"Made by `{('python -m benchmarks.long_runs ' + command).strip()}`.  What the numbers "
              "mean: docs/limits.md, \"Long runs\".", ""]
     largest = None
     for name in args.scenes:
