@@ -103,3 +103,35 @@ def test_the_first_rest_check_comes_after_the_seed_s_first_5_seconds():
     """The seed's contacts last < 0.3 s: no rest check can end a segment in them (the
     first 5 s stay bit-identical)."""
     assert resting.REST_PERIODS * resting.oscillation_period(ballc.Scene()) > 4
+
+
+def test_observer_free_seed_rolls_in_closed_form():
+    """The seed's throw without the observer rolls uniformly from t ~ 31 s: entered by
+    resting.rolls, then exact (ballc.flight.FreeFlight with g = 0).  Oracle: the
+    integrated run (rest=False), which keeps v and omega to 10 digits."""
+    scene = ballc.Scene().replace(observer_mass=0.0)
+    closed = ballc.simulate(scene, 2000)
+    integrated = ballc.simulate(scene, 2000, rest=False)
+    assert closed.status == 0 and "rolls uniformly on the floor" in closed.message
+    contact = closed.contacts[-1]
+    assert 30 < contact.t_rolling < 60 and math.isnan(contact.t_rest)
+    assert contact.transitions[-1] == (contact.t_rolling, "rolling")
+    # within REST_FACTOR tolerances of the integrated motion, after 2000 s
+    assert np.max(np.abs(closed.y[:13, -1] - integrated.y[:13, -1])) < 1e-7
+    assert closed.y[Z, -1] == pytest.approx(
+        scene.radius - resting.equilibrium_penetration(scene), rel=0, abs=1e-15)
+    # no step after it: 1e9 s cost what 100 s cost, with at most MAX_ROLL_SAMPLES more samples
+    short, far = ballc.simulate(scene, 100), ballc.simulate(scene, 1e9)
+    assert far.status == 0 and far.nfev == short.nfev
+    assert far.t.size <= short.t.size + resting.MAX_ROLL_SAMPLES
+    assert "rolling uniformly from t" in far.contact_table()
+    assert np.all(np.diff(far.t) > 0)
+    run = ballc.simulate(scene, 1000, dense_output=True)
+    assert np.allclose(run.sol(run.t[-10:]), run.y[:, -10:], rtol=0, atol=1e-12)
+
+
+def test_the_seed_observer_keeps_the_rolling_integrated():
+    """With the seed's observer (1e-4 kg off centre) rolling is not uniform (its
+    direction wanders): no closed form, the run integrates on."""
+    run = ballc.simulate(ballc.Scene(), 60)
+    assert "rolls" not in run.message and math.isnan(run.contacts[-1].t_rolling)

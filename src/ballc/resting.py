@@ -149,12 +149,89 @@ def rest_state(scene, y, plane="floor"):
     rest[_Z] = scene.radius - equilibrium_penetration(scene)
     rest[_DEFLECTION["floor"]] = 0.0
     rest[_DEFLECTION["ceiling"]] = 0.0
-    params = scene.parameter_vector()
-    both = _core.energies(np.ascontiguousarray(np.stack([y, rest])), params)
+    return _booked(scene, y, rest)
+
+
+def _booked(scene, y, new):
+    """``new`` with the mechanical energy y has above it added to dissipated_normal."""
+    both = _core.energies(np.ascontiguousarray(np.stack([y, new])), scene.parameter_vector())
     before, after = (float(row[0] + row[1] + row[2] + row[3] + row[4] + row[5])
                      for row in both)
-    rest[_STATE["dissipated_normal"]] += before - after
-    return rest
+    new[_STATE["dissipated_normal"]] += before - after
+    return new
+
+
+# ---- uniform rolling ----
+
+#: At most this many samples of a closed-form rolling stretch (sol(t) is exact anywhere).
+MAX_ROLL_SAMPLES = 4096
+
+
+def rolling_state(scene, y):
+    """The uniform rolling state for y: the centre at the static equilibrium, vz = 0,
+    tangential deflections zero, the rest as it is; energy booked (see rest_state)."""
+    roll = np.array(y, dtype=float)
+    roll[_Z] = scene.radius - equilibrium_penetration(scene)
+    roll[_STATE["vz"]] = 0.0
+    roll[_DEFLECTION["floor"]] = 0.0
+    roll[_DEFLECTION["ceiling"]] = 0.0
+    return _booked(scene, y, roll)
+
+
+def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, flags):
+    """The uniform rolling state when the contact with ``plane`` (since ``t_start``)
+    rolls uniformly at state y and time t, else None.
+
+    Criterion: the scene has an exact free rotation (ballc.flight.scene_allows:
+    massless observer, isotropic inertia); the contact has lasted REST_PERIODS T0;
+    the slip speed ``slip_speed`` is at most REST_FACTOR dv; the energy above the
+    rolling state (vertical kinetic energy, Hertz spring plus gravity above rho_eq,
+    tangential spring) is below :func:`energy_threshold`; and the rolling state is a
+    steady state of the segment's equations (flags, latch): its accelerations, linear
+    and angular (times r), and the deflection rates are at rounding level
+    (1e3 eps g).  Then the motion is the exact uniform rolling: v and omega constant,
+    the centre on a straight line at z_eq, the orientation turning at omega
+    (ballc.flight.FreeFlight with g = 0)."""
+    from . import flight
+    if plane != resting_plane(scene) or t - t_start < REST_PERIODS * oscillation_period(scene):
+        return None
+    if not flight.scene_allows(params):
+        return None
+    largest_atol = float(np.max(atol))
+    dv = REST_FACTOR * (largest_atol + rtol * math.sqrt(scene.gravity * scene.radius))
+    if not slip_speed <= dv:
+        return None
+    e = _core.energies(np.ascontiguousarray(y[None, :]), params)[0]
+    rho_eq = equilibrium_penetration(scene)
+    x = (scene.radius - y[_Z] - rho_eq) / rho_eq
+    if not x > -1:
+        return None
+    weight = total_mass(scene) * scene.gravity
+    above = (0.5 * total_mass(scene) * y[_STATE["vz"]] ** 2 + float(e[4] + e[5])
+             + max(weight * rho_eq * (0.4 * math.expm1(2.5 * math.log1p(x)) - x), 0.0))
+    if not above <= energy_threshold(scene, rtol, atol):
+        return None
+    roll = rolling_state(scene, y)
+    rate = _core.rhs(np.ascontiguousarray(roll), np.ascontiguousarray(params, dtype=float),
+                     np.ascontiguousarray(latch, dtype=float), int(flags))
+    level = 1e3 * np.finfo(float).eps * scene.gravity
+    if (np.max(np.abs(rate[_VELOCITY])) > level
+            or scene.radius * np.max(np.abs(rate[_ANGULAR])) > level
+            or np.max(np.abs(rate[_DEFLECTION["floor"]])) > level
+            or np.max(np.abs(rate[_DEFLECTION["ceiling"]])) > level):
+        return None
+    return roll
+
+
+def rolling_samples(t0, t1, rate):
+    """Sample times of a closed-form rolling stretch after t0 up to t1: the turn at most
+    ballc.flight.MAX_TURN per interval, at least 32 and at most MAX_ROLL_SAMPLES."""
+    from . import flight
+    n = min(MAX_ROLL_SAMPLES, max(flight.MIN_INTERVALS,
+                                  math.ceil(rate * (t1 - t0) / flight.MAX_TURN)))
+    t = t0 + (t1 - t0) * np.arange(1, n + 1) / n
+    t[-1] = t1
+    return t
 
 
 class Constant:

@@ -18,6 +18,7 @@ import numpy as np
 from . import _core, events as ev, layout, modes, outcome, resting, stickslip
 from ._format import plain
 from .dense import PiecewiseSolution
+from .flight import FreeFlight
 from .integrate import failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
@@ -285,6 +286,31 @@ class _Run:
                                self.options.rtol, self.options.atol):
             self.rest_check[plane] = resting.next_check(self.scene, contact.t_start, self.t)
             return False
+        return self.enter_rest(plane)
+
+    def check_rolling(self, plane):
+        """At a rest check that found no rest: the uniform rolling state (a new state)
+        when the contact rolls uniformly (resting.rolls), else None."""
+        contact = self.open[plane]
+        speed = self.slip(plane, self.y)[1]
+        roll = resting.rolls(self.scene, self.y, plane, contact.t_start, self.t,
+                             self.options.rtol, self.options.atol, speed, self.params,
+                             self.latch, self.flags())
+        if roll is None:
+            return None
+        self.y = roll
+        contact.t_rolling = self.t
+        contact.transitions.append((self.t, "rolling"))
+        v = float(np.hypot(*roll[layout.VELOCITY][:2]))
+        self.message = (f"{SUCCESS} The ball rolls uniformly on the {plane} from t = "
+                        f"{self.t:.9g} s at {v:.6g} m/s (ballc.resting: no slip, static "
+                        f"Hertz equilibrium, penetration "
+                        f"{resting.equilibrium_penetration(self.scene):.6g} m); from there "
+                        "to t_end the state is that rolling, in closed form.")
+        return roll
+
+    def enter_rest(self, plane):
+        contact = self.open[plane]
         self.y = resting.rest_state(self.scene, self.y, plane)
         self.t_rest = contact.t_rest = self.t
         contact.transitions.append((self.t, "rest"))
@@ -495,6 +521,15 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     samples.add(np.array([t_end]), run.y[:, None], flags, run.latch)
                     if options.dense_output:
                         pieces.append((run.t, t_end, resting.Constant(run.y)))
+                    run.t = t_end
+                    break
+                if run.check_rolling(rest_plane) is not None:
+                    rolling = FreeFlight(run.t, run.y, 0.0, t_max=t_end)
+                    times = resting.rolling_samples(run.t, t_end, rolling.rate)
+                    samples.add(times, rolling(times), flags, run.latch)
+                    if options.dense_output:
+                        pieces.append((run.t, t_end, rolling))
+                    run.y = samples.last_state.copy()
                     run.t = t_end
                     break
                 h_next = sol.get("h_next", 0)
