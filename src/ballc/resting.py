@@ -36,8 +36,12 @@ energy balance stays exact.
 **Not resting**: a ball that spins about the normal (the model has no torsional
 friction: the spin never decays, and its energy is counted in criterion 3), a ball
 rolling on the plane (no rolling resistance: it rolls for ever -- the seed scene
-does, at ~0.8 m/s, from t = 30.94 s), a ball rocked by an eccentric observer.  Those
-are left to the integrator.
+does, at ~0.8 m/s, from t = 30.94 s), a ball rocked by an eccentric observer.
+
+**Uniform rolling** (:func:`rolls`): when the scene's free rotation is exact (massless
+observer, isotropic inertia), a rolling contact that has settled at the equilibrium
+is continued in closed form (see :func:`rolls` for the criterion).  With the seed's
+observer the rolling is not uniform, and is left to the integrator.
 """
 from __future__ import annotations
 

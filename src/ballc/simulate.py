@@ -411,8 +411,11 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         ballc.resting: a contact lasting 20 small-oscillation periods, energy above
         the static Hertz equilibrium below that of an oscillation of 10 tolerances)
         is put in the rest state and the run finishes analytically: ``message`` says
-        when, and so does the contact's ``t_rest``.  Checked only without ``t_eval``
-        and user ``events``.  False: integrate to t_end whatever happens.
+        when, and so does the contact's ``t_rest``; likewise a ball rolling uniformly
+        without slip at the equilibrium, when its rotation is exact (massless observer,
+        isotropic inertia), goes on in closed form (``t_rolling``).  Checked only
+        without ``t_eval`` and user ``events``.  False: integrate to t_end whatever
+        happens.
 
     Returns
     -------
