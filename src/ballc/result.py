@@ -69,6 +69,10 @@ class Contact:
     time_slipping: float = np.nan          # s, |F_t| at the cap
     #: exact Coulomb friction: [(t, "slip" or "stick")], the start of each phase (s)
     transitions: list = field(default_factory=list)
+    #: when the contact came to rest (ballc.resting), NaN if it did not (s)
+    t_rest: float = np.nan
+    #: when the contact began to roll uniformly (ballc.resting), NaN if it did not (s)
+    t_rolling: float = np.nan
 
     @property
     def duration(self) -> float:
@@ -86,7 +90,8 @@ class Contact:
                "energy_lost_normal": self.energy_lost_normal,
                "energy_lost_tangential": self.energy_lost_tangential,
                "time_sticking": self.time_sticking, "time_slipping": self.time_slipping,
-               "penetration_rate_at_impact": self.penetration_rate_at_impact}
+               "penetration_rate_at_impact": self.penetration_rate_at_impact,
+               "t_rest": self.t_rest, "t_rolling": self.t_rolling}
         for name in ("velocity_before", "velocity_after", "angular_velocity_before",
                      "angular_velocity_after"):
             for axis, value in zip("xyz", getattr(self, name)):
@@ -99,7 +104,8 @@ CONTACT_UNITS = {
     "plane": "", "t_start": "s", "t_end": "s", "duration": "s", "max_penetration": "m",
     "contact_point_x": "m", "contact_point_y": "m", "peak_normal_force": "N",
     "energy_lost_normal": "J", "energy_lost_tangential": "J", "time_sticking": "s",
-    "time_slipping": "s", "penetration_rate_at_impact": "m/s",
+    "time_slipping": "s", "penetration_rate_at_impact": "m/s", "t_rest": "s",
+    "t_rolling": "s",
     **{f"{name}_{axis}": unit for name, unit in (
         ("velocity_before", "m/s"), ("velocity_after", "m/s"),
         ("angular_velocity_before", "rad/s"), ("angular_velocity_after", "rad/s"))
@@ -355,6 +361,11 @@ class Result:
             lines.append(f"{i:2d} {c.plane:7} {c.t_start:8.4f} {c.t_end:8.4f} "
                          f"{c.max_penetration:9.4f} {vb[0]:10.3f} {va[0]:9.3f} "
                          f"{vb[1]:10.3f} {va[1]:9.3f} {vb[2]:10.3f} {va[2]:9.3f}")
+        lines += [f"contact {i}: at rest from t = {c.t_rest:.6g} s (ballc.resting)"
+                  for i, c in enumerate(self.contacts, 1) if c.t_rest == c.t_rest]
+        lines += [f"contact {i}: rolling uniformly from t = {c.t_rolling:.6g} s "
+                  "(ballc.resting)" for i, c in enumerate(self.contacts, 1)
+                  if c.t_rolling == c.t_rolling]
         return "\n".join(lines)
 
     def __repr__(self):
@@ -376,6 +387,8 @@ def _contacts_from(arrays: dict) -> list:
     for i in range(len(arrays["plane"])):
         values = {}
         for name in CONTACT_FIELDS:
+            if name not in arrays:   # a file from before the field existed
+                continue
             value = arrays[name][i]
             if name == "plane":
                 values[name] = str(value)

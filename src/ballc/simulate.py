@@ -15,9 +15,10 @@ import math
 
 import numpy as np
 
-from . import _core, events as ev, layout, modes, outcome, stickslip
+from . import _core, events as ev, layout, modes, outcome, resting, stickslip
 from ._format import plain
 from .dense import PiecewiseSolution
+from .flight import FreeFlight
 from .integrate import failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
@@ -83,6 +84,8 @@ class _Run:
         self.status, self.message = 0, SUCCESS
         self.last_transition, self.stalled = None, 0   # mode changes that left t unchanged
         self.rearmed: list[tuple[float, np.ndarray]] = []   # this segment's: (t, latch before)
+        self.rest_check: dict[str, float] = {}   # plane -> the time of its next rest check
+        self.t_rest = None                        # when the ball came to rest (ballc.resting)
         self._flags: dict[tuple, int] = {}
         self._slip_terms = {plane: stickslip.slip_terms(self.params, plane) for plane in PLANES}
 
@@ -115,11 +118,14 @@ class _Run:
         self.contacts.append(contact)
         self.dissipated_at_start[plane] = y[_DISSIPATED].copy()
         self.relatches[plane] = self.transitions[plane] = 0
+        self.rest_check[plane] = resting.first_check(self.scene, self.t) \
+            if plane == resting.resting_plane(self.scene) else math.inf
         if self.exact:
             self.start_coulomb(plane)
 
     def end_contact(self, plane):
         y = self.y
+        self.rest_check.pop(plane, None)
         self.in_contact[plane] = False
         self.coulomb[plane] = self.approach[plane] = None
         contact = self.open.pop(plane)
@@ -261,6 +267,59 @@ class _Run:
                     self.latch)
         return rearm
 
+    # ---- the resting end state (ballc.resting) ----
+
+    def rest_candidate(self):
+        """(plane, time of its next rest check) when the ball is in contact with the
+        resting plane alone, else (None, inf)."""
+        plane = resting.resting_plane(self.scene)
+        if plane is None or not self.in_contact[plane] or any(
+                self.in_contact[other] for other in PLANES if other != plane):
+            return None, math.inf
+        return plane, self.rest_check.get(plane, math.inf)
+
+    def check_rest(self, plane):
+        """At a rest check: True (and the rest state entered) when the contact with
+        ``plane`` is at rest (resting.at_rest), else schedule the next check."""
+        contact = self.open[plane]
+        if not resting.at_rest(self.scene, self.y, plane, contact.t_start, self.t,
+                               self.options.rtol, self.options.atol):
+            self.rest_check[plane] = resting.next_check(self.scene, contact.t_start, self.t)
+            return False
+        return self.enter_rest(plane)
+
+    def check_rolling(self, plane):
+        """At a rest check that found no rest: the uniform rolling state (a new state)
+        when the contact rolls uniformly (resting.rolls), else None."""
+        contact = self.open[plane]
+        speed = self.slip(plane, self.y)[1]
+        roll = resting.rolls(self.scene, self.y, plane, contact.t_start, self.t,
+                             self.options.rtol, self.options.atol, speed, self.params,
+                             self.latch, self.flags())
+        if roll is None:
+            return None
+        self.y = roll
+        contact.t_rolling = self.t
+        contact.transitions.append((self.t, "rolling"))
+        v = float(np.hypot(*roll[layout.VELOCITY][:2]))
+        self.message = (f"{SUCCESS} The ball rolls uniformly on the {plane} from t = "
+                        f"{self.t:.9g} s at {v:.6g} m/s (ballc.resting: no slip, static "
+                        f"Hertz equilibrium, penetration "
+                        f"{resting.equilibrium_penetration(self.scene):.6g} m); from there "
+                        "to t_end the state is that rolling, in closed form.")
+        return roll
+
+    def enter_rest(self, plane):
+        contact = self.open[plane]
+        self.y = resting.rest_state(self.scene, self.y, plane)
+        self.t_rest = contact.t_rest = self.t
+        contact.transitions.append((self.t, "rest"))
+        self.message = (f"{SUCCESS} The ball came to rest on the {plane} at t = {self.t:.9g} s "
+                        f"(ballc.resting: static Hertz equilibrium, penetration "
+                        f"{resting.equilibrium_penetration(self.scene):.6g} m); from there "
+                        "to t_end the state is that rest state.")
+        return True
+
     # ---- one event ----
 
     def handle(self, kind, plane):
@@ -283,7 +342,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
              atol: float = 1e-10, t_eval=None, max_step: float = np.inf,
              first_step: float | None = None, events=None, dense_output: bool = False,
              y0=None, progress: bool | None = None,
-             max_nfev: int | None = DEFAULT_MAX_NFEV, exact_flight: bool = True) -> Result:
+             max_nfev: int | None = DEFAULT_MAX_NFEV, exact_flight: bool = True,
+             rest: bool = True) -> Result:
     """Simulate ``scene`` from t = 0 to ``t_end`` (s), like ``scipy.integrate.solve_ivp``.
 
     Parameters
@@ -346,6 +406,16 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         right-hand-side call.  A segment with a user event that is not a
         ``ballc.events.LinearEvent`` is integrated as before.  False: every segment is
         integrated by ``method``.
+    rest : bool
+        True (default): a ball that has come to rest on the floor (the criterion of
+        ballc.resting: a contact lasting 20 small-oscillation periods, energy above
+        the static Hertz equilibrium below that of an oscillation of 10 tolerances)
+        is put in the rest state and the run finishes analytically: ``message`` says
+        when, and so does the contact's ``t_rest``; likewise a ball rolling uniformly
+        without slip at the equilibrium, when its rotation is exact (massless observer,
+        isotropic inertia), goes on in closed form (``t_rolling``).  Checked only
+        without ``t_eval`` and user ``events``.  False: integrate to t_end whatever
+        happens.
 
     Returns
     -------
@@ -378,6 +448,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     nfev = njev = nlu = 0
     first = options.first_step
     stiff_at = None
+    checks_rest = rest and t_eval is None and not user
 
     while run.t < t_end and run.status == 0:
         if bar is not None:
@@ -388,12 +459,14 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                                           run.params, run.latch, flags, run.clear_speed(),
                                           run.approach, run.rearm_approach)
         run.rearmed = []
+        rest_plane, t_stop = run.rest_candidate() if checks_rest else (None, math.inf)
+        t_stop = min(t_stop, t_end)   # a rest check ends the segment there
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
         remaining = None if options.max_nfev is None else max(options.max_nfev - nfev, 1)
         events = [event for _, _, event in driver_events] + users.for_segment()
-        sol = integrate_segment(system, run.t, t_end, run.y, events,
+        sol = integrate_segment(system, run.t, t_stop, run.y, events,
                                 method=options.method, rtol=options.rtol, atol=options.atol,
                                 t_eval=segment_eval, max_step=options.max_step,
                                 max_nfev=remaining, first_step=first,
@@ -443,8 +516,28 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             break
         if status == 0:
             if options.dense_output:
-                pieces.append((run.t, t_end, sol.interpolant))
-            run.t = t_end
+                pieces.append((run.t, t_stop, sol.interpolant))
+            run.t = t_stop
+            if t_stop < t_end:   # a rest check
+                run.y = np.array(sol["y"][:, -1])
+                if run.check_rest(rest_plane):
+                    samples.add(np.array([t_end]), run.y[:, None], flags, run.latch)
+                    if options.dense_output:
+                        pieces.append((run.t, t_end, resting.Constant(run.y)))
+                    run.t = t_end
+                    break
+                if run.check_rolling(rest_plane) is not None:
+                    rolling = FreeFlight(run.t, run.y, 0.0, t_max=t_end)
+                    times = resting.rolling_samples(run.t, t_end, rolling.rate)
+                    samples.add(times, rolling(times), flags, run.latch)
+                    if options.dense_output:
+                        pieces.append((run.t, t_end, rolling))
+                    run.y = samples.last_state.copy()
+                    run.t = t_end
+                    break
+                h_next = sol.get("h_next", 0)
+                first = min(h_next, options.max_step) if h_next > 0 else None
+                continue
             break
         if fired < 0:
             raise RuntimeError("the integrator stopped on a terminal event (status 1) but "

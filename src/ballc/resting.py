@@ -1,0 +1,251 @@
+"""The resting end state: a ball in persistent contact that has stopped moving.
+
+A bouncing ball whose bounces die out stays in contact with the floor, and its normal
+oscillation about the static Hertz equilibrium decays (Hunt-Crossley or viscoelastic
+damping).  Integrating that state to a long t_end costs steps for nothing.  The driver
+(ballc.simulate) checks, at times of a persistent contact, whether the ball is at rest
+by the criterion below, and if it is finishes the run analytically: the state is the
+static equilibrium from then on.
+
+**Criterion** (:func:`at_rest`), at a check time t, all of:
+
+1. the ball is in contact with the plane gravity presses it against (the floor, for
+   g > 0; a scene has g >= 0, so never the ceiling) and not with the other one;
+2. the contact has lasted at least REST_PERIODS periods of small normal oscillation
+   about the equilibrium, T0 = 2 pi / sqrt(k_lin / m_total), k_lin = 3/2 k0
+   rho_eq^(1/2) (:func:`oscillation_period`);
+3. the mechanical energy above the rest state (:func:`energy_above_rest`: kinetic
+   energy of ball and observer, spin about the normal included; Hertz spring plus
+   gravity above their minimum at rho_eq; the compliant law's tangential spring; the
+   observer's height above its lowest point) is at most the energy of an oscillation
+   of REST_FACTOR times the integration tolerance: min(1/2 k_lin dx^2, 1/2 m_total
+   dv^2), dx = REST_FACTOR (atol + rtol r), dv = REST_FACTOR (atol + rtol sqrt(g r))
+   (:func:`energy_threshold`).  The energy in contact does not increase (the contact
+   forces dissipate, gravity and the springs conserve), so the motion stays within
+   that bound for ever, and replacing it with the rest state changes the centre by
+   at most ~dx and its velocity by at most ~dv;
+4. a massive observer sits below the centre (a ball whose observer is above it is
+   in unstable equilibrium at best).
+
+**The rest state** (:func:`rest_state`): velocities and angular velocity zero, the
+centre at the static Hertz equilibrium rho_eq = (m_total g / k0)^(2/3)
+(:func:`equilibrium_penetration`), the orientation as it is, the tangential
+deflections zero, and the energy above it added to ``dissipated_normal`` so that the
+energy balance stays exact.
+
+**Not resting**: a ball that spins about the normal (the model has no torsional
+friction: the spin never decays, and its energy is counted in criterion 3), a ball
+rolling on the plane (no rolling resistance: it rolls for ever -- the seed scene
+does, at ~0.8 m/s, from t = 30.94 s), a ball rocked by an eccentric observer.
+
+**Uniform rolling** (:func:`rolls`): when the scene's free rotation is exact (massless
+observer, isotropic inertia), a rolling contact that has settled at the equilibrium
+is continued in closed form (see :func:`rolls` for the criterion).  With the seed's
+observer the rolling is not uniform, and is left to the integrator.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _core, layout
+
+#: A contact must have lasted this many small-oscillation periods before a rest check.
+REST_PERIODS = 20.0
+
+#: The rest state is at most this many integration tolerances from the true motion.
+REST_FACTOR = 10.0
+
+#: After a failed check at contact age a, the next is at age a + max(REST_PERIODS T0,
+#: CHECK_GROWTH a): a few dozen checks over any run, a detection at most 25 % late.
+CHECK_GROWTH = 0.25
+
+_STATE = layout.INDEX
+_Z, _VELOCITY, _ANGULAR = _STATE["z"], layout.VELOCITY, layout.ANGULAR_VELOCITY
+_DEFLECTION = layout.DEFLECTION
+
+
+def resting_plane(scene) -> str | None:
+    """The plane gravity presses the ball against ("floor"), or None (g = 0)."""
+    return "floor" if scene.gravity > 0 else None
+
+
+def total_mass(scene) -> float:
+    return scene.mass + scene.observer_mass
+
+
+def equilibrium_penetration(scene) -> float:
+    """rho_eq = (m_total g / k0)^(2/3) (m): the Hertz force k0 rho^(3/2) carries the weight."""
+    return (total_mass(scene) * scene.gravity / scene.hertz_stiffness) ** (2.0 / 3.0)
+
+
+def linear_stiffness(scene) -> float:
+    """d(k0 rho^(3/2))/d rho at rho_eq: 3/2 k0 rho_eq^(1/2) (N/m)."""
+    return 1.5 * scene.hertz_stiffness * math.sqrt(equilibrium_penetration(scene))
+
+
+def oscillation_period(scene) -> float:
+    """T0 = 2 pi sqrt(m_total / k_lin) (s), the undamped small normal oscillation."""
+    return 2 * math.pi * math.sqrt(total_mass(scene) / linear_stiffness(scene))
+
+
+def first_check(scene, t_start) -> float:
+    return t_start + REST_PERIODS * oscillation_period(scene)
+
+
+def next_check(scene, t_start, t) -> float:
+    return t + max(REST_PERIODS * oscillation_period(scene), CHECK_GROWTH * (t - t_start))
+
+
+def energy_threshold(scene, rtol, atol) -> float:
+    """The energy (J) of an oscillation of REST_FACTOR integration tolerances."""
+    largest_atol = float(np.max(atol))
+    dx = REST_FACTOR * (largest_atol + rtol * scene.radius)
+    dv = REST_FACTOR * (largest_atol + rtol * math.sqrt(scene.gravity * scene.radius))
+    return min(0.5 * linear_stiffness(scene) * dx * dx, 0.5 * total_mass(scene) * dv * dv)
+
+
+def _observer_offset(scene, y):
+    """(horizontal, vertical) offset (m) of the observer from the centre."""
+    params = scene.parameter_vector()
+    where = _core.observer_positions(np.ascontiguousarray(y[None, :]), params)[0]
+    d = where - y[layout.rows("x", 3)]
+    return math.hypot(d[0], d[1]), float(d[2])
+
+
+def energy_above_rest(scene, y, plane="floor") -> float:
+    """The mechanical energy (J) of state y above the rest state on ``plane``, each
+    term computed without cancellation (see the module docstring)."""
+    e = _core.energies(np.ascontiguousarray(y[None, :]), scene.parameter_vector())[0]
+    kinetic, tangential_spring = float(e[0]), float(e[4] + e[5])
+    rho_eq = equilibrium_penetration(scene)
+    rho = scene.radius - y[_Z]
+    x = (rho - rho_eq) / rho_eq
+    weight = total_mass(scene) * scene.gravity
+    # (2/5) k0 (rho^(5/2) - rho_eq^(5/2)) - m g (rho - rho_eq), k0 rho_eq^(3/2) = m g
+    normal = weight * rho_eq * (0.4 * math.expm1(2.5 * math.log1p(x)) - x) if x > -1 else \
+        math.inf
+    observer = 0.0
+    if scene.observer_mass > 0:
+        across, up = _observer_offset(scene, y)
+        reach = math.hypot(across, up)
+        observer = scene.observer_mass * scene.gravity * across * across / (
+            reach + abs(up)) if reach > 0 else 0.0
+    return kinetic + max(normal, 0.0) + tangential_spring + observer
+
+
+def at_rest(scene, y, plane, t_start, t, rtol, atol) -> bool:
+    """Whether the contact with ``plane`` (since ``t_start``) has come to rest at state
+    y and time t (criteria 2-4 of the module docstring; the caller checks 1)."""
+    if plane != resting_plane(scene) or t - t_start < REST_PERIODS * oscillation_period(scene):
+        return False
+    if scene.observer_mass > 0 and _observer_offset(scene, y)[1] >= 0:
+        return False
+    return energy_above_rest(scene, y, plane) <= energy_threshold(scene, rtol, atol)
+
+
+def rest_state(scene, y, plane="floor"):
+    """The rest state for state y (see the module docstring): a new array."""
+    rest = np.array(y, dtype=float)
+    rest[_VELOCITY] = 0.0
+    rest[_ANGULAR] = 0.0
+    rest[_Z] = scene.radius - equilibrium_penetration(scene)
+    rest[_DEFLECTION["floor"]] = 0.0
+    rest[_DEFLECTION["ceiling"]] = 0.0
+    return _booked(scene, y, rest)
+
+
+def _booked(scene, y, new):
+    """``new`` with the mechanical energy y has above it added to dissipated_normal."""
+    both = _core.energies(np.ascontiguousarray(np.stack([y, new])), scene.parameter_vector())
+    before, after = (float(row[0] + row[1] + row[2] + row[3] + row[4] + row[5])
+                     for row in both)
+    new[_STATE["dissipated_normal"]] += before - after
+    return new
+
+
+# ---- uniform rolling ----
+
+#: At most this many samples of a closed-form rolling stretch (sol(t) is exact anywhere).
+MAX_ROLL_SAMPLES = 4096
+
+
+def rolling_state(scene, y):
+    """The uniform rolling state for y: the centre at the static equilibrium, vz = 0,
+    tangential deflections zero, the rest as it is; energy booked (see rest_state)."""
+    roll = np.array(y, dtype=float)
+    roll[_Z] = scene.radius - equilibrium_penetration(scene)
+    roll[_STATE["vz"]] = 0.0
+    roll[_DEFLECTION["floor"]] = 0.0
+    roll[_DEFLECTION["ceiling"]] = 0.0
+    return _booked(scene, y, roll)
+
+
+def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, flags):
+    """The uniform rolling state when the contact with ``plane`` (since ``t_start``)
+    rolls uniformly at state y and time t, else None.
+
+    Criterion: the scene has an exact free rotation (ballc.flight.scene_allows:
+    massless observer, isotropic inertia); the contact has lasted REST_PERIODS T0;
+    the slip speed ``slip_speed`` is at most REST_FACTOR dv; the energy above the
+    rolling state (vertical kinetic energy, Hertz spring plus gravity above rho_eq,
+    tangential spring) is below :func:`energy_threshold`; and the rolling state is a
+    steady state of the segment's equations (flags, latch): its accelerations, linear
+    and angular (times r), and the deflection rates are at rounding level
+    (1e3 eps g).  Then the motion is the exact uniform rolling: v and omega constant,
+    the centre on a straight line at z_eq, the orientation turning at omega
+    (ballc.flight.FreeFlight with g = 0)."""
+    from . import flight
+    if plane != resting_plane(scene) or t - t_start < REST_PERIODS * oscillation_period(scene):
+        return None
+    if not flight.scene_allows(params):
+        return None
+    largest_atol = float(np.max(atol))
+    dv = REST_FACTOR * (largest_atol + rtol * math.sqrt(scene.gravity * scene.radius))
+    if not slip_speed <= dv:
+        return None
+    e = _core.energies(np.ascontiguousarray(y[None, :]), params)[0]
+    rho_eq = equilibrium_penetration(scene)
+    x = (scene.radius - y[_Z] - rho_eq) / rho_eq
+    if not x > -1:
+        return None
+    weight = total_mass(scene) * scene.gravity
+    above = (0.5 * total_mass(scene) * y[_STATE["vz"]] ** 2 + float(e[4] + e[5])
+             + max(weight * rho_eq * (0.4 * math.expm1(2.5 * math.log1p(x)) - x), 0.0))
+    if not above <= energy_threshold(scene, rtol, atol):
+        return None
+    roll = rolling_state(scene, y)
+    rate = _core.rhs(np.ascontiguousarray(roll), np.ascontiguousarray(params, dtype=float),
+                     np.ascontiguousarray(latch, dtype=float), int(flags))
+    level = 1e3 * np.finfo(float).eps * scene.gravity
+    if (np.max(np.abs(rate[_VELOCITY])) > level
+            or scene.radius * np.max(np.abs(rate[_ANGULAR])) > level
+            or np.max(np.abs(rate[_DEFLECTION["floor"]])) > level
+            or np.max(np.abs(rate[_DEFLECTION["ceiling"]])) > level):
+        return None
+    return roll
+
+
+def rolling_samples(t0, t1, rate):
+    """Sample times of a closed-form rolling stretch after t0 up to t1: the turn at most
+    ballc.flight.MAX_TURN per interval, at least 32 and at most MAX_ROLL_SAMPLES."""
+    from . import flight
+    n = min(MAX_ROLL_SAMPLES, max(flight.MIN_INTERVALS,
+                                  math.ceil(rate * (t1 - t0) / flight.MAX_TURN)))
+    t = t0 + (t1 - t0) * np.arange(1, n + 1) / n
+    t[-1] = t1
+    return t
+
+
+class Constant:
+    """The dense output of the rest state: y(t) = y_rest."""
+
+    def __init__(self, y):
+        self.y = np.array(y, dtype=float)
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        if t.ndim == 0:
+            return self.y.copy()
+        return np.repeat(self.y[:, None], t.size, axis=1)
