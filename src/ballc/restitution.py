@@ -85,6 +85,15 @@ def _number(name, value, allowed):
         raise ValueError(message) from None
 
 
+def _restitution_input(e, parameter):
+    """e as a float in (0, 1], or ValueError naming it (e -> 0 needs ``parameter`` -> inf)."""
+    v = _number("restitution", e, "(0, 1]")
+    if not 0.0 < v <= 1.0:
+        raise ValueError(f"restitution = {e!r} is not allowed: must be a number in (0, 1] "
+                         f"(e -> 0 would need {parameter} -> infinity)")
+    return v
+
+
 def hunt_crossley_restitution_of_chi(chi: float) -> float:
     """Restitution e (1) of one Hunt-Crossley impact with damping factor ``chi`` (1).
 
@@ -161,10 +170,7 @@ def hunt_crossley_chi_for_restitution(e: float) -> float:
     float
         chi >= 0 (dimensionless).
     """
-    v = _number("restitution", e, "(0, 1]")
-    if not 0.0 < v <= 1.0:
-        raise ValueError(f"restitution = {e!r} is not allowed: must be a number in (0, 1] "
-                         "(e -> 0 would need chi -> infinity)")
+    v = _restitution_input(e, "chi")
     d = 1.0 - v
     if d < _SERIES_LIMIT:
         return _poly(_CHI_SERIES, d)
@@ -375,10 +381,7 @@ def viscoelastic_gamma_for_restitution(e: float) -> float:
     float
         gamma >= 0 (dimensionless).
     """
-    v = _number("restitution", e, "(0, 1]")
-    if not 0.0 < v <= 1.0:
-        raise ValueError(f"restitution = {e!r} is not allowed: must be a number in (0, 1] "
-                         "(e -> 0 would need gamma -> infinity)")
+    v = _restitution_input(e, "gamma")
     return _viscoelastic_gamma(v)
 
 
