@@ -15,10 +15,10 @@ from setuptools.command.build_ext import build_ext
 core = Extension(
     "ballc._core",
     sources=["src/ballc/_core.pyx", "src/ballc/_system.c", "generated/ballc_kernels.c",
-             "src/ballc/_radau5_solver.c", "src/ballc/_dop853.c", "src/ballc/_lu.c"],
+             "src/ballc/_integrator.c", "src/ballc/_dop853.c", "src/ballc/_lu.c"],
     include_dirs=["generated", "src/ballc"],
     depends=["src/ballc/_radau5_bridge.pxi", "src/ballc/_system.h", "src/ballc/_lu.h",
-             "src/ballc/_radau5_solver.h", "src/ballc/_dop853.h",
+             "src/ballc/_integrator.h", "src/ballc/_dop853.h",
              "generated/ballc_kernels.h"],
     # -fno-math-errno: sqrt never sets errno, so it is one instruction and repeated
     # calls in the generated kernels are shared (the results are the same bits).

@@ -28,7 +28,7 @@ cdef extern from "_lu.h":
     void ballc_lu_solve_complex(int, const double complex *, const int *,
                                 double complex *) nogil
 
-cdef extern from "_radau5_solver.h":
+cdef extern from "_integrator.h":
     ctypedef int (*radau5_fun)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_jac)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_event_fun)(void *, int, double, const double *, double *) noexcept nogil
@@ -351,7 +351,7 @@ def _event_arrays(events, int n):
     return m, coef, reals, ints, users, rearms
 
 
-cdef extern from "_radau5_solver.h":
+cdef extern from "_integrator.h":
     enum:
         RADAU5_CTRL_NIT7, RADAU5_CTRL_LIMITS, RADAU5_CTRL_PRED, RADAU5_CTRL_HOLD
         RADAU5_CTRL_JAC, RADAU5_CTRL_TOL, RADAU5_CTRL_SCALE, RADAU5_CTRL_HAIRER
@@ -697,7 +697,7 @@ def _lu_solve(A, b):
     return x
 
 
-cdef extern from "_radau5_solver.h":
+cdef extern from "_integrator.h":
     int RADAU5_N_CONSTANTS
     void radau5_constants(double *out)
 

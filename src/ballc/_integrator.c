@@ -1,4 +1,4 @@
-/* See _radau5_solver.h.  A line-by-line port of scipy.integrate.Radau (scipy 1.17,
+/* See _integrator.h.  A line-by-line port of scipy.integrate.Radau (scipy 1.17,
  * scipy/integrate/_ivp/radau.py) and of solve_ivp's event and output logic
  * (scipy/integrate/_ivp/ivp.py), for dense Jacobians and linear events.
  * Comments name the scipy function each part mirrors. */
@@ -13,7 +13,7 @@
 
 #include "_dop853.h"
 #include "_lu.h"
-#include "_radau5_solver.h"
+#include "_integrator.h"
 
 #define NEWTON_MAXITER 6   /* Maximum number of Newton iterations. */
 #define MIN_FACTOR 0.2     /* Minimum allowed decrease in a step size. */
