@@ -1,6 +1,6 @@
-/* See _integrator.h.  A line-by-line port of scipy.integrate.Radau (scipy 1.17,
- * scipy/integrate/_ivp/radau.py) and of solve_ivp's event and output logic
- * (scipy/integrate/_ivp/ivp.py), for dense Jacobians and linear events.
+/* See _integrator.h.  A port of solve_ivp's loop, event and output logic
+ * (scipy/integrate/_ivp/ivp.py, scipy 1.17) around the methods' steps (Radau IIA:
+ * _radau_iia.c; DOP853: _dop853.c), for linear events and events the system evaluates.
  * Comments name the scipy function each part mirrors. */
 #ifdef RADAU5_PROFILE
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
@@ -10,700 +10,29 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "_dop853.h"
-#include "_lu.h"
-#include "_integrator.h"
-
-#define NEWTON_MAXITER 6   /* Maximum number of Newton iterations. */
-#define MIN_FACTOR 0.2     /* Minimum allowed decrease in a step size. */
-#define MAX_FACTOR 10.0    /* Maximum allowed increase in a step size. */
-#define EPS DBL_EPSILON
-
-/* Compiled with -DRADAU5_PROFILE (benchmarks/profile_step.py): time-stamp-counter
- * ticks of the right-hand side, Jacobian (with partition), factorisations and
- * solves, and of the whole radau5_solve, in result->prof.  Otherwise no-ops. */
 #ifdef RADAU5_PROFILE
 #include <time.h>
-#include <x86intrin.h>
-static __thread double *prof_acc;
-#define PROF_START unsigned long long prof_t0_ = __rdtsc()
-#define PROF_STOP(k) (prof_acc[k] += (double)(__rdtsc() - prof_t0_))
-#else
-#define PROF_START (void)0
-#define PROF_STOP(k) (void)0
 #endif
 
-typedef double _Complex cplx;
+#include "_integrator_private.h"
 
-/* radau.py module constants (computed as scipy computes them). */
-typedef struct {
-    double C[3], E[3], T[3][3], TI[3][3], P[3][3];
-    double mu_real;
-    cplx mu_complex, ti_complex[3];
-} constants_t;
+#ifdef RADAU5_PROFILE
+__thread double *ballc_prof_acc;   /* see _integrator_private.h */
+#endif
 
-static void init_constants(constants_t *k)
-{
-    const double S6 = sqrt(6.0);
-    k->C[0] = (4 - S6) / 10; k->C[1] = (4 + S6) / 10; k->C[2] = 1;
-    k->E[0] = (-13 - 7 * S6) / 3; k->E[1] = (-13 + 7 * S6) / 3; k->E[2] = -1.0 / 3;
-    k->mu_real = 3 + pow(3, 2.0 / 3) - pow(3, 1.0 / 3);
-    k->mu_complex = (3 + 0.5 * (pow(3, 1.0 / 3) - pow(3, 2.0 / 3)))
-                    - 0.5 * I * (pow(3, 5.0 / 6) + pow(3, 7.0 / 6));
-    const double T[3][3] = {
-        {0.09443876248897524, -0.14125529502095421, 0.03002919410514742},
-        {0.25021312296533332, 0.20412935229379994, -0.38294211275726192},
-        {1, 1, 0}};
-    const double TI[3][3] = {
-        {4.17871859155190428, 0.32768282076106237, 0.52337644549944951},
-        {-4.17871859155190428, -0.32768282076106237, 0.47662355450055044},
-        {0.50287263494578682, -2.57192694985560522, 0.59603920482822492}};
-    const double P[3][3] = {
-        {13.0 / 3 + 7 * S6 / 3, -23.0 / 3 - 22 * S6 / 3, 10.0 / 3 + 5 * S6},
-        {13.0 / 3 - 7 * S6 / 3, -23.0 / 3 + 22 * S6 / 3, 10.0 / 3 - 5 * S6},
-        {1.0 / 3, -8.0 / 3, 10.0 / 3}};
-    memcpy(k->T, T, sizeof T);
-    memcpy(k->TI, TI, sizeof TI);
-    memcpy(k->P, P, sizeof P);
-    for (int j = 0; j < 3; j++) k->ti_complex[j] = TI[1][j] + I * TI[2][j];
-}
-
-/* Everything the integration carries from step to step. */
-typedef struct {
-    const radau5_problem *p;
-    radau5_result *r;
-    constants_t k;
-    int n;
-    double direction, newton_tol;
-    /* step control (radau5_problem.controller): the tolerances in use (transformed with
-     * RADAU5_CTRL_TOL), the Newton iteration cap, and Hairer's predictive-controller
-     * memory (h and error of the last accepted step) */
-    int ctrl, newton_maxiter;
-    double rtol, *atol;
-    double h_acc, err_acc;
-    int have_acc;
-    /* solver state (Radau attributes) */
-    double t, t_old, h_abs, h_abs_old, error_norm_old;
-    double t_bound;                       /* where steps stop: p->t_bound, or an event's
-                                           * time while stepping to it (step_to_event) */
-    double dense_end;                     /* the end of the step the interpolant Q covers */
-    long i_eval;                          /* the next of p->t_eval to store */
-    double jac_t;                         /* where J was evaluated */
-    int have_h_abs_old, have_error_norm_old, have_sol, current_jac, lu_valid;
-    double *y, *f, *y_old, *J, *Z, *Q;      /* Z, Q: of the last accepted step */
-    double *LU_real; int *piv_real;       /* nc x nc: the coupled block (see partition) */
-    cplx *LU_complex; int *piv_complex;
-    /* Structure of J (partition): the coupled states (columns of J with a nonzero entry)
-     * and the outputs (zero columns: nothing depends on them).  Ordered [coupled,
-     * outputs], M = mu/h I - J is lower block-triangular, [[M_cc, 0], [-J_oc, mu/h I]]:
-     * only M_cc is factored; the outputs follow by substitution. */
-    int nc, no, *cidx, *oidx;
-    double *Joc;                          /* J_oc's nonzeros, row by row (CSR) */
-    int *joc_col, *joc_start;             /* their coupled column; row o: [start[o], start[o+1]) */
-    double lu_mr; cplx lu_mc;             /* mu_real / h, mu_complex / h of the factors */
-    double *xc; cplx *xcc;                /* nc: gathered right-hand sides */
-    double *inv_scale;                    /* 1 / scale of the step start (Newton norm) */
-    /* scratch */
-    double *y_new, *f_new, *scale, *Z0, *Znew, *W, *F, *dW, *tmp, *err, *ZE;
-    cplx *ctmp;
-    /* DOP853 (problem.method): the stages of the last step (DOP853_STAGES_EXTENDED x n),
-     * its dense output's terms (DOP853_DENSE_TERMS x n) once computed (dense_ready) */
-    int dop853, dense_ready, k_stale;     /* k_stale: K was overwritten by attempts that
-                                           * were not accepted (a failed step) */
-    double *K, *Fdense;
-    int stiff_steps, nonstiff_steps;      /* Hairer's stiffness test (step_dop853) */
-    /* events */
-    double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */
-    int *active;
-    int *ev_count;                      /* occurrences of each event in this call */
-    size_t cap_out, cap_hits, cap_dense;
-} solver_t;
-
-/* common.norm: RMS norm (two partial sums: half the chain of dependent additions). */
-static double rms(const double *x, int n)
-{
-    double s0 = 0, s1 = 0;
-    int i = 0;
-    for (; i + 1 < n; i += 2) {
-        s0 += x[i] * x[i];
-        s1 += x[i + 1] * x[i + 1];
-    }
-    if (i < n) s0 += x[i] * x[i];
-    return sqrt((s0 + s1) / n);
-}
-
-static int call_fun(solver_t *s, double t, const double *y, double *f)
-{
-    PROF_START;
-    s->r->nfev++;
-    int rc = s->p->fun(s->p->ctx, t, y, f);
-    if (!s->p->outputs_checked) {
-        double finite = 0.0;   /* x - x: 0 for a finite x, NaN otherwise; no branch per entry */
-        for (int i = 0; i < s->n; i++) finite += f[i] - f[i];
-        if (finite != 0.0) rc = -1;
-    }
-    PROF_STOP(RADAU5_PROF_FUN);
-    return rc == 0 ? 0 : -1;
-}
-
-/* Split the states into coupled ones (a nonzero entry in their column of J) and
- * outputs (a zero column), and gather J_oc.  The split is exact for this J: the
- * Newton matrix built from it is block-triangular, whatever made the column zero. */
-static void partition(solver_t *s)
-{
-    const int n = s->n;
-    s->nc = s->no = 0;
-    for (int j = 0; j < n; j++) {
-        int zero = 1;
-        for (int i = 0; i < n && zero; i++) zero = s->J[i * n + j] == 0.0;
-        if (zero) s->oidx[s->no++] = j;
-        else s->cidx[s->nc++] = j;
-    }
-    int k = 0;   /* J_oc is sparse (x, y: one velocity each; idle deflections: none) */
-    for (int a = 0; a < s->no; a++) {
-        s->joc_start[a] = k;
-        for (int b = 0; b < s->nc; b++) {
-            double v = s->J[s->oidx[a] * n + s->cidx[b]];
-            if (v != 0.0) {
-                s->Joc[k] = v;
-                s->joc_col[k++] = b;
-            }
-        }
-    }
-    s->joc_start[s->no] = k;
-}
-
-static int call_jac(solver_t *s, double t, const double *y)
-{
-    PROF_START;
-    s->r->njev++;
-    s->jac_t = t;
-    int rc = s->p->jac(s->p->ctx, t, y, s->J);
-    for (int i = 0; i < s->n * s->n && rc == 0 && !s->p->outputs_checked; i++)
-        if (!isfinite(s->J[i])) rc = -1;
-    if (rc == 0) partition(s);
-    PROF_STOP(RADAU5_PROF_JAC);
-    return rc == 0 ? 0 : -1;
-}
-
-/* LU of the coupled block of MU_REAL / h I - J and MU_COMPLEX / h I - J (row-major,
- * as J; see _lu.h and partition). */
-static int factor(solver_t *s, double h)
-{
-    PROF_START;
-    const int n = s->n, nc = s->nc;
-    double mr = s->k.mu_real / h;
-    cplx mc = s->k.mu_complex / h;
-    for (int a = 0; a < nc; a++)
-        for (int b = 0; b < nc; b++) {
-            double v = -s->J[s->cidx[a] * n + s->cidx[b]];
-            s->LU_real[a * nc + b] = v + (a == b ? mr : 0.0);
-            s->LU_complex[a * nc + b] = v + (a == b ? mc : 0.0);
-        }
-    s->lu_mr = mr;
-    s->lu_mc = mc;
-    int info_r = ballc_lu_factor(nc, s->LU_real, s->piv_real);
-    int info_c = ballc_lu_factor_complex(nc, s->LU_complex, s->piv_complex);
-    s->r->nlu += 2;
-    s->lu_valid = 1;
-    PROF_STOP(RADAU5_PROF_FACTOR);
-    return (info_r == BALLC_LU_OK && info_c == BALLC_LU_OK) ? 0 : -1;
-}
-
-/* (mu/h I - J) x = b, b (n) overwritten by x: the coupled block by LU, then each
- * output o from its row, mu/h x_o - J_oc x_c = b_o. */
-static void solve_real(solver_t *s, double *b)
-{
-    PROF_START;
-    const int nc = s->nc, no = s->no;
-    if (no == 0) {
-        ballc_lu_solve(nc, s->LU_real, s->piv_real, b);
-    } else {
-        double *x = s->xc;
-        for (int a = 0; a < nc; a++) x[a] = b[s->cidx[a]];
-        ballc_lu_solve(nc, s->LU_real, s->piv_real, x);
-        for (int a = 0; a < nc; a++) b[s->cidx[a]] = x[a];
-        for (int o = 0; o < no; o++) {
-            double v = b[s->oidx[o]];
-            for (int q = s->joc_start[o]; q < s->joc_start[o + 1]; q++)
-                v += s->Joc[q] * x[s->joc_col[q]];
-            b[s->oidx[o]] = v / s->lu_mr;
-        }
-    }
-    PROF_STOP(RADAU5_PROF_SOLVE);
-}
-
-static void solve_complex(solver_t *s, cplx *b)
-{
-    PROF_START;
-    const int nc = s->nc, no = s->no;
-    if (no == 0) {
-        ballc_lu_solve_complex(nc, s->LU_complex, s->piv_complex, b);
-    } else {
-        cplx *x = s->xcc;
-        for (int a = 0; a < nc; a++) x[a] = b[s->cidx[a]];
-        ballc_lu_solve_complex(nc, s->LU_complex, s->piv_complex, x);
-        for (int a = 0; a < nc; a++) b[s->cidx[a]] = x[a];
-        cplx inverse = 1.0 / s->lu_mc;
-        for (int o = 0; o < no; o++) {
-            cplx v = b[s->oidx[o]];
-            for (int q = s->joc_start[o]; q < s->joc_start[o + 1]; q++)
-                v += s->Joc[q] * x[s->joc_col[q]];
-            b[s->oidx[o]] = v * inverse;
-        }
-    }
-    PROF_STOP(RADAU5_PROF_SOLVE);
-}
-
-/* radau.solve_collocation_system: Z (3 x n) starts as Z0 and ends as the solution. */
-static int solve_collocation(solver_t *s, double t, double h, double *restrict Z,
-                             int *n_iter, double *rate_out, int *have_rate_out,
-                             double *theta_out)
-{
-    const int maxiter = s->newton_maxiter;
-    const constants_t *k = &s->k;
-    const int n = s->n;
-    double M_real = k->mu_real / h;
-    cplx M_complex = k->mu_complex / h;
-    /* distinct buffers: restrict lets the compiler vectorise the stage loops */
-    double *restrict W = s->W, *restrict F = s->F, *restrict dW = s->dW, *restrict yi = s->tmp;
-    const double *restrict inv_scale = s->inv_scale;
-    cplx *restrict fc = s->ctmp;
-    /* the transformation matrices as locals: the stage loops below then keep them in
-     * registers (through k the compiler reloads them for every element) */
-    const double T00 = k->T[0][0], T01 = k->T[0][1], T02 = k->T[0][2],
-                 T10 = k->T[1][0], T11 = k->T[1][1], T12 = k->T[1][2],
-                 T20 = k->T[2][0], T21 = k->T[2][1], T22 = k->T[2][2];
-    const double Ti00 = k->TI[0][0], Ti01 = k->TI[0][1], Ti02 = k->TI[0][2],
-                 Ti10 = k->TI[1][0], Ti11 = k->TI[1][1], Ti12 = k->TI[1][2],
-                 Ti20 = k->TI[2][0], Ti21 = k->TI[2][1], Ti22 = k->TI[2][2];
-    for (int c = 0; c < n; c++) {
-        double z0 = Z[c], z1 = Z[n + c], z2 = Z[2 * n + c];
-        W[c] = Ti00 * z0 + Ti01 * z1 + Ti02 * z2;
-        W[n + c] = Ti10 * z0 + Ti11 * z1 + Ti12 * z2;
-        W[2 * n + c] = Ti20 * z0 + Ti21 * z1 + Ti22 * z2;
-    }
-    const cplx tc0 = k->ti_complex[0], tc1 = k->ti_complex[1], tc2 = k->ti_complex[2];
-    double dW_norm_old = 0, rate = 0, theta = 0, rate_prev = 0;
-    int have_old = 0, have_rate = 0, converged = 0, it;
-    for (it = 0; it < maxiter; it++) {
-        int finite = 1;
-        for (int i = 0; i < 3 && finite; i++) {
-            for (int c = 0; c < n; c++) yi[c] = s->y[c] + Z[i * n + c];
-            if (call_fun(s, t + h * k->C[i], yi, F + i * n) != 0) finite = 0;
-        }
-        if (!finite) break;
-        for (int c = 0; c < n; c++) {
-            double f0 = F[c], f1 = F[n + c], f2 = F[2 * n + c];
-            dW[c] = f0 * Ti00 + f1 * Ti01 + f2 * Ti02 - M_real * W[c];
-            fc[c] = f0 * tc0 + f1 * tc1 + f2 * tc2 - M_complex * (W[n + c] + I * W[2 * n + c]);
-        }
-        solve_real(s, dW);
-        solve_complex(s, fc);
-        double sum0 = 0, sum1 = 0, sum2 = 0;   /* one partial sum per stage: three short
-                                                * chains of dependent additions, not one */
-        for (int c = 0; c < n; c++) {
-            double v0 = dW[c] * inv_scale[c], v1 = creal(fc[c]), v2 = cimag(fc[c]);
-            dW[n + c] = v1;
-            dW[2 * n + c] = v2;
-            v1 *= inv_scale[c];
-            v2 *= inv_scale[c];
-            sum0 += v0 * v0;
-            sum1 += v1 * v1;
-            sum2 += v2 * v2;
-        }
-        double dW_norm = sqrt((sum0 + sum1 + sum2) / (3 * n));
-        if (!isfinite(dW_norm)) break;
-        if (have_old) {
-            rate = dW_norm / dW_norm_old;
-            /* RADAU5's theta: the first ratio, then the geometric mean of the last two */
-            theta = have_rate ? sqrt(rate * rate_prev) : rate;
-            rate_prev = rate;
-            have_rate = 1;
-        }
-        if (have_rate && (rate >= 1 ||
-                          pow(rate, maxiter - it) / (1 - rate) * dW_norm > s->newton_tol))
-            break;
-        for (int i = 0; i < 3 * n; i++) W[i] += dW[i];
-        for (int c = 0; c < n; c++) {
-            double w0 = W[c], w1 = W[n + c], w2 = W[2 * n + c];
-            Z[c] = T00 * w0 + T01 * w1 + T02 * w2;
-            Z[n + c] = T10 * w0 + T11 * w1 + T12 * w2;
-            Z[2 * n + c] = T20 * w0 + T21 * w1 + T22 * w2;
-        }
-        if (dW_norm == 0 || (have_rate && rate / (1 - rate) * dW_norm < s->newton_tol)) {
-            converged = 1;
-            break;
-        }
-        dW_norm_old = dW_norm;
-        have_old = 1;
-    }
-    *n_iter = (it < maxiter ? it : maxiter - 1) + 1;
-    *rate_out = rate;
-    *have_rate_out = have_rate;
-    *theta_out = theta;
-    return converged;
-}
-
-/* radau.predict_factor */
-static double predict_factor(double h_abs, double h_abs_old, int have_h_abs_old,
-                             double error_norm, double error_norm_old, int have_error_norm_old)
-{
-    double multiplier;
-    if (!have_error_norm_old || !have_h_abs_old || error_norm == 0)
-        multiplier = 1;
-    else
-        multiplier = h_abs / h_abs_old * pow(error_norm_old / error_norm, 0.25);
-    return fmin(1, multiplier) * pow(error_norm, -0.25);   /* inf when error_norm == 0 */
-}
-
-/* The last accepted step's dense output terms, r->dense_terms rows of n: Radau's Q
- * (x, x^2, x^3), or DOP853's F (once prepare_dense has computed them). */
-static const double *dense_terms(const solver_t *s)
-{
-    return s->dop853 ? s->Fdense : s->Q;
-}
-
-/* RadauDenseOutput (or Dop853DenseOutput: its terms computed by prepare_dense) of the
- * last accepted step at time tt. */
-static void dense(const solver_t *s, double tt, double *out)
-{
-    const int n = s->n;
-    double x = (tt - s->t_old) / (s->dense_end - s->t_old);
-    if (s->dop853) {
-        dop853_eval(n, x, s->y_old, s->Fdense, out);
-        return;
-    }
-    double p1 = x, p2 = x * x, p3 = x * x * x;
-    for (int c = 0; c < n; c++)
-        out[c] = s->y_old[c] + s->Q[c] * p1 + s->Q[n + c] * p2 + s->Q[2 * n + c] * p3;
-}
-
-/* The next attempt's step from t: *h_abs in the direction of integration, cut at
- * t_bound; sets *h and *t_new, and *h_abs to the cut size.  Returns 0 (message set)
- * when *h_abs is below min_step (as scipy's solvers). */
-static int attempt_size(solver_t *s, double t, double min_step, double *h_abs, double *h,
-                        double *t_new)
-{
-    if (*h_abs < min_step) {
-        snprintf(s->r->message, sizeof s->r->message,
-                 "Required step size is less than spacing between numbers.");
-        return 0;
-    }
-    *h = *h_abs * s->direction;
-    *t_new = t + *h;
-    if (s->direction * (*t_new - s->t_bound) > 0) *t_new = s->t_bound;
-    *h = *t_new - t;
-    *h_abs = fabs(*h);
-    return 1;
-}
-
-/* Radau._step_impl.  Returns 1 on success, 0 on failure (message set). */
-static int step_radau(solver_t *s)
-{
-    const radau5_problem *p = s->p;
-    const constants_t *k = &s->k;
-    const int n = s->n;
-    const double t = s->t;
-    double *y = s->y;
-
-    double min_step = 10 * fabs(nextafter(t, s->direction * INFINITY) - t);
-    double h_abs, h_abs_old = 0, error_norm_old = 0;
-    int have_h_abs_old = 0, have_error_norm_old = 0;
-    if (s->h_abs > p->max_step) {
-        h_abs = p->max_step;
-    } else if (s->h_abs < min_step) {
-        h_abs = min_step;
-    } else {
-        h_abs = s->h_abs;
-        h_abs_old = s->h_abs_old; have_h_abs_old = s->have_h_abs_old;
-        error_norm_old = s->error_norm_old; have_error_norm_old = s->have_error_norm_old;
-    }
-
-    const int ctrl = s->ctrl;
-    int rejected = 0, converged = 0, n_iter = 0, have_rate = 0;
-    double rate = 0, theta = 0, h = 0, t_new = t, error_norm = 0, safety = 0;
-    double *Z = s->Znew, *y_new = s->y_new, *err = s->err, *ZE = s->ZE;
-    for (;;) {   /* while not step_accepted */
-        if (!attempt_size(s, t, min_step, &h_abs, &h, &t_new)) return 0;
-
-        if (!s->have_sol) {
-            memset(s->Z0, 0, 3 * n * sizeof(double));
-        } else {
-            for (int i = 0; i < 3; i++) {
-                dense(s, t + h * k->C[i], s->Z0 + i * n);
-                for (int c = 0; c < n; c++) s->Z0[i * n + c] -= y[c];
-            }
-        }
-        for (int c = 0; c < n; c++) {
-            s->scale[c] = s->atol[c] + fabs(y[c]) * s->rtol;
-            s->inv_scale[c] = 1.0 / s->scale[c];
-        }
-
-        converged = 0;
-        int tried_ahead = 0;
-        while (!converged) {
-            int lu_ok = 1;
-            if (!s->lu_valid) lu_ok = factor(s, h) == 0;
-            memcpy(Z, s->Z0, 3 * n * sizeof(double));
-            converged = lu_ok && solve_collocation(s, t, h, Z, &n_iter, &rate, &have_rate,
-                                                  &theta);
-            if (!lu_ok) n_iter = 0;
-            if (!converged) {
-                /* The first step of a segment whose Newton fails with the Jacobian of its
-                 * start: try once more with the Jacobian at the explicit Euler prediction
-                 * of the step's end.  A contact law can be singular where a segment starts
-                 * (the compliant law's yield: stiffness ~ n/t from contact start), where
-                 * the start's Jacobian holds none of the stiffness every later point has;
-                 * halving h then never helps.  Only where the caller asks (problem
-                 * jacobian_ahead: segments with a compliant contact). */
-                if (s->p->jacobian_ahead && s->current_jac && !s->have_sol && !tried_ahead
-                    && h != 0) {
-                    tried_ahead = 1;
-                    for (int c = 0; c < n; c++) err[c] = y[c] + h * s->f[c];
-                    if (call_jac(s, t + h, err) == 0) {
-                        s->lu_valid = 0;
-                        continue;
-                    }
-                    if (call_jac(s, t, y) != 0) {
-                        snprintf(s->r->message, sizeof s->r->message,
-                                 "the Jacobian cannot be evaluated at t = %.17g", t);
-                        return 0;
-                    }
-                    s->lu_valid = 0;
-                }
-                if (s->current_jac) break;
-                if (call_jac(s, t, y) != 0) {
-                    snprintf(s->r->message, sizeof s->r->message,
-                             "the Jacobian cannot be evaluated at t = %.17g", t);
-                    return 0;
-                }
-                s->current_jac = 1;
-                s->lu_valid = 0;
-            }
-        }
-        if (!converged) {
-            h_abs *= 0.5;
-            s->lu_valid = 0;
-            continue;
-        }
-
-        const double E0 = k->E[0] / h, E1 = k->E[1] / h, E2 = k->E[2] / h;
-        for (int c = 0; c < n; c++) {
-            y_new[c] = y[c] + Z[2 * n + c];
-            ZE[c] = Z[c] * E0 + Z[n + c] * E1 + Z[2 * n + c] * E2;
-            err[c] = s->f[c] + ZE[c];
-        }
-        solve_real(s, err);
-        for (int c = 0; c < n; c++) {
-            if (!(ctrl & RADAU5_CTRL_SCALE))
-                s->scale[c] = s->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * s->rtol;
-            s->tmp[c] = err[c] / s->scale[c];
-        }
-        error_norm = rms(s->tmp, n);
-        safety = 0.9 * (2 * s->newton_maxiter + 1) / (2 * s->newton_maxiter + n_iter);
-
-        if (rejected && error_norm > 1) {
-            for (int c = 0; c < n; c++) s->tmp[c] = y[c] + err[c];
-            if (call_fun(s, t, s->tmp, err) != 0) {
-                error_norm = INFINITY;   /* scipy would go on with NaN; reject instead */
-            } else {
-                for (int c = 0; c < n; c++) err[c] += ZE[c];
-                solve_real(s, err);
-                for (int c = 0; c < n; c++) s->tmp[c] = err[c] / s->scale[c];
-                error_norm = rms(s->tmp, n);
-            }
-        }
-        if (!(error_norm <= 1)) {
-            double fac = (ctrl & RADAU5_CTRL_PRED)   /* RADAU5: the standard factor alone */
-                         ? pow(error_norm, -0.25)
-                         : predict_factor(h_abs, h_abs_old, have_h_abs_old, error_norm,
-                                          error_norm_old, have_error_norm_old);
-            h_abs *= fmax(MIN_FACTOR, safety * fac);
-            s->lu_valid = 0;
-            rejected = 1;
-            s->r->nreject++;
-            continue;
-        }
-        /* f at the new point: needed for the next step's error estimate. */
-        if (call_fun(s, t_new, y_new, s->f_new) != 0) {
-            h_abs *= 0.5;   /* not in scipy (it would carry NaN): treat as a failed step */
-            s->lu_valid = 0;
-            rejected = 1;
-            s->r->nreject++;
-            continue;
-        }
-        break;   /* step_accepted */
-    }
-
-    int recompute_jac = (ctrl & RADAU5_CTRL_JAC) ? (have_rate && theta > 1e-3)
-                                                 : (n_iter > 2 && have_rate && rate > 1e-3);
-    const double max_factor = (ctrl & RADAU5_CTRL_LIMITS) ? 8.0 : MAX_FACTOR;
-    double fac;
-    if (ctrl & RADAU5_CTRL_PRED) {
-        /* RADCOR: standard factor, and Gustafsson's from the last accepted step (plain
-         * safety), each within the limits; the smaller one */
-        double e = fmax(error_norm, 1e-10);
-        fac = fmin(max_factor, fmax(MIN_FACTOR, safety * pow(e, -0.25)));
-        if (s->have_acc) {
-            double gus = 0.9 * h_abs / s->h_acc * pow(s->err_acc / (e * e), 0.25);
-            fac = fmin(fac, fmin(max_factor, fmax(MIN_FACTOR, gus)));
-        }
-        s->h_acc = h_abs;
-        s->err_acc = fmax(0.01, e);
-        s->have_acc = 1;
-    } else {
-        fac = predict_factor(h_abs, h_abs_old, have_h_abs_old, error_norm,
-                             error_norm_old, have_error_norm_old);
-        fac = fmin(max_factor, safety * fac);
-    }
-    if ((ctrl & RADAU5_CTRL_LIMITS) && rejected && fac > 1)
-        fac = 1;   /* RADCOR: no growth right after a rejection */
-    int hold = (ctrl & RADAU5_CTRL_HOLD) ? (fac >= 1 && fac <= 1.2) : (fac < 1.2);
-    if (!recompute_jac && hold)
-        fac = 1;
-    else
-        s->lu_valid = 0;
-
-    if (recompute_jac && t_new == s->t_bound)
-        recompute_jac = 0;   /* the last step: nothing would use it (a new run starts anew) */
-    if (recompute_jac) {
-        if (call_jac(s, t_new, y_new) != 0) {
-            snprintf(s->r->message, sizeof s->r->message,
-                     "the Jacobian cannot be evaluated at t = %.17g", t_new);
-            return 0;
-        }
-        s->current_jac = 1;
-    } else {
-        s->current_jac = 0;
-    }
-    s->h_abs_old = s->h_abs;
-    s->have_h_abs_old = 1;
-    s->error_norm_old = error_norm;
-    s->have_error_norm_old = 1;
-    s->h_abs = h_abs * fac;
-
-    memcpy(s->y_old, y, n * sizeof(double));
-    memcpy(y, y_new, n * sizeof(double));
-    memcpy(s->f, s->f_new, n * sizeof(double));
-    memcpy(s->Z, Z, 3 * n * sizeof(double));
-    s->t_old = t;
-    s->t = t_new;
-    s->dense_end = t_new;
-    /* _compute_dense_output: Q = Z^T P (n x 3), stored transposed: row j holds the x^(j+1)
-     * coefficients of the n states (the layout of the stored dense output) */
-    for (int c = 0; c < n; c++)
-        for (int j = 0; j < 3; j++)
-            s->Q[j * n + c] = Z[c] * k->P[0][j] + Z[n + c] * k->P[1][j] + Z[2 * n + c] * k->P[2][j];
-    s->have_sol = 1;
-    s->r->nstep++;
-    return 1;
-}
-
-/* The function the DOP853 stages call: call_fun (counted, checked, profiled). */
-static int dop853_call(void *ctx, double t, const double *y, double *f)
-{
-    solver_t *s = ctx;
-    return call_fun(s, t, y, f);
-}
-
-/* RungeKutta._step_impl with DOP853's error norm.  Returns 1 on success, 0 on failure
- * (message set).  A step whose stages cannot be evaluated is rejected with its size
- * halved (scipy would carry the NaN on). */
-static int step_dop853(solver_t *s)
-{
-    const radau5_problem *p = s->p;
-    const int n = s->n;
-    const double t = s->t;
-    double *y = s->y, *y_new = s->y_new, *K = s->K;
-    const double exponent = -1.0 / (DOP853_ERROR_ORDER + 1);
-    double min_step = 10 * fabs(nextafter(t, s->direction * INFINITY) - t);
-    double h_abs = s->h_abs > p->max_step ? p->max_step
-                   : (s->h_abs < min_step ? min_step : s->h_abs);
-    int rejected = 0;
-    double h = 0, t_new = t;
-    memcpy(K, s->f, n * sizeof(double));
-    s->k_stale = 1;   /* until an attempt is accepted: K no longer holds the last step's */
-    for (;;) {
-        if (!attempt_size(s, t, min_step, &h_abs, &h, &t_new)) return 0;
-        if (dop853_attempt(dop853_call, s, n, t, h, y, K, y_new, s->tmp) != 0) {
-            h_abs *= 0.5;
-            rejected = 1;
-            s->r->nreject++;
-            continue;
-        }
-        for (int c = 0; c < n; c++)
-            s->scale[c] = s->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * s->rtol;
-        double error_norm = dop853_error_norm(n, K, h, s->scale, s->err, s->ZE);
-        if (error_norm < 1) {
-            double factor = error_norm == 0 ? MAX_FACTOR
-                            : fmin(MAX_FACTOR, 0.9 * pow(error_norm, exponent));
-            if (rejected) factor = fmin(1, factor);
-            h_abs *= factor;
-            break;
-        }
-        h_abs *= fmax(MIN_FACTOR, 0.9 * pow(error_norm, exponent));
-        rejected = 1;
-        s->r->nreject++;
-    }
-    /* Hairer's stiffness test (dop853.f, after each accepted step here): h lambda
-     * estimated from the last two stages at c = 1, K[11] at the stage argument (s->tmp,
-     * as dop853_attempt left it) and K[12] at y_new; 15 estimates in a row beyond the
-     * stability boundary (6.1) mean the steps are bounded by stability, not accuracy */
-    double num = 0, den = 0;
-    for (int c = 0; c < n; c++) {
-        double dk = K[DOP853_STAGES * n + c] - K[(DOP853_STAGES - 1) * n + c];
-        double dy = y_new[c] - s->tmp[c];
-        num += dk * dk;
-        den += dy * dy;
-    }
-    if (den > 0 && fabs(h) * sqrt(num / den) > 6.1) {
-        s->nonstiff_steps = 0;
-        if (++s->stiff_steps == 15 && isnan(s->r->stiff_at)) s->r->stiff_at = t;
-    } else if (++s->nonstiff_steps == 6) {
-        s->stiff_steps = 0;
-    }
-    s->h_abs = h_abs;
-    memcpy(s->y_old, y, n * sizeof(double));
-    memcpy(y, y_new, n * sizeof(double));
-    memcpy(s->f, K + DOP853_STAGES * n, n * sizeof(double));
-    s->t_old = t;
-    s->t = t_new;
-    s->dense_end = t_new;
-    s->dense_ready = 0;
-    s->k_stale = 0;
-    s->have_sol = 1;
-    s->r->nstep++;
-    return 1;
-}
-
+/* One accepted step of the method in use. */
 static int step(solver_t *s)
 {
-    return s->dop853 ? step_dop853(s) : step_radau(s);
+    return s->dop853 ? dop853_step(s) : radau_iia_step(s);
 }
 
 /* The last step's dense output made ready for dense(): DOP853 computes its extra stages
- * here, once per step and only for the steps whose dense output is used (Radau's is
- * part of the step).  Returns 0, or -1 (message set) when they cannot be evaluated. */
+ * then (dop853_prepare_dense), once per step and only for the steps whose dense output
+ * is used (Radau's is part of the step).  Returns 0, or -1 (message set) when they
+ * cannot be evaluated. */
 static int prepare_dense(solver_t *s)
 {
-    if (!s->dop853 || s->dense_ready) return 0;
-    if (s->k_stale) {   /* a step failed after this one without its dense output made */
-        snprintf(s->r->message, sizeof s->r->message,
-                 "the dense output of the step from t = %.17g was lost to a failed step",
-                 s->t_old);
-        return -1;
-    }
-    if (dop853_dense(dop853_call, s, s->n, s->t_old, s->t - s->t_old, s->y_old, s->y, s->K,
-                     s->Fdense, s->tmp) != 0) {
-        snprintf(s->r->message, sizeof s->r->message,
-                 "the right-hand side cannot be evaluated for the dense output of the step "
-                 "from t = %.17g", s->t_old);
-        return -1;
-    }
-    s->dense_ready = 1;
-    return 0;
+    return s->dop853 ? dop853_prepare_dense(s) : 0;
 }
 
 /* common.select_initial_step with the error estimator's order (Radau 3, DOP853 7). */
@@ -849,8 +178,6 @@ static double poly_at(void *ctx, double tt)
 
 /* A system event on the last step's dense output. */
 typedef struct { solver_t *s; int e; } dense_event_t;
-
-static void dense(const solver_t *s, double tt, double *out);
 
 static double dense_event_at(void *ctx, double tt)
 {
@@ -1032,7 +359,7 @@ static int step_to_event(solver_t *s, double t_stop, double *y_stop)
         /* J was evaluated at the crossing step's end, past the event (the mode's
          * equations may have turned sharply there, e.g. a slip direction swinging
          * through zero): take it at the start again */
-        ok = call_jac(s, s->t, s->y) == 0;
+        ok = radau_iia_jacobian(s, s->t, s->y) == 0;
         s->current_jac = 1;
     }
     s->t_bound = t_stop;
@@ -1099,7 +426,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     }
 
 #ifdef RADAU5_PROFILE
-    prof_acc = r->prof;
+    ballc_prof_acc = r->prof;
     struct timespec prof_ts0, prof_ts1;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &prof_ts0);
     unsigned long long prof_total0 = __rdtsc();
@@ -1112,7 +439,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.n = n;
     s.dop853 = p->method == RADAU5_METHOD_DOP853;
     r->dense_terms = s.dop853 ? DOP853_DENSE_TERMS : 3;
-    init_constants(&s.k);
+    radau_iia_init_constants(&s.k);
     s.direction = p->t_bound >= p->t0 ? 1.0 : -1.0;
     s.ctrl = p->controller;
     s.newton_maxiter = (s.ctrl & RADAU5_CTRL_NIT7) ? 7 : NEWTON_MAXITER;
@@ -1169,7 +496,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     }
     for (int e = 0; e < m; e++) s.g[e] = event_value(&s, e, s.t, s.y);
     s.h_abs = p->first_step > 0 ? p->first_step : initial_step(&s);
-    if (!s.dop853 && call_jac(&s, s.t, s.y) != 0) {
+    if (!s.dop853 && radau_iia_jacobian(&s, s.t, s.y) != 0) {
         snprintf(r->message, sizeof r->message,
                  "the Jacobian cannot be evaluated at the initial state (t = %.17g)", s.t);
         r->status = RADAU5_FAILED;
@@ -1264,27 +591,4 @@ done:
     free(cblock);
     free(iblock);
     return rc;
-}
-
-/* The method's constants as the solver uses them, for tests/test_radau5_constants.py
- * (compared with scipy.integrate._ivp.radau).  out[RADAU5_N_CONSTANTS], see the header
- * for the layout. */
-void radau5_constants(double *out)
-{
-    constants_t k;
-    init_constants(&k);
-    double *o = out;
-    for (int i = 0; i < 3; i++) *o++ = k.C[i];
-    for (int i = 0; i < 3; i++) *o++ = k.E[i];
-    for (int i = 0; i < 3; i++) for (int j = 0; j < 3; j++) *o++ = k.T[i][j];
-    for (int i = 0; i < 3; i++) for (int j = 0; j < 3; j++) *o++ = k.TI[i][j];
-    for (int i = 0; i < 3; i++) for (int j = 0; j < 3; j++) *o++ = k.P[i][j];
-    *o++ = k.mu_real;
-    *o++ = creal(k.mu_complex);
-    *o++ = cimag(k.mu_complex);
-    for (int j = 0; j < 3; j++) *o++ = creal(k.ti_complex[j]);
-    for (int j = 0; j < 3; j++) *o++ = cimag(k.ti_complex[j]);
-    *o++ = NEWTON_MAXITER;
-    *o++ = MIN_FACTOR;
-    *o++ = MAX_FACTOR;
 }
