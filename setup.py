@@ -1,8 +1,8 @@
 """Build the compiled core: generated/ kernels + src/ballc glue, bridged by Cython.
 
 One extension module, ``ballc._core``: the generated kernels, ``_system.c``, the
-radau5 solver and its LU are compiled and linked once, so no build or partial
-rebuild can leave two copies of the model that disagree.  ``ballc._radau5`` is a
+integrator (its loop and both methods' steps) and its LU are compiled and linked once,
+so no build or partial rebuild can leave two copies of the model that disagree.  ``ballc._radau5`` is a
 plain Python module re-exporting the solver's bridge (``_radau5_bridge.pxi``, included
 by ``_core.pyx``).
 """
@@ -15,10 +15,12 @@ from setuptools.command.build_ext import build_ext
 core = Extension(
     "ballc._core",
     sources=["src/ballc/_core.pyx", "src/ballc/_system.c", "generated/ballc_kernels.c",
-             "src/ballc/_radau5_solver.c", "src/ballc/_dop853.c", "src/ballc/_lu.c"],
+             "src/ballc/_integrator.c", "src/ballc/_radau_iia.c", "src/ballc/_dop853.c",
+             "src/ballc/_lu.c"],
     include_dirs=["generated", "src/ballc"],
     depends=["src/ballc/_radau5_bridge.pxi", "src/ballc/_system.h", "src/ballc/_lu.h",
-             "src/ballc/_radau5_solver.h", "src/ballc/_dop853.h",
+             "src/ballc/_integrator.h", "src/ballc/_integrator_private.h",
+             "src/ballc/_radau_iia.h", "src/ballc/_dop853.h",
              "generated/ballc_kernels.h"],
     # -fno-math-errno: sqrt never sets errno, so it is one instruction and repeated
     # calls in the generated kernels are shared (the results are the same bits).

@@ -5,7 +5,7 @@
 
 radau5 ports scipy's Radau step control; Hairer & Wanner's RADAU5 (radau5.f, RADCOR
 and ESTRAD) controls the same method differently.  Each difference is a bit of the
-solver's private ``controller`` option (``_radau5_solver.h``, RADAU5_CTRL_*):
+solver's private ``controller`` option (``_integrator.h``, RADAU5_CTRL_*):
 
 * ``nit7``   at most 7 Newton iterations (scipy 6), safety 0.9 (1 + 2 nit)/(newt + 2 nit)
 * ``limits`` h_new/h in [0.2, 8] (scipy [0.2, 10]), no growth right after a rejection

@@ -8,7 +8,8 @@ are recorded as in peers.py (``record_segments``, ``replayable``), written to a 
 file, and a small C program (benchmarks/cvode_harness.c) integrates every segment
 from its recorded start state to its recorded end time with
 
-- ``radau5``: ballc's ``radau5_solve`` (src/ballc/_radau5_solver.c), set up as
+- ``radau5``: ballc's ``radau5_solve`` (src/ballc/_integrator.c with the Radau IIA
+  step of src/ballc/_radau_iia.c), set up as
   ``ballc._radau5.solve_system`` sets it up (scipy's step control, every step stored);
 - ``dop853``: the same ``radau5_solve`` with ``method = RADAU5_METHOD_DOP853``
   (src/ballc/_dop853.c): Dormand & Prince's explicit Runge-Kutta pair of order 8, scipy's

@@ -33,7 +33,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "_radau5_solver.h"
+#include "_integrator.h"
 #include "_system.h"
 
 /* ---- SUNDIALS 7 (serial, double, 32-bit index) ---- */

@@ -76,7 +76,7 @@ DEFECTS = [
            "    dilution = _positive(rhodot) / (2 * sm.Max(_positive(rho), _LENGTH_FLOOR)) "
            "if dilute \\\n",
            "    dilution = sm.S.Zero if dilute \\\n", regenerate=True),
-    Defect("radau5 T[0][0] off in its 7th significant digit", "src/ballc/_radau5_solver.c",
+    Defect("radau5 T[0][0] off in its 7th significant digit", "src/ballc/_radau_iia.c",
            "{0.09443876248897524, -0.14125529502095421, 0.03002919410514742}",
            "{0.09443877248897524, -0.14125529502095421, 0.03002919410514742}",
            regenerate=False),

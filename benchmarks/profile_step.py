@@ -9,11 +9,12 @@ rest, on the seed scene.
 factorisation or solves: its step is 12 RHS calls and their combinations).
 
 The split needs a build of ``ballc._core`` with the solver's timers compiled in
-(``-DRADAU5_PROFILE``: time-stamp-counter reads around every right-hand side,
-Jacobian, factorisation, solve and event check, see ``_radau5_solver.c``).  ``--build DIR`` makes
-one in DIR (about a minute; the normal build is not touched) and runs this script
-against it in a child process; without ``--build`` the script uses whatever ``ballc``
-it imports, and prints only the uninstrumented figures when that build has no timers.
+(``-DRADAU5_PROFILE``: time-stamp-counter reads around every right-hand side, Jacobian,
+factorisation, solve and event check, see ``_integrator_private.h``, used by
+``_integrator.c`` and ``_radau_iia.c``). ``--build DIR`` makes one in DIR (about a
+minute; the normal build is not touched) and runs this script against it in a child
+process; without ``--build`` the script uses whatever ``ballc`` it imports, and prints
+only the uninstrumented figures when that build has no timers.
 
 Printed per tolerance: accepted steps, RHS / Jacobian / LU calls per step, and CPU µs
 per accepted step inside ``radau5_solve`` (thread CPU time of the instrumented run;

@@ -1,6 +1,6 @@
 """radau5's method constants against scipy's Radau module (the oracle it was ported from).
 
-radau5 (src/ballc/_radau5_solver.c) claims to be scipy.integrate.Radau step for step:
+radau5 (src/ballc/_radau_iia.c) claims to be scipy.integrate.Radau step for step:
 the same Radau IIA (order 5) collocation nodes C, error-estimate weights E, the
 transformation T / TI that block-diagonalises the method's matrix (eigenvalues
 MU_REAL and MU_COMPLEX), dense-output matrix P, and the same Newton and step-size

@@ -2,9 +2,11 @@
  * step by step (see _dop853.h).  The coefficients are scipy's dop853_coefficients.py,
  * printed to 17 significant digits (tests/test_dop853.py compares them with scipy's). */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "_dop853.h"
+#include "_integrator_private.h"
 
 static const double A[16][16] = {
     {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
@@ -138,4 +140,103 @@ void dop853_constants(double *out)
     memcpy(out, E3, sizeof E3); out += 13;
     memcpy(out, E5, sizeof E5); out += 13;
     memcpy(out, D_, sizeof D_);
+}
+
+/* ---- the integrator's DOP853 step (see _dop853.h; the loop is _integrator.c's) ---- */
+
+/* The function the DOP853 stages call: call_fun (counted, checked, profiled). */
+static int dop853_call(void *ctx, double t, const double *y, double *f)
+{
+    solver_t *s = ctx;
+    return call_fun(s, t, y, f);
+}
+
+/* RungeKutta._step_impl with DOP853's error norm.  Returns 1 on success, 0 on failure
+ * (message set).  A step whose stages cannot be evaluated is rejected with its size
+ * halved (scipy would carry the NaN on). */
+int dop853_step(solver_t *s)
+{
+    const radau5_problem *p = s->p;
+    const int n = s->n;
+    const double t = s->t;
+    double *y = s->y, *y_new = s->y_new, *K = s->K;
+    const double exponent = -1.0 / (DOP853_ERROR_ORDER + 1);
+    double min_step = 10 * fabs(nextafter(t, s->direction * INFINITY) - t);
+    double h_abs = s->h_abs > p->max_step ? p->max_step
+                   : (s->h_abs < min_step ? min_step : s->h_abs);
+    int rejected = 0;
+    double h = 0, t_new = t;
+    memcpy(K, s->f, n * sizeof(double));
+    s->k_stale = 1;   /* until an attempt is accepted: K no longer holds the last step's */
+    for (;;) {
+        if (!attempt_size(s, t, min_step, &h_abs, &h, &t_new)) return 0;
+        if (dop853_attempt(dop853_call, s, n, t, h, y, K, y_new, s->tmp) != 0) {
+            h_abs *= 0.5;
+            rejected = 1;
+            s->r->nreject++;
+            continue;
+        }
+        for (int c = 0; c < n; c++)
+            s->scale[c] = s->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * s->rtol;
+        double error_norm = dop853_error_norm(n, K, h, s->scale, s->err, s->ZE);
+        if (error_norm < 1) {
+            double factor = error_norm == 0 ? MAX_FACTOR
+                            : fmin(MAX_FACTOR, 0.9 * pow(error_norm, exponent));
+            if (rejected) factor = fmin(1, factor);
+            h_abs *= factor;
+            break;
+        }
+        h_abs *= fmax(MIN_FACTOR, 0.9 * pow(error_norm, exponent));
+        rejected = 1;
+        s->r->nreject++;
+    }
+    /* Hairer's stiffness test (dop853.f, after each accepted step here): h lambda
+     * estimated from the last two stages at c = 1, K[11] at the stage argument (s->tmp,
+     * as dop853_attempt left it) and K[12] at y_new; 15 estimates in a row beyond the
+     * stability boundary (6.1) mean the steps are bounded by stability, not accuracy */
+    double num = 0, den = 0;
+    for (int c = 0; c < n; c++) {
+        double dk = K[DOP853_STAGES * n + c] - K[(DOP853_STAGES - 1) * n + c];
+        double dy = y_new[c] - s->tmp[c];
+        num += dk * dk;
+        den += dy * dy;
+    }
+    if (den > 0 && fabs(h) * sqrt(num / den) > 6.1) {
+        s->nonstiff_steps = 0;
+        if (++s->stiff_steps == 15 && isnan(s->r->stiff_at)) s->r->stiff_at = t;
+    } else if (++s->nonstiff_steps == 6) {
+        s->stiff_steps = 0;
+    }
+    s->h_abs = h_abs;
+    memcpy(s->y_old, y, n * sizeof(double));
+    memcpy(y, y_new, n * sizeof(double));
+    memcpy(s->f, K + DOP853_STAGES * n, n * sizeof(double));
+    s->t_old = t;
+    s->t = t_new;
+    s->dense_end = t_new;
+    s->dense_ready = 0;
+    s->k_stale = 0;
+    s->have_sol = 1;
+    s->r->nstep++;
+    return 1;
+}
+
+int dop853_prepare_dense(solver_t *s)
+{
+    if (s->dense_ready) return 0;
+    if (s->k_stale) {   /* a step failed after this one without its dense output made */
+        snprintf(s->r->message, sizeof s->r->message,
+                 "the dense output of the step from t = %.17g was lost to a failed step",
+                 s->t_old);
+        return -1;
+    }
+    if (dop853_dense(dop853_call, s, s->n, s->t_old, s->t - s->t_old, s->y_old, s->y, s->K,
+                     s->Fdense, s->tmp) != 0) {
+        snprintf(s->r->message, sizeof s->r->message,
+                 "the right-hand side cannot be evaluated for the dense output of the step "
+                 "from t = %.17g", s->t_old);
+        return -1;
+    }
+    s->dense_ready = 1;
+    return 0;
 }

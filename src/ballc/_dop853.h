@@ -1,8 +1,10 @@
 /* dop853: the explicit Runge-Kutta pair of order 8(5,3) of Dormand & Prince (Hairer's
  * DOP853), as scipy.integrate.DOP853 implements it (scipy/integrate/_ivp/rk.py and
  * dop853_coefficients.py): the same coefficients, the same combined error estimate and
- * the same 7th-order dense output.  Stepping only: the loop, step-size control, events
- * and output are radau5_solve's (_radau5_solver.c, problem.method = RADAU5_METHOD_DOP853).
+ * the same 7th-order dense output, and the integrator's DOP853 step built from them
+ * (dop853_step: RungeKutta._step_impl's step-size control and Hairer's stiffness test).
+ * The loop, events and output are radau5_solve's (_integrator.c, problem.method =
+ * RADAU5_METHOD_DOP853).
  */
 #ifndef BALLC_DOP853_H
 #define BALLC_DOP853_H
@@ -44,5 +46,15 @@ double dop853_eval_scalar(double x, double a0, const double *a);
  * in that order, DOP853_N_CONSTANTS values. */
 #define DOP853_N_CONSTANTS (256 + 12 + 16 + 13 + 13 + 64)
 void dop853_constants(double *out);
+
+/* The loop's entry points (the solver: _integrator_private.h). */
+struct ballc_solver;
+/* RungeKutta._step_impl with DOP853's error norm: one accepted step from s->t.  Returns
+ * 1 on success, 0 on failure (message set).  A step whose stages cannot be evaluated is
+ * rejected with its size halved (scipy would carry the NaN on). */
+int dop853_step(struct ballc_solver *s);
+/* The last accepted step's dense output terms (s->Fdense), once per step.  Returns 0, or
+ * -1 (message set) when they cannot be evaluated or were lost to a failed step. */
+int dop853_prepare_dense(struct ballc_solver *s);
 
 #endif

@@ -1,6 +1,7 @@
 # Included by _core.pyx (one extension, one compiled copy of the kernels); compiled
 # with its directives (boundscheck=False, wraparound=False, initializedcheck=False).
-# Bridge to the compiled Radau IIA (order 5) integrator in ``_radau5_solver.c``.
+# Bridge to the compiled integrator (``_integrator.c``: the loop; ``_radau_iia.c``: the
+# Radau IIA (order 5) step; ``_dop853.c``: the DOP853 step).
 #
 # Private: use ``ballc.simulate(..., method="radau5")``; imported as ``ballc._radau5``
 # (a thin module re-exporting these names).  This part of ``_core`` checks and
@@ -28,7 +29,7 @@ cdef extern from "_lu.h":
     void ballc_lu_solve_complex(int, const double complex *, const int *,
                                 double complex *) nogil
 
-cdef extern from "_radau5_solver.h":
+cdef extern from "_integrator.h":
     ctypedef int (*radau5_fun)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_jac)(void *, double, const double *, double *) noexcept nogil
     ctypedef int (*radau5_event_fun)(void *, int, double, const double *, double *) noexcept nogil
@@ -351,12 +352,12 @@ def _event_arrays(events, int n):
     return m, coef, reals, ints, users, rearms
 
 
-cdef extern from "_radau5_solver.h":
+cdef extern from "_integrator.h":
     enum:
         RADAU5_CTRL_NIT7, RADAU5_CTRL_LIMITS, RADAU5_CTRL_PRED, RADAU5_CTRL_HOLD
         RADAU5_CTRL_JAC, RADAU5_CTRL_TOL, RADAU5_CTRL_SCALE, RADAU5_CTRL_HAIRER
 
-#: radau5's step-control elements (internal; see _radau5_solver.h and
+#: radau5's step-control elements (internal; see _integrator.h and
 #: benchmarks/controllers.py): name -> bit of radau5_problem.controller.
 CONTROLLER_ELEMENTS = {
     "nit7": RADAU5_CTRL_NIT7, "limits": RADAU5_CTRL_LIMITS, "pred": RADAU5_CTRL_PRED,
@@ -697,7 +698,7 @@ def _lu_solve(A, b):
     return x
 
 
-cdef extern from "_radau5_solver.h":
+cdef extern from "_radau_iia.h":
     int RADAU5_N_CONSTANTS
     void radau5_constants(double *out)
 

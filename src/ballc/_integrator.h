@@ -1,24 +1,34 @@
-/* radau5: compiled Radau IIA (order 5) integrator with linear events, and the same
- * loop, events and output around Dormand & Prince's explicit DOP853 (order 8).
- *
- * The same method and error control as scipy.integrate.Radau
- * (scipy/integrate/_ivp/radau.py): the same constants, simplified Newton
- * iteration on the transformed collocation system (one real and one complex
- * linear system per iteration), third-order embedded error estimate (with the
- * extra solve after a rejection), predictive (Gustafsson) step-size controller,
- * Jacobian / LU reuse strategy and collocation-polynomial dense output.  The
- * event logic is solve_ivp's (find_active_events, handle_events, brentq with
- * xtol = rtol = 4 eps), for events that are linear functionals of the state,
- * g(y) = c . y + d (on one step g(t) is then a cubic in t), and for events the
- * system evaluates itself (a callback, evaluated on the dense output).  Events are evaluated
- * exactly as solve_ivp evaluates them (the driver keeps segments from starting on
- * an event's zero; see simulate.py).  One difference, on by default
+/* integrator: the integration loop of ballc's compiled integrators (_integrator.c,
+ * radau5_solve) and its public API; the steps are the methods' own files:
+ *   - Radau IIA of order 5 (_radau_iia.c, problem.method = RADAU5_METHOD_RADAU, the
+ *     default): scipy.integrate.Radau's method and error control
+ *     (scipy/integrate/_ivp/radau.py): the same constants, simplified Newton iteration
+ *     on the transformed collocation system (one real and one complex linear system per
+ *     iteration), third-order embedded error estimate (with the extra solve after a
+ *     rejection), predictive (Gustafsson) step-size controller, Jacobian / LU reuse
+ *     strategy and collocation-polynomial dense output;
+ *   - DOP853 (_dop853.c, problem.method = RADAU5_METHOD_DOP853): Dormand & Prince's
+ *     explicit pair of order 8 as scipy.integrate.DOP853 (its coefficients, error
+ *     estimate, step-size control and 7th-order dense output; no Jacobian, which may then
+ *     be NULL): for scenes that are not stiff, where its order 8 takes far fewer steps at
+ *     tight tolerances.  The dense output's 3 extra stages are computed only for the steps
+ *     that need them (an event's sign change, a t_eval point, dense_output), where scipy
+ *     computes them on every step when there are events: nfev is smaller than scipy's by
+ *     that much.
+ * The loop (the same code for both methods): solve_ivp's event logic (find_active_events,
+ * handle_events, brentq with xtol = rtol = 4 eps), for events that are linear
+ * functionals of the state, g(y) = c . y + d (on one step g(t) is then a polynomial in
+ * t), and for events the system evaluates itself (a callback, evaluated on the dense
+ * output); their refinement and re-arming, t_eval, dense output and the call budget.
+ * Events are evaluated exactly as solve_ivp evaluates them (the driver keeps segments
+ * from starting on an event's zero; see simulate.py).  One difference, on by default
  * (radau5_problem.refine_events): the state at a terminal event is not the crossing
- * step's dense output (a cubic, order 3, without error control) but the end point of
- * the step taken again from that step's start to the event's time.
+ * step's dense output (Radau's: a cubic, order 3, without error control) but the end
+ * point of the step taken again from that step's start to the event's time.  The loop
+ * and the steps share the solver's state through _integrator_private.h.
  *
  * Generic in the system: the right-hand side and Jacobian are C callbacks, the
- * dimension is a run-time value.  The Newton systems are solved by ballc's own
+ * dimension is a run-time value.  Radau's Newton systems are solved by ballc's own
  * small LU with partial pivoting (_lu.h: fixed loop order, no BLAS, no threads),
  * so results do not depend on the machine's LAPACK or its threading.  Only the
  * coupled states are factored: states whose column of the Jacobian is zero (pure
@@ -26,17 +36,11 @@
  * lower block-triangular, so they follow from the coupled block's solution by
  * substitution; they stay in the error norm and in the Newton convergence test.
  *
- * With problem.method = RADAU5_METHOD_DOP853 the steps are scipy.integrate.DOP853's
- * instead (_dop853.h: its coefficients, error estimate, step-size control and 7th-order
- * dense output; no Jacobian, which may then be NULL): for scenes that are not stiff,
- * where its order 8 takes far fewer steps at tight tolerances.  Everything else (events,
- * their refinement and re-arming, t_eval, dense output, the call budget) is the same
- * code.  The dense output's 3 extra stages are computed only for the steps that need
- * them (an event's sign change, a t_eval point, dense_output), where scipy computes them
- * on every step when there are events: nfev is smaller than scipy's by that much.
+ * The public names keep the radau5_ prefix (radau5_solve, radau5_problem, ...) for
+ * both methods.
  */
-#ifndef BALLC_RADAU5_H
-#define BALLC_RADAU5_H
+#ifndef BALLC_INTEGRATOR_H
+#define BALLC_INTEGRATOR_H
 
 #include <complex.h>
 
@@ -158,10 +162,6 @@ typedef struct {
 int radau5_solve(const radau5_problem *problem, radau5_result *result);
 void radau5_free(radau5_result *result);
 
-/* The method's constants (tests only): out[RADAU5_N_CONSTANTS] =
- * C[3], E[3], T[3][3], TI[3][3], P[3][3] (row-major), MU_REAL, MU_COMPLEX (re, im),
- * TI_COMPLEX[3] (re), TI_COMPLEX[3] (im), NEWTON_MAXITER, MIN_FACTOR, MAX_FACTOR. */
-#define RADAU5_N_CONSTANTS 45
-void radau5_constants(double *out);
+/* radau5_constants (the Radau IIA method's constants, tests only): _radau_iia.h. */
 
 #endif

@@ -1,0 +1,136 @@
+"""Do two builds of ballc give the same bits?  For changes that must not change results
+(a file split, a rename, a refactoring of the C core).
+
+    python -m benchmarks.bit_identical BEFORE_SRC AFTER_SRC
+
+BEFORE_SRC and AFTER_SRC are ``src`` directories of two checkouts with their extension
+built in place (``python setup.py build_ext --inplace``), e.g. a clone of an older
+commit and this tree (as for ``benchmarks/compare_builds.py``).  One child process per
+build imports ballc from its ``src`` (and checks that it did), runs the cases below and
+saves every array and counter of the results; the parent compares them with
+``np.array_equal`` (NaN equal to NaN) and ``==``.  Exit status 0 when every case is
+bit-identical, 1 otherwise.
+
+Cases: ``ballc.simulate(ballc.Scene(), 5)`` with method radau5 and dop853 at the default
+tolerances (rtol = atol = 1e-10) and at 1e-6 and 1e-3, and
+``Scene(tangential_model="compliant")`` for 5 s with radau5 (default and 1e-6).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import pickle
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+CHILD = r"""
+import pickle, sys
+from pathlib import Path
+src = Path(sys.argv[1]).resolve()
+sys.path.insert(0, str(src))
+import numpy as np
+import ballc
+assert Path(ballc.__file__).resolve().parent == src / "ballc", (ballc.__file__, str(src))
+cases = [
+    ("default scene, radau5, default tol", {}, dict(method="radau5")),
+    ("default scene, dop853, default tol", {}, dict(method="dop853")),
+    ("default scene, radau5, 1e-6", {}, dict(method="radau5", rtol=1e-6, atol=1e-6)),
+    ("default scene, dop853, 1e-6", {}, dict(method="dop853", rtol=1e-6, atol=1e-6)),
+    ("default scene, radau5, 1e-3", {}, dict(method="radau5", rtol=1e-3, atol=1e-3)),
+    ("default scene, dop853, 1e-3", {}, dict(method="dop853", rtol=1e-3, atol=1e-3)),
+    ("compliant scene, radau5, default tol", dict(tangential_model="compliant"),
+     dict(method="radau5")),
+    ("compliant scene, radau5, 1e-6", dict(tangential_model="compliant"),
+     dict(method="radau5", rtol=1e-6, atol=1e-6)),
+]
+
+def plain(value):
+    # numbers, strings and arrays as they are; containers and dataclasses element-wise
+    if isinstance(value, np.ndarray) or value is None or isinstance(value, (str, bool, int, float)):
+        return value
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: plain(v) for k, v in value.items()}
+    if hasattr(value, "__dataclass_fields__"):
+        return {k: plain(getattr(value, k)) for k in value.__dataclass_fields__}
+    if isinstance(value, np.generic):
+        return value.item()
+    return repr(value)
+
+out = {}
+for name, scene_kw, kw in cases:
+    r = ballc.simulate(ballc.Scene(**scene_kw), 5.0, **kw)
+    out[name] = {
+        "t": r.t, "y": r.y, "status": r.status, "message": r.message, "nfev": r.nfev,
+        "njev": r.njev, "nlu": r.nlu, "t_events": plain(r.t_events),
+        "y_events": plain(r.y_events), "contacts": plain(r.contacts),
+    }
+with open(sys.argv[2], "wb") as f:
+    pickle.dump((ballc.__file__, out), f)
+"""
+
+
+def run(src: Path, where: Path) -> tuple[str, dict]:
+    """The cases' results from the ballc under ``src`` (a child process)."""
+    target = where / f"{abs(hash(str(src)))}.pkl"
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    subprocess.run([sys.executable, "-c", CHILD, str(src), str(target)], check=True,
+                   env=env, cwd=where)
+    with open(target, "rb") as f:
+        return pickle.load(f)
+
+
+def differences(a, b, path="") -> list[str]:
+    """Where ``a`` and ``b`` differ (bit for bit for arrays and floats; NaN == NaN)."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        if a.shape != b.shape or a.dtype != b.dtype:
+            return [f"{path}: shape/dtype {a.shape} {a.dtype} vs {b.shape} {b.dtype}"]
+        equal_nan = a.dtype.kind in "fc"
+        if not np.array_equal(a, b, equal_nan=equal_nan):
+            if equal_nan:
+                worst = np.nanmax(np.abs(a - b)) if a.size else 0.0
+                return [f"{path}: arrays differ (max |diff| {worst:.3g})"]
+            return [f"{path}: arrays differ"]
+        return []
+    if isinstance(a, dict) and isinstance(b, dict):
+        if a.keys() != b.keys():
+            return [f"{path}: keys {sorted(a)} vs {sorted(b)}"]
+        return [d for k in a for d in differences(a[k], b[k], f"{path}.{k}")]
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{path}: length {len(a)} vs {len(b)}"]
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in differences(x, y, f"{path}[{i}]")]
+    if isinstance(a, float) and isinstance(b, float) and np.isnan(a) and np.isnan(b):
+        return []
+    return [] if a == b else [f"{path}: {a!r} vs {b!r}"]
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("before", type=Path, help="src/ of the first build")
+    parser.add_argument("after", type=Path, help="src/ of the second build")
+    args = parser.parse_args(argv)
+    with tempfile.TemporaryDirectory() as tmp:
+        file_a, before = run(args.before.resolve(), Path(tmp))
+        file_b, after = run(args.after.resolve(), Path(tmp))
+    print(f"before: {file_a}\nafter:  {file_b}")
+    failed = False
+    for name in before:
+        diff = differences(before[name], after[name])
+        a = before[name]
+        summary = f"{len(a['t'])} points, nfev {a['nfev']}, njev {a['njev']}, nlu {a['nlu']}"
+        print(f"{'identical' if not diff else 'DIFFERENT'}  {name}  ({summary})")
+        for d in diff[:10]:
+            print("    " + d)
+        failed |= bool(diff)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
