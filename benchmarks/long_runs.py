@@ -10,8 +10,8 @@ segments (calls of the driver's integrate_segment, counted by a wrapper), the st
 the last segment, the right-hand-side calls, the samples, the contacts, and the median
 step after the last contact started.  For the largest run, the figures
 (``result.plot()``, ``plot_energy()``, ``plot_observer()``, ``plot_contacts()``, matplotlib
-Agg, not saved) are timed too.  ``--scene drop``: a vertical drop without spin or
-observer (the seed's materials), a ball that truly comes to rest; ``rolling``: the
+Agg, not saved) and the animation (GIF) are timed too.  ``--scene drop``: a vertical
+drop without spin or observer (the seed's materials), a ball that truly comes to rest; ``rolling``: the
 seed's throw without its observer, which rolls uniformly (closed form in ballc.resting).  Each scene is run
 with ``rest=True`` (the default: the resting end state of ballc.resting) and with
 ``rest=False`` (the integrator all the way, what the build before ballc.resting did;
@@ -85,6 +85,10 @@ def run(scene, t_end, method, rest):
 
 
 def time_figures(result):
+    """Wall time (s) of each figure (drawn, not saved) and of the animation (the default
+    100 frames, written as a GIF to a temporary folder)."""
+    import tempfile
+
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -95,6 +99,11 @@ def time_figures(result):
         fig.canvas.draw()
         times[name] = time.perf_counter() - started
         plt.close(fig)
+    with tempfile.TemporaryDirectory() as folder:
+        started = time.perf_counter()
+        animation = result.animate(Path(folder) / "run.gif")
+        times["animate"] = time.perf_counter() - started
+        plt.close(animation._fig)
     return times
 
 
@@ -134,10 +143,15 @@ def main(argv=None):
         lines.append("")
     if not args.no_figures and largest is not None:
         times = time_figures(largest)
+        figures = {name: s for name, s in times.items() if name != "animate"}
         lines += [f"Figures of the run with the most samples ({largest.t.size}), matplotlib "
-                  "Agg, drawn, not saved:", "", "| figure | wall (s) |", "|---|---|"]
-        lines += [f"| {name}() | {seconds:.3g} |" for name, seconds in times.items()]
-        lines.append(f"| all | {sum(times.values()):.3g} |")
+                  "Agg, drawn, not saved (each line decimated for drawing to at most "
+                  "ballc.plot.MAX_POINTS points, a min/max envelope; the Result keeps every "
+                  "sample), and its animation (100 frames, GIF):", "",
+                  "| figure | wall (s) |", "|---|---|"]
+        lines += [f"| {name}() | {seconds:.3g} |" for name, seconds in figures.items()]
+        lines.append(f"| all figures | {sum(figures.values()):.3g} |")
+        lines.append(f"| animate() | {times['animate']:.3g} |")
     text = "\n".join(lines) + "\n"
     print(text)
     args.out.write_text(text)

@@ -205,6 +205,28 @@ def jacobian(const double[::1] y, const double[::1] params, const double[::1] la
     return out
 
 
+def rhs_per_sample(const double[:, ::1] states, const double[::1] params,
+                   const double[:, ::1] latch, const int[::1] flags):
+    """(n, N_STATES): the state derivative at each state row, with that row's latched
+    values and flags (what ``rhs`` gives row by row, in one call); a row whose
+    right-hand side cannot be evaluated raises, as ``rhs`` does."""
+    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check("latch.shape[1]", latch.shape[1], BALLC_N_LATCH)
+    _check("latch.shape[0]", latch.shape[0], states.shape[0])
+    _check("flags", flags.shape[0], states.shape[0])
+    out = np.empty((states.shape[0], BALLC_N_STATES))
+    cdef double[:, ::1] o = out
+    cdef Py_ssize_t i
+    cdef int status
+    for i in range(states.shape[0]):
+        status = ballc_rhs(&states[i, 0], &params[0], &latch[i, 0], flags[i], &o[i, 0])
+        if status != BALLC_OK:
+            raise FloatingPointError(
+                f"right-hand side failed with C status {status} at row {i}")
+    return out
+
+
 ctypedef void (*kernel_fn)(const double *, const double *, const double *, const double *,
                            double *) nogil
 

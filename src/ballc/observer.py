@@ -29,13 +29,10 @@ def state_derivatives(result) -> np.ndarray:
     if result.flags is None or result.latch is None:
         raise ValueError("this Result has no per-sample flags/latch (made by an older ballc); "
                          "re-run the simulation to get the observer's acceleration")
-    params = result.scene.parameter_vector()
-    states = np.ascontiguousarray(result.y.T)
-    latch = np.ascontiguousarray(result.latch.T)
-    out = np.empty_like(result.y)
-    for i in range(states.shape[0]):
-        out[:, i] = _core.rhs(states[i], params, latch[i], int(result.flags[i]))
-    return out
+    return _core.rhs_per_sample(np.ascontiguousarray(result.y.T),
+                                result.scene.parameter_vector(),
+                                np.ascontiguousarray(result.latch.T),
+                                np.ascontiguousarray(result.flags, dtype=np.intc)).T
 
 
 def observer_acceleration(result) -> np.ndarray:
@@ -60,7 +57,10 @@ def specific_force(result, frame: str = "inertial") -> np.ndarray:
     force = observer_acceleration(result)
     force[2] += result.scene.gravity
     force /= STANDARD_GRAVITY
-    if frame == "ball":
-        rotation = rotation_matrix(result.y[layout.QUATERNION].T)      # v_N = R v_A
-        force = np.einsum("nji,jn->in", rotation, force)             # v_A = R^T v_N
-    return force
+    return to_ball_frame(result, force) if frame == "ball" else force
+
+
+def to_ball_frame(result, vectors) -> np.ndarray:
+    """(3, n) inertial components at each sample -> the ball's body-axis components."""
+    rotation = rotation_matrix(result.y[layout.QUATERNION].T)          # v_N = R v_A
+    return np.einsum("nji,jn->in", rotation, vectors)                  # v_A = R^T v_N

@@ -3,6 +3,10 @@
 Every function takes a :class:`ballc.Result` and returns ``(figure, axes)``; pass
 ``ax=`` (or ``axes=``) to draw into existing axes.  Time in s, lengths in m, speeds in
 m/s, energies in J, specific force in g (9.80665 m/s^2).
+
+Lines drawn from per-sample arrays are decimated for drawing (``_for_drawing``: at most
+``MAX_POINTS`` points, a min/max envelope per time bucket), so a run of millions of
+samples draws in about a second; the Result's arrays are never changed.
 """
 from __future__ import annotations
 
@@ -19,6 +23,58 @@ COMPONENT_STYLES = ("-", "--", ":")
 #: Sweep map colours of "came back": yes, no, and no answer (failed run, NaN).
 CAME_BACK_COLOURS = {"yes": "#1a9850", "no": "#d73027", "undetermined": "#fee08b",
                      "none": "0.85"}
+
+
+#: At most this many points per line drawn from per-sample arrays (see ``_for_drawing``):
+#: about 10 per pixel column of a 2000-pixel-wide figure, so a decimated line looks the
+#: same as the full one, and a figure of any run draws in about a second.
+MAX_POINTS = 20000
+
+
+def _drawn_indices(t, series, max_points: int = MAX_POINTS) -> np.ndarray:
+    """Sorted indices of the samples to draw: all of them when there are at most
+    ``max_points``; else the first, the last, and in each of equal time buckets the
+    sample of each series' minimum and of its maximum (a min/max envelope: no peak is
+    lost, however narrow).  At most ``max_points`` indices."""
+    t = np.asarray(t)
+    n = t.size
+    if n <= max_points:
+        return np.arange(n)
+    series = [np.asarray(values) for values in series]
+    buckets = (max_points - 2) // (2 * max(len(series), 1))
+    if buckets < 1:
+        raise ValueError(f"max_points = {max_points} is too few for {len(series)} series: "
+                         f"needs at least {2 * len(series) + 2}")
+    # equal time buckets (a pixel column is a span of time); by index if t is constant.
+    # t is nondecreasing: each bucket is a run of samples, found by binary search.
+    if t[-1] > t[0]:
+        starts = np.searchsorted(t, np.linspace(t[0], t[-1], buckets + 1)[:-1], "left")
+    else:
+        starts = np.linspace(0, n, buckets + 1)[:-1].astype(np.intp)
+    starts = np.unique(starts)                              # empty buckets dropped
+    segment = np.zeros(n, dtype=np.intp)                    # bucket of each sample
+    segment[starts[1:]] = 1
+    np.cumsum(segment, out=segment)
+    keep = [np.array([0, n - 1])]
+    for values in series:
+        values = np.ascontiguousarray(values, dtype=float)
+        for reduce in (np.fmin, np.fmax):                   # fmin/fmax: NaN ignored
+            extreme = reduce.reduceat(values, starts)
+            hits = np.flatnonzero(values == extreme[segment])
+            first = np.r_[True, segment[hits[1:]] != segment[hits[:-1]]]
+            keep.append(hits[first])                        # first hit in its bucket
+    return np.unique(np.concatenate(keep))
+
+
+def _for_drawing(t, *series, max_points: int = MAX_POINTS):
+    """``(t, *series)`` reduced to at most ``max_points`` samples for drawing: the first
+    and last samples and, per time bucket, each series' minimum and maximum (so peaks and
+    contacts stay visible; ``_drawn_indices``).  Only what is drawn is reduced: the
+    Result's arrays are not touched.  All series share the kept times."""
+    index = _drawn_indices(t, series, max_points)
+    if index.size == np.asarray(t).size:
+        return (t, *series)
+    return (np.asarray(t)[index], *(np.asarray(values)[index] for values in series))
 
 
 def _verdict_value(value) -> float:
@@ -65,7 +121,8 @@ def plot_coordinates(result, axes=None, figsize=(10, 8)):
                ("$\\omega_x$", "$\\omega_y$", "$\\omega_z$")))
     for ax, (values, label, names) in zip(axes, panels):
         for row, name, style in zip(values, names, COMPONENT_STYLES):
-            ax.plot(result.t, row, label=name, lw=1.5 if style == ":" else 1.2, ls=style)
+            ax.plot(*_for_drawing(result.t, row), label=name,
+                    lw=1.5 if style == ":" else 1.2, ls=style)
         shade_contacts(ax, result)
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
@@ -86,9 +143,10 @@ def plot_energy(result, ax=None, figsize=(10, 5)):
     names += [k for k in energy if k not in names and k != "total"]
     for name in names:
         style = "--" if name.startswith("dissipated") else ":" if name == "balance" else "-"
-        ax.plot(result.t, energy[name], label=name.replace("_", " "), lw=1.2, ls=style)
+        ax.plot(*_for_drawing(result.t, energy[name]), label=name.replace("_", " "),
+                lw=1.2, ls=style)
     if "total" in energy:
-        ax.plot(result.t, energy["total"], label="total", color="k", lw=2)
+        ax.plot(*_for_drawing(result.t, energy["total"]), label="total", color="k", lw=2)
     shade_contacts(ax, result)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("energy (J)")
@@ -118,8 +176,8 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
     plt = _pyplot()
     fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
                else (ax.figure, ax))
-    ax.plot(result.position[0], result.position[1], color="0.6", lw=0.8,
-            label="centre path")
+    _, x, y = _for_drawing(result.t, result.position[0], result.position[1])
+    ax.plot(x, y, color="0.6", lw=0.8, label="centre path")
     ax.plot(*result.position[:2, 0], "kx", ms=8, label="start")
     points = contact_points(result)
     times = np.array([c.t_start for c in result.contacts])
@@ -153,6 +211,62 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
     return fig, ax
 
 
+#: plot_observer evaluates the specific force (the compiled right-hand side, per
+#: sample) at every sample of a run with at most this many, else at about this many
+#: chosen samples (``_observer_samples``): a bounded cost, about 0.3 s.
+OBSERVER_SAMPLES = 200_000
+#: ... and at every sample of each contact with at most this many samples (impacts,
+#: where the specific force peaks), however long the run.
+OBSERVER_CONTACT_SAMPLES = 5_000
+
+
+def _observer_indices(result, budget: int = OBSERVER_SAMPLES,
+                      contact_samples: int = OBSERVER_CONTACT_SAMPLES) -> np.ndarray:
+    """Sorted indices of the samples at which plot_observer evaluates the specific force.
+
+    All samples when there are at most ``budget``.  Otherwise the specific force (which
+    needs the right-hand side at each sample) cannot be decimated by its own envelope
+    without computing it everywhere, so the samples are chosen from what drives it:
+
+    * every sample of each contact with at most ``contact_samples`` samples: the impacts,
+      where the specific force has its peaks, are drawn exactly (the first contacts,
+      up to ``budget`` such samples in all);
+    * in equal time buckets, the samples of the minimum and the maximum of the centre's
+      height, velocity and angular velocity (``_drawn_indices`` with ``budget`` points):
+      penetration, impacts and spin-ups, and the first and last samples.
+
+    In a long persistent contact (rest, rolling) the force is then drawn through those
+    samples: its envelope there is that of the samples chosen, not of every sample.
+    """
+    t = result.t
+    n = t.size
+    if n <= budget:
+        return np.arange(n)
+    rows = [result.position[2], *result.velocity, *result.angular_velocity]
+    keep = [_drawn_indices(t, rows, budget)]
+    spent = 0                        # contact samples, at most another ``budget`` in all
+    for contact in result.contacts:
+        end = contact.t_end if np.isfinite(contact.t_end) else t[-1]
+        first, last = np.searchsorted(t, [contact.t_start, end], side="left")
+        last = min(int(last) + 1, n)
+        if last - first <= contact_samples and spent + last - first <= budget:
+            keep.append(np.arange(first, last))
+            spent += last - first
+    return np.unique(np.concatenate(keep))
+
+
+def _observer_samples(result):
+    """``result`` itself, or a copy holding only the samples of ``_observer_indices``
+    (for evaluation and drawing; the Result is not changed)."""
+    import dataclasses
+    index = _observer_indices(result)
+    if index.size == result.t.size or result.flags is None or result.latch is None:
+        return result               # (without flags/latch, specific_force says why not)
+    return dataclasses.replace(result, t=result.t[index], y=result.y[:, index],
+                               flags=result.flags[index], latch=result.latch[:, index],
+                               _energy=None, sol=None)
+
+
 def plot_observer(result, axes=None, figsize=(10, 7)):
     """The observer's specific force (acceleration - gravity) in g: ball-frame
     components (what an accelerometer inside the ball reads) and inertial ones."""
@@ -161,13 +275,18 @@ def plot_observer(result, axes=None, figsize=(10, 7)):
         fig, axes = plt.subplots(2, 1, sharex=True, figsize=figsize, constrained_layout=True)
     else:
         fig = axes[0].figure
-    inertial = result.observer_specific_force
-    ball = result.observer_specific_force_ball
+    from .observer import specific_force, to_ball_frame
+    # The specific force is evaluated once for both frames, at the samples
+    # _observer_samples picks (all of them up to OBSERVER_SAMPLES); each line is then
+    # decimated for drawing by its own min/max envelope.
+    drawn = _observer_samples(result)
+    inertial = specific_force(drawn, frame="inertial")
+    ball = to_ball_frame(drawn, inertial)
     magnitude = np.linalg.norm(inertial, axis=0)
     for ax, values, frame in ((axes[0], ball, "ball frame"), (axes[1], inertial, "inertial")):
         for row, axis in zip(values, "xyz"):
-            ax.plot(result.t, row, lw=1.0, label=f"{axis}")
-        ax.plot(result.t, magnitude, color="k", lw=0.8, ls="--", label="|f|")
+            ax.plot(*_for_drawing(drawn.t, row), lw=1.0, label=f"{axis}")
+        ax.plot(*_for_drawing(drawn.t, magnitude), color="k", lw=0.8, ls="--", label="|f|")
         shade_contacts(ax, result)
         ax.set_ylabel(f"specific force, {frame} (g)")
         ax.grid(alpha=0.3)
