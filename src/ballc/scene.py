@@ -94,8 +94,9 @@ class Scene:
         gamma of the viscoelastic normal damping (1), >= 0; or give ``restitution``.
     tangential_damping_ratio : float, optional
         gamma_t of the compliant law's tangential damping c_t = 2 gamma_t sqrt(m* k_t)
-        (1), >= 0.  Default (None): the viscoelastic gamma of the scene's normal
-        restitution (Kratos' choice, the same gamma as the normal force).
+        (1), >= 0.  Default (None): with the compliant law, the viscoelastic gamma of
+        the scene's normal restitution (Kratos' choice, the same gamma as the normal
+        force); the other laws have no tangential damping and leave it None.
     friction_coefficient : float
         Coulomb friction coefficient mu (1), >= 0.  Default 0.1.
     mixture : float
@@ -151,7 +152,7 @@ class Scene:
     restitution                        (none)          1            None (c_tau)
     normal_damping                     (none)          (none)       "hunt_crossley"
     damping_ratio                      (none)          1            None
-    tangential_damping_ratio           (none)          1            from restitution
+    tangential_damping_ratio           (none)          1            compliant: from e
     friction_coefficient               mu              1            0.1
     mixture                            mixtur          1            0.375
     tangential_model                   (none)          (none)       "mixture"
@@ -226,7 +227,6 @@ class Scene:
                                                        self.plane_poisson_ratio,
                                                        self.ball_youngs_modulus,
                                                        self.plane_youngs_modulus))
-        _resolve_damping(self)
         if self.inertia is None:
             try:
                 i = 0.4 * float(self.mass) * float(self.radius) ** 2
@@ -234,6 +234,7 @@ class Scene:
                 i = math.nan   # _validate reports the bad mass or radius first
             object.__setattr__(self, "inertia", (i, i, i))
         _validate(self)
+        _resolve_damping(self)   # after _validate: c_tau, if given, is a valid number
 
     @classmethod
     def from_dict(cls, values: dict) -> "Scene":
@@ -339,7 +340,7 @@ class Scene:
             "tangential_stiffness_ratio": self.tangential_stiffness_ratio,
             "normal_damping_model": float(self.normal_damping == "viscoelastic"),
             "damping_ratio": self.damping_ratio or 0.0,
-            "tangential_damping_ratio": self.tangential_damping_ratio,
+            "tangential_damping_ratio": self.tangential_damping_ratio or 0.0,
         }
         return np.array([float(values[name]) for name in _core.PARAMETER_NAMES])
 
@@ -356,7 +357,9 @@ _DAMPING_INPUTS = ("c_tau", "restitution", "damping_ratio")
 
 def _resolve_damping(s: Scene) -> None:
     """Check that the scene gives one normal damping input, fill in c_tau's default, the
-    viscoelastic gamma of a restitution, and the tangential damping ratio's default."""
+    viscoelastic gamma of a restitution, and (compliant law only: no other law has
+    tangential damping, and the inversion costs ~60 ms per new restitution) the
+    tangential damping ratio's default."""
     from . import restitution as law
     derived = []
     if s.normal_damping not in NORMAL_DAMPINGS:
@@ -369,12 +372,9 @@ def _resolve_damping(s: Scene) -> None:
         raise SceneError(f"{' and '.join(given)} are both given: a scene gives one of "
                          f"{', '.join(_DAMPING_INPUTS)} (replace() drops the others)")
     if s.restitution is not None:
-        e = s.restitution
-        if isinstance(e, (bool, np.bool_)) or not isinstance(e, (int, float, np.number)) \
-                or not math.isfinite(float(e)) or not 0 < float(e) <= 1:
-            raise SceneError(f"restitution = {_plain(e)} is not allowed: must be a number "
-                             "in (0, 1]")
-        object.__setattr__(s, "restitution", float(e))
+        if not 0 < _finite("restitution", s.restitution) <= 1:
+            _fail("restitution", s.restitution, "must be a number in (0, 1]")
+        object.__setattr__(s, "restitution", float(s.restitution))
     if s.normal_damping == "viscoelastic":
         if s.c_tau is not None:
             raise SceneError("c_tau is given with normal_damping = 'viscoelastic': give "
@@ -394,33 +394,19 @@ def _resolve_damping(s: Scene) -> None:
                              "normal_damping = 'hunt_crossley' give c_tau or restitution")
         if s.c_tau is None and s.restitution is None:
             object.__setattr__(s, "c_tau", DEFAULT_C_TAU)
-        c = s.c_tau
-        if c is not None and (isinstance(c, (bool, np.bool_, str, bytes))
-                              or not isinstance(c, (int, float, np.number))
-                              or not math.isfinite(float(c)) or not 0 < float(c) <= 1):
-            raise SceneError(f"c_tau = {_plain(c)} is not allowed: must be in (0, 1]")
-    if s.tangential_damping_ratio is None:
+    if s.tangential_damping_ratio is None and s.tangential_model == "compliant":
         gamma = s.damping_ratio if s.normal_damping == "viscoelastic" else \
             law.viscoelastic_gamma_for_restitution(s.normal_restitution)
         object.__setattr__(s, "tangential_damping_ratio", float(gamma))
         derived.append("tangential_damping_ratio")
-    else:
+    elif s.tangential_damping_ratio is not None:
         _non_negative("tangential_damping_ratio", s.tangential_damping_ratio)
     object.__setattr__(s, "_derived", tuple(derived))
 
 
 def _non_negative(name, value):
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)) \
-            or not math.isfinite(float(value)) or not float(value) >= 0:
-        raise SceneError(f"{name} = {_plain(value)} is not allowed: must be a finite number "
-                         ">= 0")
-
-
-def _plain(value):
-    """A number as a user wrote it (not np.float64(...)); anything else as repr."""
-    if isinstance(value, (int, float, np.number)) and not isinstance(value, (bool, np.bool_)):
-        return repr(float(value)) if not isinstance(value, (int, np.integer)) else str(value)
-    return repr(value)
+    if not _finite(name, value) >= 0:
+        _fail(name, value, "must be a finite number >= 0")
 
 
 def mindlin_stiffness_ratio(nu_ball, nu_plane, e_ball, e_plane):
@@ -485,22 +471,27 @@ def _toml_value(value) -> str:
     raise TypeError(f"cannot write {value!r} ({type(value).__name__}) to TOML")
 
 
-def _validate(s: Scene) -> None:
-    def fail(name, value, allowed):
-        raise SceneError(f"{name} = {plain(value)} is not allowed: {allowed}")
+def _fail(name, value, allowed):
+    raise SceneError(f"{name} = {plain(value)} is not allowed: {allowed}")
 
-    def finite(name, value):
-        # Strings and bools would pass float() but are not numbers (a str field
-        # would break arithmetic later, e.g. in hertz_stiffness).
-        if isinstance(value, (str, bytes, bool, np.bool_)):
-            fail(name, value, "must be a real number")
-        try:
-            x = float(value)
-        except (TypeError, ValueError):
-            fail(name, value, "must be a real number")
-        if not math.isfinite(x):
-            fail(name, value, "must be finite")
-        return x
+
+def _finite(name, value) -> float:
+    """``value`` as a finite float, or SceneError naming ``name``."""
+    # Strings and bools would pass float() but are not numbers (a str field
+    # would break arithmetic later, e.g. in hertz_stiffness).
+    if isinstance(value, (str, bytes, bool, np.bool_)):
+        _fail(name, value, "must be a real number")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        _fail(name, value, "must be a real number")
+    if not math.isfinite(x):
+        _fail(name, value, "must be finite")
+    return x
+
+
+def _validate(s: Scene) -> None:
+    fail, finite = _fail, _finite
 
     for name in ("mass", "radius", "ceiling_height", "ball_youngs_modulus",
                  "plane_youngs_modulus", "friction_regularization_speed"):
