@@ -141,6 +141,16 @@ _FORCE_FLOOR2, _LENGTH_FLOOR2 = sm.Float(1e-24), sm.Float(1e-30)
 _LENGTH_FLOOR = sm.Float(1e-30)
 
 
+def _rho_floor(rho):
+    """The penetration as a divisor: max(rho, 0) floored at 1e-30 m."""
+    return sm.Max(_positive(rho), _LENGTH_FLOOR)
+
+
+def _hunt_crossley_chi(model: Model):
+    """chi = 3/2 (1 - c_tau) of the Hunt-Crossley bracket 1 + chi rhodot / |rhodot^-|."""
+    return sm.Rational(3, 2) * (1 - model.p["c_tau"])
+
+
 def _sqrt_positive(x):
     """sqrt(x) for x >= 0 written as x / sqrt(max(x, 1e-30)): the same value, exactly 0
     at 0, and a finite derivative there (d sqrt(x)/dx is infinite at 0, which would put
@@ -165,8 +175,7 @@ def effective_mass(model: Model):
 
 def hunt_crossley_damping(model: Model, elastic, stiffness, rhodot, rate_at_impact):
     """Hunt-Crossley damping force (N): F_H chi rhodot / |rhodot^-|, chi = 3/2 (1 - c_tau)."""
-    chi = sm.Rational(3, 2) * (1 - model.p["c_tau"])
-    return elastic * chi * rhodot / sm.Abs(rate_at_impact)
+    return elastic * _hunt_crossley_chi(model) * rhodot / sm.Abs(rate_at_impact)
 
 
 def viscoelastic_damping(model: Model, elastic, stiffness, rhodot, rate_at_impact):
@@ -186,28 +195,27 @@ def damped_normal(model: Model, rho, rhodot, rate_at_impact):
     return _positive(elastic + damping), stiffness
 
 
-def normal_force_rate(model: Model, plane: str, rho, rhodot, rate_at_impact):
-    """dF_n/dt (N/s) of the damped normal force while it is positive, with the
-    penetration's acceleration taken as the contact's own: rho'' = -F_n/m* + g n_z (exact
-    for a ball in one contact without observer; the yield's shrinking term only)."""
+def normal_force_rate(model: Model, plane: str, rho, rhodot, rate_at_impact, f_n):
+    """dF_n/dt (N/s) of the damped normal force ``f_n`` (damped_normal's) while it is
+    positive, with the penetration's acceleration taken as the contact's own:
+    rho'' = -F_n/m* + g n_z (exact for a ball in one contact without observer; the
+    yield's shrinking term only)."""
     elastic, stiffness = hertz_normal(model, rho)
-    f_n, _ = damped_normal(model, rho, rhodot, rate_at_impact)
     normal, _ = plane_geometry(model, plane)
     mass = effective_mass(model)
     accel = -f_n / mass + model.p["gravity"] * me.dot(normal, model.frame.z)
-    rho_floor = sm.Max(_positive(rho), _LENGTH_FLOOR)
     select = model.p["normal_damping_model"]
     # Hunt-Crossley: P = F_H (1 + chi rhodot / |v-|)
-    chi = sm.Rational(3, 2) * (1 - model.p["c_tau"]) / sm.Abs(rate_at_impact)
+    chi = _hunt_crossley_chi(model) / sm.Abs(rate_at_impact)
     hc = stiffness * (1 + chi * rhodot) * rhodot + elastic * chi * accel
     # viscoelastic: P = F_H + 2 gamma sqrt(m* k_n) rhodot, dk_n/drho = k_n / (2 rho)
     c_n = 2 * model.p["damping_ratio"] * _sqrt_positive(mass * stiffness)
-    ve = (stiffness + c_n * rhodot / (4 * rho_floor)) * rhodot + c_n * accel
+    ve = (stiffness + c_n * rhodot / (4 * _rho_floor(rho))) * rhodot + c_n * accel
     return (1 - select) * hc + select * ve
 
 
-def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, slip,
-                        normal_force_rate, dilute=True):
+def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, cap,
+                        slip, normal_force_rate, dilute=True):
     """The incremental (passive) Mindlin tangential spring with a Coulomb cap.
 
     Returns (capped elastic force F_e (2), deflection rate s' (2), the rate of the
@@ -222,23 +230,20 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     """
     sx, sy = deflection_symbols(model, plane)
     vx, vy = slip
-    cap = model.p["friction_coefficient"] * normal_force
     k_t = model.p["tangential_stiffness_ratio"] * stiffness
     size2 = sx**2 + sy**2
     ratio2 = sm.Min(k_t**2 * size2 / sm.Max(cap**2, _FORCE_FLOOR2), _RATIO2_CLIP)
     loading = sm.Max(sx*vx + sy*vy, 0) / sm.Max(size2, _LENGTH_FLOOR2)
-    # the DEM codes truncate the stored force to the cap also when the cap shrinks
-    # faster than k_t (unloading: cap / k_t ~ rho for Hertz): the second term
-    # relative rate of cap / k_t: dF_n/dt / F_n - rhodot / (2 rho) (Hertz undamped:
-    # rhodot / rho)
-    rho_floor = sm.Max(_positive(rho), _LENGTH_FLOOR)
-    relative = normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2)) \
-        - rhodot / (2 * rho_floor)
+    # dk_t/dt / k_t = rhodot / (2 rho)
+    stiffening = rhodot / (2 * _rho_floor(rho))
+    # the DEM codes truncate the stored force to the cap also when the cap shrinks faster
+    # than k_t: the second term, with the relative rate of cap / k_t,
+    # dF_n/dt / F_n - rhodot / (2 rho) (Hertz undamped: rhodot / rho)
+    relative = normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2)) - stiffening
     shrinking = _positive(-relative)
     excess = _positive(ratio2**(YIELD_EXPONENT // 2) - 1)     # 0 below the cap
     flow = excess * loading + sm.Min(excess, 1) * shrinking
-    dilution = _positive(rhodot) / (2 * sm.Max(_positive(rho), _LENGTH_FLOOR)) if dilute \
-        else sm.S.Zero
+    dilution = _positive(rhodot) / (2 * _rho_floor(rho)) if dilute else sm.S.Zero
     # the deflection only moves while the contact carries a load (F_n > 0): a contact
     # segment starts where its event located rho = 0, possibly a rounding below it, and
     # a damped normal force may reach 0 (its clamp) before rho does; the DEM codes'
@@ -250,9 +255,8 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     elastic = [-k_t * sx, -k_t * sy]
     size = sm.sqrt(sm.Max(k_t**2 * size2, cap**2, _FORCE_FLOOR2))
     capped = [f * cap / size for f in elastic]      # = elastic unless above the cap
-    # d/dt (1/2 k_t |s|^2) = k_t s.s' + 1/2 |s|^2 dk_t/dt, dk_t/dt = k_t rhodot / (2 rho)
-    storage = k_t * (sx*rate[0] + sy*rate[1]) \
-        + k_t * size2 / 2 * rhodot / (2 * sm.Max(_positive(rho), _LENGTH_FLOOR))
+    # d/dt (1/2 k_t |s|^2) = k_t s.s' + 1/2 |s|^2 dk_t/dt
+    storage = k_t * (sx*rate[0] + sy*rate[1]) + k_t * size2 / 2 * stiffening
     return capped, rate, storage, k_t
 
 
@@ -280,12 +284,12 @@ def compliant_model_force(model: Model, plane: str, jacobian_form=False):
     N = model.frame
     point, _, normal, slip = slip_kinematics(model, plane)
     _, _, rho, rhodot = contact_kinematics(model, plane)
-    f_n, stiffness = damped_normal(model, rho, rhodot, latch_symbols(model, plane)[0])
-    cap = model.p["friction_coefficient"] * f_n
     rate_at_impact = latch_symbols(model, plane)[0]
-    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact)
+    f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
+    cap = model.p["friction_coefficient"] * f_n
+    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
     capped, rate, storage, k_t = incremental_mindlin(model, plane, stiffness, rho, rhodot,
-                                                     f_n, slip, f_rate,
+                                                     f_n, cap, slip, f_rate,
                                                      dilute=not jacobian_form)
     viscous = capacity_damping(model, k_t, cap, capped, slip)
     tangential = [e + v for e, v in zip(capped, viscous)]

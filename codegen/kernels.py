@@ -66,6 +66,15 @@ def pack_mass(M: sm.Matrix) -> list:
     return J + B + [D]
 
 
+def _law_outputs(model, plane, force_map, law):
+    """A contact law's kernel outputs (CONTACT_LAW_LAYOUT) on ``plane``."""
+    N = model.frame
+    f = sm.Matrix([me.dot(law.force, v) for v in (N.x, N.y, N.z)])
+    dissipation = contact.dissipation_rates(model, plane, law)
+    deflection = law.deflection_rate or [0, 0]
+    return sm.Matrix([*(force_map * f), *f, *dissipation, *deflection])
+
+
 def derive(model: Model | None = None):
     """Derive everything once: returns (model, dict of sympy pieces)."""
     model = model or build_model()
@@ -93,17 +102,10 @@ def derive(model: Model | None = None):
         G = F.jacobian(sm.Matrix(contact_forces[plane]))   # generalized-force map, 6x3
         pieces[f"{plane}_force_map"] = G
         for name, function in contact.TANGENTIAL_LAWS.items():
-            law = function(model, plane)
-            f = sm.Matrix([me.dot(law.force, v) for v in (N.x, N.y, N.z)])
-            dissipation = contact.dissipation_rates(model, plane, law)
-            deflection = law.deflection_rate or [0, 0]
-            pieces[f"{plane}_{name}"] = sm.Matrix([*(G * f), *f, *dissipation, *deflection])
+            pieces[f"{plane}_{name}"] = _law_outputs(model, plane, G, function(model, plane))
             if name in contact.JACOBIAN_FORMS:
-                law = contact.JACOBIAN_FORMS[name](model, plane)
-                f = sm.Matrix([me.dot(law.force, v) for v in (N.x, N.y, N.z)])
-                dissipation = contact.dissipation_rates(model, plane, law)
-                pieces[f"{plane}_{name}_jacobian_form"] = sm.Matrix(
-                    [*(G * f), *f, *dissipation, *law.deflection_rate])
+                pieces[f"{plane}_{name}_jacobian_form"] = _law_outputs(
+                    model, plane, G, contact.JACOBIAN_FORMS[name](model, plane))
     return model, pieces
 
 
