@@ -260,6 +260,120 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     return capped, rate, storage, k_t
 
 
+#: |s|^2 below which the sliding mode's direction s/|s| is taken as 0 (m^2): far below
+#: any deflection the mode sees (a sliding contact starts at |s| = mu F_n / k_t of a
+#: penetration of ~1e-17 m, ~1e-18 m), and its square root (1e-140 m) is not subnormal.
+_DIRECTION_FLOOR2 = sm.Float(1e-280)
+#: k_t as a divisor (N/m): k_t is 0 only where F_n is 0 too (no penetration); far below
+#: any k_t in contact (~1 N/m at rho ~ 1e-17 m for the hardest materials, 1e-4 for a
+#: soft one), and large enough that the Jacobian's d(1/k_t) stays finite (its terms are
+#: multiplied by F_n = 0 there: a NaN otherwise).
+_STIFFNESS_FLOOR = sm.Float(1e-100)
+
+
+def capped_deflection(model: Model, k_t, stiffening, normal_force, normal_force_rate):
+    """The deflection at the Coulomb cap, s_cap = mu F_n / k_t (m), and its rate (m/s):
+    d/dt (mu F_n / k_t) = mu dF_n/dt / k_t - s_cap dk_t/dt / k_t, dk_t/dt / k_t =
+    ``stiffening`` = rhodot / (2 rho)."""
+    mu = model.p["friction_coefficient"]
+    stiffness = sm.Max(k_t, _STIFFNESS_FLOOR)
+    s_cap = mu * normal_force / stiffness
+    return s_cap, mu * normal_force_rate / stiffness - s_cap * stiffening
+
+
+def sliding_direction(model: Model, plane: str):
+    """The unit deflection e = s/|s| (2), 0 where |s|^2 < 1e-280 m^2."""
+    sx, sy = deflection_symbols(model, plane)
+    size = sm.sqrt(sm.Max(sx**2 + sy**2, _DIRECTION_FLOOR2))
+    return [sx / size, sy / size]
+
+
+def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, cap, slip,
+                    normal_force_rate, direction):
+    """The incremental Mindlin spring in its sliding mode: the DEM codes' truncation in
+    the limit dt -> 0 (docs/contact_laws.md, "Exact elastic and sliding modes").
+
+    The stored force sits at the cap, F_el = -mu F_n e with e = s/|s| (``direction``);
+    |s| follows s_cap = mu F_n / k_t and e turns with the slip velocity's part across
+    it: s' = v_t - (e . v_t) e + e ds_cap/dt, which keeps |s| = s_cap and gives
+    de/dt = (v_t - (e . v_t) e) / |s|, the truncated increment's direction.  Returns
+    (applied force (2), deflection rate (2), rate of the stored energy 1/2 k_t |s|^2
+    (W), k_t).  No viscous damping: it is dropped while sliding (capacity 0).
+    """
+    sx, sy = deflection_symbols(model, plane)
+    vx, vy = slip
+    ex, ey = direction
+    k_t = model.p["tangential_stiffness_ratio"] * stiffness
+    stiffening = rhodot / (2 * _rho_floor(rho))
+    _, s_cap_rate = capped_deflection(model, k_t, stiffening, normal_force, normal_force_rate)
+    along = ex * vx + ey * vy
+    in_contact = normal_force / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
+    rate = [in_contact * (v - along * e + e * s_cap_rate) for v, e in zip((vx, vy), (ex, ey))]
+    force = [-cap * ex, -cap * ey]
+    storage = k_t * (sx*rate[0] + sy*rate[1]) + k_t * (sx**2 + sy**2) / 2 * stiffening
+    return force, rate, storage, k_t
+
+
+def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
+    """The compliant law's sliding mode (``<plane>_compliant_sliding``): the same normal
+    force, the tangential force -mu F_n e at the cap (sliding_mindlin).
+    ``jacobian_form``: the direction e enters as symbols defined before the kernel's
+    code (``ContactLaw.frozen``), so the Jacobian leaves out de/ds ~ 1/|s|, singular at
+    a contact that starts sliding (see JACOBIAN_FORMS)."""
+    N = model.frame
+    point, _, normal, slip = slip_kinematics(model, plane)
+    _, _, rho, rhodot = contact_kinematics(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
+    cap = model.p["friction_coefficient"] * f_n
+    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
+    exact = sliding_direction(model, plane)
+    frozen = None
+    direction = exact
+    if jacobian_form:
+        direction = list(sm.symbols(f"{plane}_sliding_direction_x {plane}_sliding_direction_y"))
+        frozen = list(zip(direction, exact))
+    tangential, rate, storage, _ = sliding_mindlin(model, plane, stiffness, rho, rhodot, f_n,
+                                                   cap, slip, f_rate, direction)
+    force = f_n*normal + tangential[0]*N.x + tangential[1]*N.y
+    return ContactLaw(point, force, sm.S.One, deflection_rate=rate,
+                      tangential_storage=storage, frozen=frozen)
+
+
+def compliant_margins(model: Model, plane: str):
+    """The guards of the compliant law's modes on ``plane`` (``<plane>_compliant_margins``):
+
+    * yield margin 1 - k_t |s| / (mu F_n) (1): the elastic mode ends where it falls
+      below 0;
+    * re-stick margin (m/s): (e . v_t - max(rhodot, 0)/(2 rho) |s|) - ds_cap/dt, how much
+      faster the elastic law would stretch the spring than the cap grows; the sliding
+      mode ends where it falls below 0;
+    * s_cap = mu F_n / k_t (m) and k_t (N/m): what a mode change resets to.
+    """
+    _, _, _, slip = slip_kinematics(model, plane)
+    _, _, rho, rhodot = contact_kinematics(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
+    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
+    sx, sy = deflection_symbols(model, plane)
+    k_t = model.p["tangential_stiffness_ratio"] * stiffness
+    stiffening = rhodot / (2 * _rho_floor(rho))
+    s_cap, s_cap_rate = capped_deflection(model, k_t, stiffening, f_n, f_rate)
+    size = sm.sqrt(sx**2 + sy**2)
+    ex, ey = sliding_direction(model, plane)
+    dilution = _positive(rhodot) / (2 * _rho_floor(rho))
+    stretch = ex * slip[0] + ey * slip[1] - dilution * size
+    cap = model.p["friction_coefficient"] * f_n
+    yield_margin = 1 - k_t * size / sm.Max(cap, sm.sqrt(_FORCE_FLOOR2))
+    # with no load (F_n = 0: the contact's last instants, or its clamp) both modes apply
+    # no tangential force and the deflection stands still: neither guard fires (1, and
+    # 1 m/s: any positive value)
+    in_contact = sm.Heaviside(f_n, 0)
+    idle = 1 - in_contact
+    return [in_contact * yield_margin + idle, in_contact * (stretch - s_cap_rate) + idle,
+            s_cap, k_t]
+
+
 def capacity_damping(model: Model, k_t, cap, capped, slip):
     """The viscous tangential force (2) within the capacity the elastic force leaves:
     V = -c_t v_t, c_t = 2 gamma_t sqrt(m* k_t), scaled by
@@ -315,6 +429,9 @@ class ContactLaw:
     weight: sm.Expr            # share of the Hertz spring this law carries
     deflection_rate: list | None = None   # d/dt of the plane's deflection states
     tangential_storage: sm.Expr | None = None  # d/dt of its tangential spring's energy
+    #: [(symbol, expression)] computed before the Jacobian kernel's code and held
+    #: constant by its differentiation (a Jacobian form's frozen quantities)
+    frozen: list | None = None
 
 
 #: Laws whose Jacobian kernel is derived from a form of the law other than its value
@@ -326,14 +443,20 @@ class ContactLaw:
 #: compliant seed throw drifted by 18 J at rtol 1e-8; scipy's Radau the same).  The
 #: Jacobian leaves the term out: a stiffness underestimated by 1/(2t) where the steps
 #: are ~t costs Newton little and never converges falsely (docs/contact_laws.md).
+#: The sliding mode's direction e = s/|s| has de/ds ~ 1/|s|, ~1e18 /s at a contact that
+#: starts sliding (|s| ~ 1e-18 m there): the same trap, so its Jacobian holds e fixed
+#: (the stabilising turn of e towards v_t, a rate ~ 1/t, is left to Newton).
 JACOBIAN_FORMS = {
     "compliant": lambda model, plane: compliant_model_force(model, plane, jacobian_form=True),
+    "compliant_sliding": lambda model, plane: compliant_sliding_force(model, plane,
+                                                                      jacobian_form=True),
 }
 
 TANGENTIAL_LAWS = {
     "friction": friction_model_force,
     "digin": digin_model_force,
     "compliant": compliant_model_force,
+    "compliant_sliding": compliant_sliding_force,
 }
 
 

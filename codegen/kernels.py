@@ -104,18 +104,21 @@ def derive(model: Model | None = None):
         for name, function in contact.TANGENTIAL_LAWS.items():
             pieces[f"{plane}_{name}"] = _law_outputs(model, plane, G, function(model, plane))
             if name in contact.JACOBIAN_FORMS:
-                pieces[f"{plane}_{name}_jacobian_form"] = _law_outputs(
-                    model, plane, G, contact.JACOBIAN_FORMS[name](model, plane))
+                form = contact.JACOBIAN_FORMS[name](model, plane)
+                pieces[f"{plane}_{name}_jacobian_form"] = _law_outputs(model, plane, G, form)
+                pieces[f"{plane}_{name}_frozen"] = form.frozen or []
     return model, pieces
 
 
-def jacobian_kernel(model, name, doc, outputs, extra=(), extra_doc="", prefix="j"):
-    """Kernel of d(outputs)/d(state), row-major, by forward_jacobian."""
+def jacobian_kernel(model, name, doc, outputs, extra=(), extra_doc="", prefix="j", frozen=()):
+    """Kernel of d(outputs)/d(state), row-major, by forward_jacobian.  ``frozen``:
+    [(symbol, expression)] computed first and differentiated as constants."""
     states = plain_symbols(model.states)
     replacements = dict(zip(model.states, states))
     outputs = [sm.sympify(e).xreplace(replacements) for e in outputs]
+    leading = [(symbol, sm.sympify(e).xreplace(replacements)) for symbol, e in frozen]
     definitions, jac = forward_jacobian(outputs, states, prefix)
-    return Kernel(name, doc, jac, list(extra), extra_doc, definitions)
+    return Kernel(name, doc, jac, list(extra), extra_doc, leading + definitions)
 
 
 def _dynamics_kernels(model, name, M, F, what):
@@ -166,7 +169,8 @@ def build_kernels():
                 "contact.JACOBIAN_FORMS)"
             kernels.append(jacobian_kernel(model, f"{plane}_{law}_jac", f"{doc} d(outputs)/dx "
                                            f"({len(outputs)}x{n} row-major){note}.", list(form),
-                                           latch, extra_doc))
+                                           latch, extra_doc,
+                                           frozen=pieces.get(f"{plane}_{law}_frozen", ())))
         # Exact (event-driven) Coulomb friction applies the tangential force itself and
         # takes only the friction law's normal share: the law with mu = 0, whose
         # regularised Coulomb part (two square roots and a division) then drops out.
@@ -180,6 +184,14 @@ def build_kernels():
                                        list(outputs), latch, extra_doc))
     for plane in PLANES:
         kernels.append(slip_kernel(model, plane, pieces[f"{plane}_force_map"]))
+    for plane in PLANES:
+        kernels.append(Kernel(
+            f"{plane}_compliant_margins",
+            f"{plane} contact, the compliant law's mode guards (contact.compliant_margins): "
+            "yield margin 1 - k_t |s| / (mu F_n), re-stick margin (m/s), s_cap = mu F_n / k_t "
+            "(m), k_t (N/m).", contact.compliant_margins(model, plane),
+            list(contact.latch_symbols(model, plane)),
+            "latched rhodot^-, d_x, d_y, d_z of this plane"))
     kernels += output_kernels(model)
     return model, kernels
 

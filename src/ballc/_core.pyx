@@ -60,6 +60,11 @@ cdef extern from "_system.h":
     int ballc_remove_slip(const double *, const double *, int, int, double *) nogil
     int BALLC_FLOOR_SLIP, BALLC_CEILING_SLIP, BALLC_FLOOR_STICK, BALLC_CEILING_STICK
     int BALLC_FLOOR_SLIP_FIXED, BALLC_CEILING_SLIP_FIXED
+    int BALLC_FLOOR_COMPLIANT_SLIDING, BALLC_CEILING_COMPLIANT_SLIDING
+    int ballc_compliant_margins(const double *, const double *, const double *, int,
+                                double *) nogil
+    int ballc_compliant_margins_prepared(const double *, const ballc_parameters_t *,
+                                         const double *, int, double *) nogil
 
 N_STATES = BALLC_N_STATES
 N_PARAMETERS = BALLC_N_PARAMETERS
@@ -90,6 +95,8 @@ FLAGS = {
     "ceiling_stick": BALLC_CEILING_STICK,
     "floor_slip_fixed": BALLC_FLOOR_SLIP_FIXED,
     "ceiling_slip_fixed": BALLC_CEILING_SLIP_FIXED,
+    "floor_compliant_sliding": BALLC_FLOOR_COMPLIANT_SLIDING,
+    "ceiling_compliant_sliding": BALLC_CEILING_COMPLIANT_SLIDING,
 }
 ENERGY_NOUT = BALLC_ENERGY_NOUT
 CONTACT_KINEMATICS_NOUT = BALLC_CONTACT_KINEMATICS_NOUT
@@ -317,6 +324,23 @@ def stick_state(const double[::1] y, const double[::1] params, const double[::1]
     cdef int status = ballc_stick_state(&y[0], &params[0], &latch[0], flags, plane, &o[0])
     if status != BALLC_OK:
         raise FloatingPointError(f"stick state failed with C status {status}")
+    return out
+
+
+def compliant_margins(const double[::1] y, const double[::1] params, const double[::1] latch,
+                      int plane):
+    """The compliant law's mode guards on ``plane`` at state y: (yield margin
+    1 - k_t |s| / (mu F_n) (1), re-stick margin (m/s), s_cap = mu F_n / k_t (m), k_t (N/m));
+    see codegen/contact.py, compliant_margins.  Raises if they are not finite."""
+    _check("y", y.shape[0], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check("latch", latch.shape[0], BALLC_N_LATCH)
+    _plane_index(plane)
+    out = np.empty(4)
+    cdef double[::1] o = out
+    cdef int status = ballc_compliant_margins(&y[0], &params[0], &latch[0], plane, &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"compliant margins failed with C status {status}")
     return out
 
 

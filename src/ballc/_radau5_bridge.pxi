@@ -97,8 +97,9 @@ ctypedef struct ball_ctx:
     ballc_parameters_t prepared   # params and their constants, prepared once per segment
     double *latch            # writable: a re-armed event may change it
     int flags
-    const int *event_plane   # per event: 0/1 stick release of that plane, -1 linear,
-                             # -2 - k the user's Python event k
+    const int *event_plane   # per event: 0/1 stick release of that plane, 2/3 the
+                             # compliant yield margin, 4/5 its re-stick margin, -1
+                             # linear, -2 - k the user's Python event k
     void *user_events        # list of the user's event callables (borrowed)
     void *errors             # list collecting exceptions raised by them (borrowed)
     void *rearms             # per event: its ``rearm`` callable or None (borrowed)
@@ -114,14 +115,20 @@ cdef int _ball_jac(void *ctx, double t, const double *y, double *jac) noexcept n
     return ballc_jacobian_checked_inputs(y, &c.prepared, c.latch, c.flags, jac)
 
 cdef int _ball_event(void *ctx, int e, double t, const double *y, double *g) noexcept nogil:
-    """The stick-to-slip margin mu N - |lambda| of the event's plane, or a user event."""
+    """The stick-to-slip margin mu N - |lambda| of the event's plane, a compliant mode
+    guard (yield or re-stick margin), or a user event."""
     cdef ball_ctx *c = <ball_ctx *>ctx
     cdef double out[4]
     cdef int plane = c.event_plane[e]
+    cdef int status
     if plane <= -2:
         with gil:
             return _user_event(c, -2 - plane, t, y, g)
-    cdef int status = ballc_stick_state(y, c.params, c.latch, c.flags, plane, out)
+    if plane >= 2:
+        status = ballc_compliant_margins_prepared(y, &c.prepared, c.latch, plane % 2, out)
+        g[0] = out[(plane - 2) // 2]
+        return status
+    status = ballc_stick_state(y, c.params, c.latch, c.flags, plane, out)
     g[0] = out[3]
     return status
 
@@ -304,11 +311,12 @@ def terminal_count(terminal) -> int:
 
 
 def _event_arrays(events, int n):
-    """Linear events (``coefficients``, ``offset``), stick-release events
-    (``stick_plane``, ``offset``: g = mu N - |lambda| + offset, evaluated in C) and, for
+    """Linear events (``coefficients``, ``offset``), events the system evaluates in C
+    (``system_event``, ``offset``: 0/1 the stick release mu N - |lambda| + offset of the
+    floor/ceiling, 2/3 the compliant yield margin, 4/5 its re-stick margin) and, for
     ballc's system, any other callable g(t, y) (a user event, called from C).
     Returns (m, coef, offset, ints, user callables, rearms); ``ints`` (5 rows):
-    terminal, direction, plane (-1 linear, 0/1 stick release, -2 - k the user's event
+    terminal, direction, plane (-1 linear, 0..5 a system event, -2 - k the user's event
     k), nonlinear (not evaluated from ``coef``) and re-armable (a terminal linear event
     with a ``rearm`` callable, see solve_system); ``rearms``: per event, that callable
     or None."""
@@ -330,8 +338,8 @@ def _event_arrays(events, int n):
             row = _checked_row(f"events[{k}].coefficients", c, n)
             cv[k, :] = row
             offset[k] = float(getattr(e, "offset", 0.0))
-        elif hasattr(e, "stick_plane"):
-            iv[2, k] = int(e.stick_plane)
+        elif hasattr(e, "system_event"):
+            iv[2, k] = int(e.system_event)
             iv[3, k] = 1
             offset[k] = float(getattr(e, "offset", 0.0))
         elif callable(e):
@@ -340,8 +348,8 @@ def _event_arrays(events, int n):
             users.append(e)
         else:
             raise TypeError(f"events[{k}] = {e!r} is neither a linear event (`coefficients` "
-                            "and `offset`: g(y) = coefficients . y + offset), a stick-release "
-                            "event (`stick_plane`) nor a callable g(t, y)")
+                            "and `offset`: g(y) = coefficients . y + offset), a system "
+                            "event (`system_event`) nor a callable g(t, y)")
         iv[0, k] = terminal_count(getattr(e, "terminal", False))
         dirn = float(getattr(e, "direction", 0))
         iv[1, k] = (dirn > 0) - (dirn < 0)
@@ -520,7 +528,7 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
             event_plane[k] = iv[2, k]
         elif iv[3, k]:
             raise TypeError("this system takes linear events only (`coefficients` and "
-                            "`offset`): stick-release and callable events need ballc's "
+                            "`offset`): system and callable events need ballc's "
                             "system (solve_system)")
     if event_plane is not None:
         users.extend(found)
@@ -591,8 +599,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
     ``_core.System``.  ``events``: objects with ``coefficients`` (N_STATES),
     ``offset``, ``terminal`` and ``direction`` -- g(y) = coefficients . y + offset --
-    or with ``stick_plane`` (0 floor, 1 ceiling) instead of ``coefficients``: the
-    stick-to-slip margin mu N - |lambda| + offset of that plane, evaluated in C; or
+    or with ``system_event`` instead of ``coefficients``: a margin evaluated in C plus
+    ``offset`` (0/1: the stick-to-slip margin mu N - |lambda| of the floor/ceiling;
+    2/3: the compliant law's yield margin, 4/5: its re-stick margin); or
     any other callable g(t, y) with optional ``terminal``/``direction`` (called from C
     with the GIL; an exception it raises is re-raised after the integration).  A
     terminal linear event may carry ``rearm``: a callable (t, y) -> None or

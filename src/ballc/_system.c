@@ -28,11 +28,15 @@ CONTACT_LAWS[] = {
      ballc_floor_friction_normal, ballc_floor_friction_normal_jac},
     {BALLC_FLOOR_DIGIN, ballc_floor_digin, ballc_floor_digin_jac, 0, NULL, NULL},
     {BALLC_FLOOR_COMPLIANT, ballc_floor_compliant, ballc_floor_compliant_jac, 0, NULL, NULL},
+    {BALLC_FLOOR_COMPLIANT_SLIDING, ballc_floor_compliant_sliding,
+     ballc_floor_compliant_sliding_jac, 0, NULL, NULL},
     {BALLC_CEILING_FRICTION, ballc_ceiling_friction, ballc_ceiling_friction_jac, 1,
      ballc_ceiling_friction_normal, ballc_ceiling_friction_normal_jac},
     {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac, 1, NULL, NULL},
     {BALLC_CEILING_COMPLIANT, ballc_ceiling_compliant, ballc_ceiling_compliant_jac, 1,
      NULL, NULL},
+    {BALLC_CEILING_COMPLIANT_SLIDING, ballc_ceiling_compliant_sliding,
+     ballc_ceiling_compliant_sliding_jac, 1, NULL, NULL},
 };
 #define N_CONTACT_LAWS (sizeof CONTACT_LAWS / sizeof CONTACT_LAWS[0])
 #define LAW_NOUT BALLC_CONTACT_LAW_NOUT
@@ -374,6 +378,27 @@ int ballc_stick_state(const double *state, const double *params, const double *l
     out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]
              - hypot(out[0], out[1]);
     return all_finite(out, 4) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+static const kernel_fn MARGIN_KERNELS[BALLC_N_PLANES] = {
+    ballc_floor_compliant_margins, ballc_ceiling_compliant_margins};
+
+int ballc_compliant_margins_prepared(const double *state, const ballc_parameters_t *params,
+                                     const double *latch, int plane, double *out)
+{
+    MARGIN_KERNELS[plane](state, PARAMS(params), law_latch(latch, plane), out);
+    return all_finite(out, BALLC_FLOOR_COMPLIANT_MARGINS_NOUT) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+int ballc_compliant_margins(const double *state, const double *params, const double *latch,
+                            int plane, double *out)
+{
+    for (int i = 0; i < BALLC_FLOOR_COMPLIANT_MARGINS_NOUT; i++) out[i] = NAN;
+    if (plane < 0 || plane >= BALLC_N_PLANES) return BALLC_SINGULAR;
+    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
+    ballc_parameters_t prepared;
+    ballc_parameters_init(&prepared, params);
+    return ballc_compliant_margins_prepared(state, &prepared, latch, plane, out);
 }
 
 int ballc_remove_slip(const double *state, const double *params, int flags, int plane,

@@ -35,7 +35,12 @@ enum {
      * last approach to zero slip and the first departure from it, where u/|u| is
      * singular (the driver switches to SLIP once |u| is clear of zero). */
     BALLC_FLOOR_SLIP_FIXED = 2048,
-    BALLC_CEILING_SLIP_FIXED = 4096
+    BALLC_CEILING_SLIP_FIXED = 4096,
+    /* The compliant law's sliding mode (instead of the plane's COMPLIANT flag, which is
+     * its elastic mode): the stored tangential force at the Coulomb cap, -mu F_n s/|s|
+     * (codegen/contact.py, compliant_sliding_force). */
+    BALLC_FLOOR_COMPLIANT_SLIDING = 8192,
+    BALLC_CEILING_COMPLIANT_SLIDING = 16384
 };
 
 /* Sum of the contact forces on the ball, per plane (floor x y z, ceiling x y z). */
@@ -66,6 +71,15 @@ typedef struct {
 } ballc_parameters_t;
 
 void ballc_parameters_init(ballc_parameters_t *prepared, const double *params);
+
+/* The compliant law's mode guards on ``plane`` (0 floor, 1 ceiling): out[0] the yield
+ * margin 1 - k_t |s| / (mu F_n) (1), out[1] the re-stick margin (m/s), out[2] s_cap =
+ * mu F_n / k_t (m), out[3] k_t (N/m); see contact.compliant_margins. */
+int ballc_compliant_margins(const double *state, const double *params, const double *latch,
+                            int plane, double *out);
+/* The same with the parameters prepared (the integrator's adapter: inputs checked). */
+int ballc_compliant_margins_prepared(const double *state, const ballc_parameters_t *params,
+                                     const double *latch, int plane, double *out);
 
 /* ballc_rhs and ballc_jacobian for callers that have checked once that params and latch
  * are finite and prepared the parameters (the integrator's adapters, per segment): only

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from . import _core, layout, stickslip
+from . import _core, compliantmodes, layout, stickslip
 
 PLANES = ("floor", "ceiling")
 _STATE = layout.INDEX
@@ -137,7 +137,7 @@ def contact_threshold(scene, plane, rho0, entering):
 
 
 def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
-                    clear=0.0, approach=None, rearm=None):
+                    clear=0.0, approach=None, rearm=None, compliant=None):
     """Events of one segment starting at state y0: [(kind, plane, event)].
 
     ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
@@ -147,7 +147,9 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
     zero).  The stop and release events sit a rounding-level margin past their zero,
     so that a segment starting on it (slip from rest, a stick that starts at the cone)
     does not fire at once.  ``rearm`` (optional): plane -> the ``rearm`` callable of
-    that plane's approach event (see :class:`LinearEvent`).
+    that plane's approach event (see :class:`LinearEvent`).  ``compliant`` (optional,
+    per plane): the compliant law's mode ("starting", "elastic", "sliding" or None; see
+    ballc.compliantmodes), whose guard ends the segment.
     """
     events = []
     for plane in PLANES:
@@ -180,6 +182,15 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
             load = _core.stick_state(y0, params, latch, flags, PLANES.index(plane))[2]
             events.append(("release", plane, StickRelease(
                 plane, params, latch, flags, stickslip.force_scale(scene, load))))
+        law_mode = compliant[plane] if compliant else None
+        if law_mode is not None:
+            kind, offset = compliantmodes.guard(scene, law_mode, y0, params, latch, plane,
+                                                rho0)
+            if kind == "arm":     # the penetration rising through the arming depth
+                events.append((kind, plane, rho.shifted(offset, True, 1)))
+            else:
+                events.append((kind, plane, CompliantGuard(plane, kind, params, latch,
+                                                           offset)))
     return events
 
 
@@ -187,14 +198,14 @@ class StickRelease:
     """The stick-to-slip event of ``plane``: g = mu N - |lambda| + offset (N).
 
     Callable like a solve_ivp event (evaluated through ``_core``); radau5 reads
-    ``stick_plane`` and ``offset`` and evaluates it in C.
+    ``system_event`` (the plane's index) and ``offset`` and evaluates it in C.
     """
 
-    __slots__ = ("stick_plane", "offset", "terminal", "direction", "_params", "_latch",
-                 "_flags")
+    __slots__ = ("stick_plane", "system_event", "offset", "terminal", "direction", "_params",
+                 "_latch", "_flags")
 
     def __init__(self, plane: str, params, latch, flags: int, offset: float):
-        self.stick_plane = PLANES.index(plane)
+        self.stick_plane = self.system_event = PLANES.index(plane)
         self.offset = float(offset)
         self.terminal = True
         self.direction = -1
@@ -210,3 +221,35 @@ class StickRelease:
     def __repr__(self):
         return (f"StickRelease({PLANES[self.stick_plane]}: mu N - |lambda| + "
                 f"{self.offset:g})")
+
+
+class CompliantGuard:
+    """A guard of the compliant law's modes on ``plane`` (see ballc.compliantmodes):
+    ``kind`` "yield" (the elastic mode's end: g = 1 - k_t |s| / (mu F_n) + offset) or
+    "restick" (the sliding mode's end: g = the re-stick margin + offset, m/s), falling
+    through 0.
+
+    Callable like a solve_ivp event (evaluated through ``_core``); radau5 reads
+    ``system_event`` and ``offset`` and evaluates it in C.
+    """
+
+    KINDS = ("yield", "restick")
+    __slots__ = ("plane", "kind", "system_event", "offset", "terminal", "direction",
+                 "_params", "_latch")
+
+    def __init__(self, plane: str, kind: str, params, latch, offset: float):
+        self.plane, self.kind = PLANES.index(plane), kind
+        self.system_event = 2 + 2 * self.KINDS.index(kind) + self.plane
+        self.offset = float(offset)
+        self.terminal = True
+        self.direction = -1
+        self._params = np.ascontiguousarray(params, dtype=float)
+        self._latch = np.array(latch, dtype=float)
+
+    def __call__(self, t, y):
+        y = np.ascontiguousarray(y, dtype=float)
+        margins = _core.compliant_margins(y, self._params, self._latch, self.plane)
+        return float(margins[self.KINDS.index(self.kind)]) + self.offset
+
+    def __repr__(self):
+        return f"CompliantGuard({PLANES[self.plane]} {self.kind} + {self.offset:g})"

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from . import _core, stickslip
+from . import _core, compliantmodes, stickslip
 
 PLANES = ("floor", "ceiling")
 _KIN_PER_PLANE = _core.CONTACT_KINEMATICS_NOUT // len(PLANES)
@@ -21,18 +21,19 @@ _KIN_PER_PLANE = _core.CONTACT_KINEMATICS_NOUT // len(PLANES)
 MIN_IMPACT_RATE = 1e-9
 
 
-def flags(scene, in_contact, coulomb=None):
+def flags(scene, in_contact, coulomb=None, compliant=None):
     """The C flags of a segment: the observer's kernels (when it has mass), each
     contact's laws (compliant; or friction and/or dig-in by the mixture) and, with
     ``coulomb`` (plane -> "slip", "slip_fixed", "stick" or None), each contact's
-    exact Coulomb mode."""
+    exact Coulomb mode; with ``compliant`` (plane -> "elastic", "sliding" or None),
+    each compliant contact's mode (ballc.compliantmodes)."""
     flags = _core.FLAGS["observer"] if scene.observer_mass != 0 else 0
     mixture = scene.effective_mixture
     for plane in PLANES:
         if not in_contact[plane]:
             continue
         if scene.tangential_model == "compliant":
-            flags |= _core.FLAGS[f"{plane}_compliant"]
+            flags |= compliantmodes.mode_flags(plane, compliant[plane] if compliant else None)
             continue
         if mixture < 1:
             flags |= _core.FLAGS[f"{plane}_friction"]

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from . import _core, events as ev, layout, modes, outcome, resting, stickslip
+from . import _core, compliantmodes, events as ev, layout, modes, outcome, resting, stickslip
 from ._format import plain
 from .dense import PiecewiseSolution
 from .flight import FreeFlight
@@ -33,7 +33,7 @@ _QUATERNION, _DISSIPATED, _DEFLECTION = layout.QUATERNION, layout.DISSIPATED, la
 _CENTRE_XY = layout.rows("x", 2)
 SUCCESS = "The solver successfully reached the end of the integration interval."
 #: Events after which the next segment starts with the last segment's next step size.
-CARRY_STEP = ("approach", "stop", "clear", "release")
+CARRY_STEP = ("approach", "stop", "clear", "release", "arm", "yield", "restick")
 
 
 def check_initial_state(scene, y0):
@@ -73,6 +73,8 @@ class _Run:
         self.latch = np.zeros(_core.N_LATCH)
         self.t, self.y = 0.0, y
         self.exact = stickslip.uses_exact_coulomb(scene)
+        self.compliant_modes = compliantmodes.uses_modes(scene)
+        self.compliant: dict[str, str | None] = {plane: None for plane in PLANES}
         self.in_contact = {plane: False for plane in PLANES}
         self.coulomb: dict[str, str | None] = {plane: None for plane in PLANES}
         self.approach: dict[str, float | None] = {plane: None for plane in PLANES}
@@ -91,11 +93,13 @@ class _Run:
 
     def flags(self, with_coulomb=True):
         key = (self.in_contact["floor"], self.in_contact["ceiling"],
-               self.coulomb["floor"], self.coulomb["ceiling"], with_coulomb)
+               self.coulomb["floor"], self.coulomb["ceiling"], with_coulomb,
+               self.compliant["floor"], self.compliant["ceiling"])
         found = self._flags.get(key)
         if found is None:   # a run visits a handful of modes: compute each once
             found = self._flags[key] = modes.flags(
-                self.scene, self.in_contact, self.coulomb if with_coulomb else None)
+                self.scene, self.in_contact, self.coulomb if with_coulomb else None,
+                self.compliant)
         return found
 
     # ---- contacts ----
@@ -122,18 +126,55 @@ class _Run:
             if plane == resting.resting_plane(self.scene) else math.inf
         if self.exact:
             self.start_coulomb(plane)
+        if self.compliant_modes:
+            if ev.penetration(plane, self.scene)(0, y) < compliantmodes.arm_penetration(
+                    self.scene, plane):
+                self.set_compliant(plane, "starting")
+            else:   # a scene that starts in contact: the guards are armed at once
+                mode, self.y = compliantmodes.decide(y, self.params, self.latch, plane)
+                self.set_compliant(plane, mode)
 
     def end_contact(self, plane):
         y = self.y
         self.rest_check.pop(plane, None)
         self.in_contact[plane] = False
-        self.coulomb[plane] = self.approach[plane] = None
+        self.coulomb[plane] = self.approach[plane] = self.compliant[plane] = None
         contact = self.open.pop(plane)
         contact.t_end = self.t
         contact.velocity_after = y[layout.VELOCITY].copy()
         contact.angular_velocity_after = y[layout.ANGULAR_VELOCITY].copy()
         lost = y[_DISSIPATED] - self.dissipated_at_start.pop(plane)
         contact.energy_lost_normal, contact.energy_lost_tangential = map(float, lost)
+
+    # ---- the compliant law's modes (ballc.compliantmodes) ----
+
+    def set_compliant(self, plane, mode):
+        """Enter the compliant law's ``mode`` on ``plane`` now; the contact records its
+        phases as Coulomb's: "slip" (sliding, at the cap) and "stick" (elastic, or its
+        start before the guards are armed)."""
+        self.compliant[plane] = mode
+        self.transitions[plane] += 1
+        phase = "slip" if mode == "sliding" else "stick"
+        record = self.open[plane].transitions
+        if not record or record[-1][1] != phase:
+            record.append((self.t, phase))
+
+    def compliant_event(self, kind, plane):
+        """The compliant law's next mode after its guard ``kind`` fired on ``plane``."""
+        self.stalled = self.stalled_at(self.t)
+        self.last_transition = self.t
+        if self.unsettled(plane, self.stalled):
+            self.status = -1
+            self.message = (f"the compliant law's elastic/sliding transitions on the {plane} "
+                            f"did not settle: {self.transitions[plane]} mode changes in one "
+                            f"contact, {self.stalled} of them at t = {self.t:.17g} s")
+            return
+        if kind in ("arm", "yield"):
+            mode, self.y = compliantmodes.decide(self.y, self.params, self.latch, plane)
+            self.set_compliant(plane, mode)
+        else:
+            self.y = compliantmodes.restick(self.y, self.params, self.latch, plane)
+            self.set_compliant(plane, "elastic")
 
     # ---- exact Coulomb modes (ballc.stickslip) ----
 
@@ -334,6 +375,8 @@ class _Run:
             self.status = 1
             self.message = (f"ball passed through the {plane} at t = {self.t:.6g} s "
                             "(penetration reached the ball's radius)")
+        elif kind in compliantmodes.GUARDS:
+            self.compliant_event(kind, plane)
         else:
             self.coulomb_event(kind, plane)
 
@@ -457,7 +500,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         system = _core.System(run.params, run.latch, flags)
         driver_events = ev.segment_events(scene, run.in_contact, run.y, run.coulomb,
                                           run.params, run.latch, flags, run.clear_speed(),
-                                          run.approach, run.rearm_approach)
+                                          run.approach, run.rearm_approach, run.compliant)
         run.rearmed = []
         rest_plane, t_stop = run.rest_candidate() if checks_rest else (None, math.inf)
         t_stop = min(t_stop, t_end)   # a rest check ends the segment there

@@ -1,0 +1,145 @@
+"""The compliant law's Coulomb cap as exact modes: elastic and sliding.
+
+The DEM codes step the incremental Mindlin spring explicitly and truncate the stored
+force to the cap mu F_n after each step.  In the limit dt -> 0 that is a hybrid system
+with two modes per contact (docs/contact_laws.md, "Exact elastic and sliding modes"):
+
+* **elastic** (below the cap; the ``<plane>_compliant`` kernels): the spring is elastic,
+  s' = v_t - max(rhodot, 0)/(2 rho) s, F_el = -k_t s, with viscous damping within the
+  capacity the elastic force leaves.  Guard **yield**: mu F_n - k_t |s| falls below 0
+  (the spring reaches the cap, stretched by the slip or by a cap that shrinks).
+* **sliding** (at the cap; the ``<plane>_compliant_sliding`` kernels): F = -mu F_n e,
+  e = s/|s|, with |s| = s_cap = mu F_n / k_t and e turning with the slip velocity:
+  s' = v_t - (e . v_t) e + e ds_cap/dt.  Guard **restick**: the elastic law would
+  stretch the spring slower than the cap grows, (e . v_t - max(rhodot, 0)/(2 rho) |s|)
+  - ds_cap/dt falls below 0.
+
+At a contact start (s = 0) the mode is the one whose solution exists: sliding when
+the spring, started at the cap along the slip velocity, would outgrow it (the
+re-stick margin there is >= 0; for Hunt-Crossley this is kappa |v_t| >= mu (1 + chi)
+rhodot^-, the ratio of the self-similar start s = 2/3 v_t t), elastic otherwise.  At a
+re-stick the deflection is reset to |s| = s_cap exactly (ds_cap/dt uses the penetration
+acceleration of a ball in one contact, -F_n/m* + g n_z, so with an observer |s| drifts
+from s_cap by the integration of that difference); the spring energy the reset removes
+or adds is booked to the tangential dissipated work, so the energy balance stays exact.
+
+With ``friction_regularization`` "max" or "smooth" the law runs without modes, capped
+by its smooth yield alone (contact.YIELD_EXPONENT).  This module holds the decisions at
+the mode boundaries; the driver (simulate.py) holds the segment loop.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _core, layout, stickslip
+
+PLANES = ("floor", "ceiling")
+#: The modes: "starting" is the elastic mode before its guards are armed.
+MODES = ("starting", "elastic", "sliding")
+#: The guards' event kinds: the starting mode's, the elastic mode's, the sliding mode's.
+GUARDS = ("arm", "yield", "restick")
+_DEFLECTION = layout.DEFLECTION
+_DISSIPATED_TANGENTIAL = layout.INDEX["dissipated_tangential"]
+
+#: The guards are armed once the penetration reaches ARM_ULPS units in the last place of
+#: the plane's position (rho = r - z is resolved to one of them): before, rho's rounding
+#: alone moves the margins by more than 1e-6 of themselves (at the contact start, by
+#: 10 %), and mode changes would follow rounding.  Up to there the contact is in its
+#: self-similar start, whose mode does not change; the elastic kernels' smooth yield
+#: caps it meanwhile.  (4e-13 m for a 2.5-mm ball, 4e-12 m for the seed's: 1e-7 of
+#: their peak penetrations.)
+ARM_ULPS = 2.0 ** 20
+
+#: A sliding start with s_cap = 0 takes this |s| (m) along the slip, so that its
+#: direction s/|s| is defined (the kernels take s/|s| as 0 below |s| = 1e-140 m).
+START_DEFLECTION = 1e-100
+
+
+def uses_modes(scene) -> bool:
+    """Whether ``scene``'s contacts run the compliant law as exact elastic/sliding modes."""
+    return scene.tangential_model == "compliant" and scene.friction_regularization == "exact"
+
+
+def mode_flags(plane: str, mode: str | None) -> int:
+    """The C flag of the compliant law on ``plane`` in ``mode`` (None: the law alone,
+    its smooth yield capping it: the elastic mode's kernels)."""
+    return _core.FLAGS[f"{plane}_compliant_sliding" if mode == "sliding"
+                       else f"{plane}_compliant"]
+
+
+def margins(y, params, latch, plane: str) -> np.ndarray:
+    """(yield margin (1), re-stick margin (m/s), s_cap (m), k_t (N/m)) at state y."""
+    return _core.compliant_margins(np.ascontiguousarray(y, dtype=float), params, latch,
+                                   PLANES.index(plane))
+
+
+def _boundary(scene, plane):
+    return scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
+
+
+def arm_penetration(scene, plane: str) -> float:
+    """The penetration (m) at which the guards of a contact with ``plane`` are armed."""
+    return ARM_ULPS * math.ulp(_boundary(scene, plane))
+
+
+def _rounding(scene, plane, rho0):
+    """The relative rounding of margins computed from rho >= rho0: a few ulp of the
+    plane's position over rho0, and never below 64 eps."""
+    return max(64 * np.finfo(float).eps, 8 * math.ulp(_boundary(scene, plane)) / max(rho0, 1e-300))
+
+
+def guard(scene, mode: str, y0, params, latch, plane: str, rho0: float):
+    """(event kind, offset) of the guard of ``mode`` on ``plane`` for a segment starting
+    at y0 with penetration rho0: the guard g + offset falls through 0 ("arm": rises),
+    the offset a margin past g's zero (its rounding) so that a segment starting on it
+    (a mode just entered there) does not fire at once and rounding does not fire it."""
+    if mode == "starting":
+        return "arm", -arm_penetration(scene, plane)
+    rounding = _rounding(scene, plane, rho0)
+    if mode == "elastic":
+        return "yield", rounding
+    ratio = scene.friction_coefficient / max(scene.tangential_stiffness_ratio, 1e-300)
+    return "restick", rounding * stickslip.speed_scale(scene, y0) * max(1.0, ratio)
+
+
+def decide(y, params, latch, plane: str):
+    """(mode, state) where the elastic spring meets the cap (a yield, or the arming of a
+    contact's guards): the spring put at the cap (at_cap; along the slip velocity when
+    it is still relaxed) is "sliding" when the re-stick margin there is >= 0 (the elastic
+    law would stretch it past the cap); else the mode is "elastic", and a spring beyond
+    the cap is put at it."""
+    s = np.asarray(y)[_DEFLECTION[plane]]
+    trial = at_cap(y, params, latch, plane)
+    if not math.hypot(*s.tolist()) > 0:
+        u = stickslip.slip_velocity(params, plane, y)
+        speed = math.hypot(*u.tolist())
+        if not speed > 0:
+            return "elastic", y
+        s_cap = float(margins(y, params, latch, plane)[2])
+        trial[_DEFLECTION[plane]] = (s_cap if s_cap > 0 else START_DEFLECTION) * u / speed
+    if margins(trial, params, latch, plane)[1] >= 0:
+        return "sliding", trial
+    if margins(y, params, latch, plane)[0] < 0:
+        return "elastic", trial
+    return "elastic", y
+
+
+def at_cap(y, params, latch, plane: str) -> np.ndarray:
+    """The state with |s| = s_cap exactly (its direction kept), the change of the spring
+    energy 1/2 k_t |s|^2 booked as tangential dissipated work (the balance stays exact)."""
+    y = np.array(y, dtype=float)
+    s = y[_DEFLECTION[plane]]
+    size = math.hypot(*s.tolist())
+    if not size > 0:
+        return y
+    _, _, s_cap, k_t = margins(y, params, latch, plane).tolist()
+    y[_DEFLECTION[plane]] = s * (s_cap / size)
+    y[_DISSIPATED_TANGENTIAL] += 0.5 * k_t * (size * size - s_cap * s_cap)
+    return y
+
+
+def restick(y, params, latch, plane: str) -> np.ndarray:
+    """The state at a re-stick (the elastic mode follows): the spring at the cap."""
+    return at_cap(y, params, latch, plane)
