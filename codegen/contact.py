@@ -281,6 +281,22 @@ def capped_deflection(model: Model, k_t, stiffening, normal_force, normal_force_
     return s_cap, mu * normal_force_rate / stiffness - s_cap * stiffening
 
 
+#: Below |s| = TURN_FLOOR (m) the sliding spring's direction turns with the slip at
+#: most at |v_t| / TURN_FLOOR: de/dt = (v_t - (e . v_t) e) / max(|s|, TURN_FLOOR).  The
+#: exact rate, |v_t| / |s|, grows without bound as a sliding contact unloads (s_cap ->
+#: 0), which stalls any integrator there (steps ~ |s| / |v_t|, shrinking with |s|);
+#: the force it turns is mu F_n <= k_t TURN_FLOOR then (1e-12 m: 1e-6 of the
+#: deflections of a 2.5-mm alumina impact at 3.9 m/s, 1e-8 of the seed's).
+TURN_FLOOR = sm.Float(1e-12)
+
+
+def turn_factor(model: Model, plane: str):
+    """|s| / max(|s|, TURN_FLOOR): 1 above the floor (see TURN_FLOOR)."""
+    sx, sy = deflection_symbols(model, plane)
+    size = sm.sqrt(sm.Max(sx**2 + sy**2, _DIRECTION_FLOOR2))
+    return size / sm.Max(size, TURN_FLOOR)
+
+
 def sliding_direction(model: Model, plane: str):
     """The unit deflection e = s/|s| (2), 0 where |s|^2 < 1e-280 m^2."""
     sx, sy = deflection_symbols(model, plane)
@@ -289,14 +305,20 @@ def sliding_direction(model: Model, plane: str):
 
 
 def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, cap, slip,
-                    normal_force_rate, direction):
+                    normal_force_rate, direction, turn, jacobian_form=False):
     """The incremental Mindlin spring in its sliding mode: the DEM codes' truncation in
     the limit dt -> 0 (docs/contact_laws.md, "Exact elastic and sliding modes").
 
     The stored force sits at the cap, F_el = -mu F_n e with e = s/|s| (``direction``);
     |s| follows s_cap = mu F_n / k_t and e turns with the slip velocity's part across
-    it: s' = v_t - (e . v_t) e + e ds_cap/dt, which keeps |s| = s_cap and gives
-    de/dt = (v_t - (e . v_t) e) / |s|, the truncated increment's direction.  Returns
+    it: s' = (v_t - (e . v_t) e) f + s d ln(s_cap)/dt, which keeps |s| / s_cap constant
+    (1: a mode change puts the spring at the cap) and gives de/dt = (v_t - (e . v_t) e)
+    / |s|, the truncated increment's direction (``turn`` f = 1, or less below
+    TURN_FLOOR).  The radial part is relative, so that the approximate penetration
+    acceleration in ds_cap/dt (normal_force_rate's) errs by a factor on |s|, never
+    driving s through 0 before s_cap; ``jacobian_form`` writes it e ds_cap/dt (the same
+    value at |s| = s_cap), whose d/ds is 0 (d ln(s_cap)/dt ~ 1/t at a start: the
+    dilution's trap, see JACOBIAN_FORMS).  Returns
     (applied force (2), deflection rate (2), rate of the stored energy 1/2 k_t |s|^2
     (W), k_t).  No viscous damping: it is dropped while sliding (capacity 0).
     """
@@ -305,10 +327,18 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     ex, ey = direction
     k_t = model.p["tangential_stiffness_ratio"] * stiffness
     stiffening = rhodot / (2 * _rho_floor(rho))
-    _, s_cap_rate = capped_deflection(model, k_t, stiffening, normal_force, normal_force_rate)
+    s_cap, s_cap_rate = capped_deflection(model, k_t, stiffening, normal_force,
+                                          normal_force_rate)
     along = ex * vx + ey * vy
     in_contact = normal_force / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
-    rate = [in_contact * (v - along * e + e * s_cap_rate) for v, e in zip((vx, vy), (ex, ey))]
+    if jacobian_form:
+        radial = [ex * s_cap_rate, ey * s_cap_rate]
+    else:
+        # d ln(s_cap)/dt = dF_n/dt / F_n - rhodot / (2 rho)
+        relative = normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2)) - stiffening
+        radial = [sx * relative, sy * relative]
+    rate = [in_contact * ((v - along * e) * turn + w)
+            for v, e, w in zip((vx, vy), (ex, ey), radial)]
     force = [-cap * ex, -cap * ey]
     storage = k_t * (sx*rate[0] + sy*rate[1]) + k_t * (sx**2 + sy**2) / 2 * stiffening
     return force, rate, storage, k_t
@@ -317,9 +347,9 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
 def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
     """The compliant law's sliding mode (``<plane>_compliant_sliding``): the same normal
     force, the tangential force -mu F_n e at the cap (sliding_mindlin).
-    ``jacobian_form``: the direction e enters as symbols defined before the kernel's
-    code (``ContactLaw.frozen``), so the Jacobian leaves out de/ds ~ 1/|s|, singular at
-    a contact that starts sliding (see JACOBIAN_FORMS)."""
+    ``jacobian_form``: the direction e (and the turn factor) enter as symbols defined
+    before the kernel's code (``ContactLaw.frozen``), so the Jacobian leaves out
+    de/ds ~ 1/|s|, singular at a contact that starts sliding (see JACOBIAN_FORMS)."""
     N = model.frame
     point, _, normal, slip = slip_kinematics(model, plane)
     _, _, rho, rhodot = contact_kinematics(model, plane)
@@ -327,14 +357,16 @@ def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
     f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
     cap = model.p["friction_coefficient"] * f_n
     f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
-    exact = sliding_direction(model, plane)
+    exact = sliding_direction(model, plane) + [turn_factor(model, plane)]
     frozen = None
-    direction = exact
+    held = exact
     if jacobian_form:
-        direction = list(sm.symbols(f"{plane}_sliding_direction_x {plane}_sliding_direction_y"))
-        frozen = list(zip(direction, exact))
+        held = list(sm.symbols(f"{plane}_sliding_direction_x {plane}_sliding_direction_y "
+                               f"{plane}_sliding_turn"))
+        frozen = list(zip(held, exact))
     tangential, rate, storage, _ = sliding_mindlin(model, plane, stiffness, rho, rhodot, f_n,
-                                                   cap, slip, f_rate, direction)
+                                                   cap, slip, f_rate, held[:2], held[2],
+                                                   jacobian_form)
     force = f_n*normal + tangential[0]*N.x + tangential[1]*N.y
     return ContactLaw(point, force, sm.S.One, deflection_rate=rate,
                       tangential_storage=storage, frozen=frozen)

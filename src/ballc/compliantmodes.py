@@ -106,13 +106,15 @@ def guard(scene, mode: str, y0, params, latch, plane: str, rho0: float):
 
 def decide(y, params, latch, plane: str):
     """(mode, state) where the elastic spring meets the cap (a yield, or the arming of a
-    contact's guards): the spring put at the cap (at_cap; along the slip velocity when
-    it is still relaxed) is "sliding" when the re-stick margin there is >= 0 (the elastic
-    law would stretch it past the cap); else the mode is "elastic", and a spring beyond
-    the cap is put at it."""
+    contact's guards): "sliding" when the re-stick margin with the spring at the cap
+    (along the slip velocity when it is still relaxed) is >= 0 -- the elastic law would
+    stretch it past the cap; a relaxed spring is then put there, any other keeps its
+    |s| (s_cap to the integration's tolerance: the sliding law keeps |s| / s_cap).
+    Else "elastic", with a spring beyond the cap brought back to it (at_cap)."""
     s = np.asarray(y)[_DEFLECTION[plane]]
-    trial = at_cap(y, params, latch, plane)
-    if not math.hypot(*s.tolist()) > 0:
+    trial = at_cap(y, params, latch, plane, only_down=False)
+    relaxed = not math.hypot(*s.tolist()) > 0
+    if relaxed:
         u = stickslip.slip_velocity(params, plane, y)
         speed = math.hypot(*u.tolist())
         if not speed > 0:
@@ -120,26 +122,29 @@ def decide(y, params, latch, plane: str):
         s_cap = float(margins(y, params, latch, plane)[2])
         trial[_DEFLECTION[plane]] = (s_cap if s_cap > 0 else START_DEFLECTION) * u / speed
     if margins(trial, params, latch, plane)[1] >= 0:
-        return "sliding", trial
-    if margins(y, params, latch, plane)[0] < 0:
-        return "elastic", trial
-    return "elastic", y
+        return "sliding", (trial if relaxed else y)
+    return "elastic", at_cap(y, params, latch, plane)
 
 
-def at_cap(y, params, latch, plane: str) -> np.ndarray:
-    """The state with |s| = s_cap exactly (its direction kept), the change of the spring
-    energy 1/2 k_t |s|^2 booked as tangential dissipated work (the balance stays exact)."""
+def at_cap(y, params, latch, plane: str, only_down=True) -> np.ndarray:
+    """The state with |s| = s_cap (its direction kept), the spring energy 1/2 k_t |s|^2
+    it releases booked as tangential dissipated work (the balance stays exact);
+    ``only_down``: a spring below the cap is left as it is (no booking of negative
+    dissipation: only a trial state may be put up to the cap)."""
     y = np.array(y, dtype=float)
     s = y[_DEFLECTION[plane]]
     size = math.hypot(*s.tolist())
     if not size > 0:
         return y
     _, _, s_cap, k_t = margins(y, params, latch, plane).tolist()
+    if only_down and size <= s_cap:
+        return y
     y[_DEFLECTION[plane]] = s * (s_cap / size)
     y[_DISSIPATED_TANGENTIAL] += 0.5 * k_t * (size * size - s_cap * s_cap)
     return y
 
 
 def restick(y, params, latch, plane: str) -> np.ndarray:
-    """The state at a re-stick (the elastic mode follows): the spring at the cap."""
+    """The state at a re-stick (the elastic mode follows): a spring beyond the cap (by
+    the integration's tolerance) brought back to it."""
     return at_cap(y, params, latch, plane)
