@@ -36,8 +36,7 @@ import numpy as np
 from . import _core, layout, stickslip
 
 PLANES = ("floor", "ceiling")
-#: The modes: "starting" is the elastic mode before its guards are armed.
-MODES = ("starting", "elastic", "sliding")
+MODES = ("elastic", "sliding")
 #: The guards' event kinds: the starting mode's, the elastic mode's, the sliding mode's.
 GUARDS = ("arm", "yield", "restick")
 _DEFLECTION = layout.DEFLECTION
@@ -51,6 +50,11 @@ _DISSIPATED_TANGENTIAL = layout.INDEX["dissipated_tangential"]
 #: caps it meanwhile.  (4e-13 m for a 2.5-mm ball, 4e-12 m for the seed's: 1e-7 of
 #: their peak penetrations.)
 ARM_ULPS = 2.0 ** 20
+#: ... and once Hertz's force k0 rho^(3/2) reaches ARM_FORCE (N): the kernels treat a
+#: normal force below 1e-12 N as a fraction of a load (F_n / max(F_n, 1e-12 N), which
+#: keeps their derivatives finite), so the law is exact only well above it (1e-6 N:
+#: 1e-8 m for the seed's rubber ball).
+ARM_FORCE = 1e-6
 
 #: A sliding start with s_cap = 0 takes this |s| (m) along the slip, so that its
 #: direction s/|s| is defined (the kernels take s/|s| as 0 below |s| = 1e-140 m).
@@ -80,8 +84,10 @@ def _boundary(scene, plane):
 
 
 def arm_penetration(scene, plane: str) -> float:
-    """The penetration (m) at which the guards of a contact with ``plane`` are armed."""
-    return ARM_ULPS * math.ulp(_boundary(scene, plane))
+    """The penetration (m) at which the guards of a contact with ``plane`` are armed:
+    ARM_ULPS ulp of the plane's position, and Hertz's force ARM_FORCE."""
+    return max(ARM_ULPS * math.ulp(_boundary(scene, plane)),
+               (ARM_FORCE / scene.hertz_stiffness) ** (2.0 / 3.0))
 
 
 def _rounding(scene, plane, rho0):
@@ -90,12 +96,13 @@ def _rounding(scene, plane, rho0):
     return max(64 * np.finfo(float).eps, 8 * math.ulp(_boundary(scene, plane)) / max(rho0, 1e-300))
 
 
-def guard(scene, mode: str, y0, params, latch, plane: str, rho0: float):
+def guard(scene, mode: str, armed: bool, y0, params, latch, plane: str, rho0: float):
     """(event kind, offset) of the guard of ``mode`` on ``plane`` for a segment starting
-    at y0 with penetration rho0: the guard g + offset falls through 0 ("arm": rises),
-    the offset a margin past g's zero (its rounding) so that a segment starting on it
-    (a mode just entered there) does not fire at once and rounding does not fire it."""
-    if mode == "starting":
+    at y0 with penetration rho0: the guard g + offset falls through 0 ("arm", before
+    the guards are ``armed``: the penetration rises through arm_penetration), the
+    offset a margin past g's zero (its rounding) so that a segment starting on it (a
+    mode just entered there) does not fire at once and rounding does not fire it."""
+    if not armed:
         return "arm", -arm_penetration(scene, plane)
     rounding = _rounding(scene, plane, rho0)
     if mode == "elastic":
@@ -104,13 +111,34 @@ def guard(scene, mode: str, y0, params, latch, plane: str, rho0: float):
     return "restick", rounding * stickslip.speed_scale(scene, y0) * max(1.0, ratio)
 
 
-def decide(y, params, latch, plane: str):
+def start(y, params, latch, plane: str):
+    """(mode, state) at a contact start (s = 0): the self-similar start s = 2/3 v_t t
+    (elastic; for Hunt-Crossley k_t |s| / (mu F_n) = kappa |v_t| / (mu (1 + chi)
+    rhodot^-) at all t) or at the cap (sliding): "sliding", with the spring at the cap
+    along the slip velocity, when the re-stick margin there is >= 0; else "elastic".
+    The margins' ratios do not depend on the rounding of rho (s_cap and the rates are
+    proportional to it), so the decision is sound where rho itself is not resolved."""
+    u = stickslip.slip_velocity(params, plane, y)
+    speed = math.hypot(*u.tolist())
+    if not speed > 0:
+        return "elastic", y
+    s_cap = float(margins(y, params, latch, plane)[2])
+    trial = np.array(y, dtype=float)
+    trial[_DEFLECTION[plane]] = (s_cap if s_cap > 0 else START_DEFLECTION) * u / speed
+    if margins(trial, params, latch, plane)[1] >= 0:
+        return "sliding", trial
+    return "elastic", y
+
+
+def decide(y, params, latch, plane: str, arming=False):
     """(mode, state) where the elastic spring meets the cap (a yield, or the arming of a
     contact's guards): "sliding" when the re-stick margin with the spring at the cap
     (along the slip velocity when it is still relaxed) is >= 0 -- the elastic law would
-    stretch it past the cap; a relaxed spring is then put there, any other keeps its
-    |s| (s_cap to the integration's tolerance: the sliding law keeps |s| / s_cap).
-    Else "elastic", with a spring beyond the cap brought back to it (at_cap)."""
+    stretch it past the cap.  Then a relaxed spring, or one at the arming (whose |s|
+    the smooth yield and rounding set, not the cap), is put at the cap; a spring at a
+    yield keeps its |s| (s_cap to the integration's tolerance; the sliding law keeps
+    |s| / s_cap, and booking the tolerance-sized difference could show as negative
+    dissipation).  Else "elastic", with a spring beyond the cap brought back to it."""
     s = np.asarray(y)[_DEFLECTION[plane]]
     trial = at_cap(y, params, latch, plane, only_down=False)
     relaxed = not math.hypot(*s.tolist()) > 0
@@ -122,7 +150,7 @@ def decide(y, params, latch, plane: str):
         s_cap = float(margins(y, params, latch, plane)[2])
         trial[_DEFLECTION[plane]] = (s_cap if s_cap > 0 else START_DEFLECTION) * u / speed
     if margins(trial, params, latch, plane)[1] >= 0:
-        return "sliding", (trial if relaxed else y)
+        return "sliding", (trial if relaxed or arming else y)
     return "elastic", at_cap(y, params, latch, plane)
 
 

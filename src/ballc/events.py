@@ -137,7 +137,7 @@ def contact_threshold(scene, plane, rho0, entering):
 
 
 def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
-                    clear=0.0, approach=None, rearm=None, compliant=None):
+                    clear=0.0, approach=None, rearm=None, compliant=None, armed=None):
     """Events of one segment starting at state y0: [(kind, plane, event)].
 
     ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
@@ -148,8 +148,9 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
     so that a segment starting on it (slip from rest, a stick that starts at the cone)
     does not fire at once.  ``rearm`` (optional): plane -> the ``rearm`` callable of
     that plane's approach event (see :class:`LinearEvent`).  ``compliant`` (optional,
-    per plane): the compliant law's mode ("starting", "elastic", "sliding" or None; see
-    ballc.compliantmodes), whose guard ends the segment.
+    per plane): the compliant law's mode ("elastic", "sliding" or None; see
+    ballc.compliantmodes), whose guard ends the segment; ``armed`` (per plane): whether
+    that guard is armed (else the arming depth is the guard).
     """
     events = []
     for plane in PLANES:
@@ -184,8 +185,8 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
                 plane, params, latch, flags, stickslip.force_scale(scene, load))))
         law_mode = compliant[plane] if compliant else None
         if law_mode is not None:
-            kind, offset = compliantmodes.guard(scene, law_mode, y0, params, latch, plane,
-                                                rho0)
+            kind, offset = compliantmodes.guard(scene, law_mode, armed[plane], y0, params,
+                                                latch, plane, rho0)
             if kind == "arm":     # the penetration rising through the arming depth
                 events.append((kind, plane, rho.shifted(offset, True, 1)))
             else:

@@ -75,6 +75,7 @@ class _Run:
         self.exact = stickslip.uses_exact_coulomb(scene)
         self.compliant_modes = compliantmodes.uses_modes(scene)
         self.compliant: dict[str, str | None] = {plane: None for plane in PLANES}
+        self.armed = {plane: False for plane in PLANES}   # the compliant guards
         self.in_contact = {plane: False for plane in PLANES}
         self.coulomb: dict[str, str | None] = {plane: None for plane in PLANES}
         self.approach: dict[str, float | None] = {plane: None for plane in PLANES}
@@ -127,12 +128,14 @@ class _Run:
         if self.exact:
             self.start_coulomb(plane)
         if self.compliant_modes:
-            if ev.penetration(plane, self.scene)(0, y) < compliantmodes.arm_penetration(
-                    self.scene, plane):
-                self.set_compliant(plane, "starting")
-            else:   # a scene that starts in contact: the guards are armed at once
-                mode, self.y = compliantmodes.decide(y, self.params, self.latch, plane)
-                self.set_compliant(plane, mode)
+            self.armed[plane] = ev.penetration(plane, self.scene)(0, y) >= \
+                compliantmodes.arm_penetration(self.scene, plane)
+            if self.armed[plane]:   # a scene that starts in contact: armed at once
+                mode, self.y = compliantmodes.decide(y, self.params, self.latch, plane,
+                                                     arming=True)
+            else:
+                mode, self.y = compliantmodes.start(y, self.params, self.latch, plane)
+            self.set_compliant(plane, mode)
 
     def end_contact(self, plane):
         y = self.y
@@ -150,8 +153,7 @@ class _Run:
 
     def set_compliant(self, plane, mode):
         """Enter the compliant law's ``mode`` on ``plane`` now; the contact records its
-        phases as Coulomb's: "slip" (sliding, at the cap) and "stick" (elastic, or its
-        start before the guards are armed)."""
+        phases as Coulomb's: "slip" (sliding, at the cap) and "stick" (elastic)."""
         self.compliant[plane] = mode
         self.transitions[plane] += 1
         phase = "slip" if mode == "sliding" else "stick"
@@ -169,8 +171,11 @@ class _Run:
                             f"did not settle: {self.transitions[plane]} mode changes in one "
                             f"contact, {self.stalled} of them at t = {self.t:.17g} s")
             return
+        if kind == "arm":
+            self.armed[plane] = True
         if kind in ("arm", "yield"):
-            mode, self.y = compliantmodes.decide(self.y, self.params, self.latch, plane)
+            mode, self.y = compliantmodes.decide(self.y, self.params, self.latch, plane,
+                                                 arming=kind == "arm")
             self.set_compliant(plane, mode)
         else:
             self.y = compliantmodes.restick(self.y, self.params, self.latch, plane)
@@ -500,7 +505,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         system = _core.System(run.params, run.latch, flags)
         driver_events = ev.segment_events(scene, run.in_contact, run.y, run.coulomb,
                                           run.params, run.latch, flags, run.clear_speed(),
-                                          run.approach, run.rearm_approach, run.compliant)
+                                          run.approach, run.rearm_approach, run.compliant,
+                                          run.armed)
         run.rearmed = []
         rest_plane, t_stop = run.rest_candidate() if checks_rest else (None, math.inf)
         t_stop = min(t_stop, t_end)   # a rest check ends the segment there
