@@ -214,6 +214,39 @@ def normal_force_rate(model: Model, plane: str, rho, rhodot, rate_at_impact, f_n
     return (1 - select) * hc + select * ve
 
 
+def tangential_stiffness(model: Model, stiffness):
+    """k_t = kappa k_n (N/m): the tangential spring's stiffness from the normal one."""
+    return model.p["tangential_stiffness_ratio"] * stiffness
+
+
+@dataclass
+class CompliantContact:
+    """What every part of the compliant law on one plane reads: the contact point, the
+    plane's normal, the slip velocity (2), rho, rhodot, the damped normal force F_n,
+    the normal stiffness k_n, the cap mu F_n and dF_n/dt."""
+
+    point: me.Point
+    normal: me.Vector
+    slip: tuple
+    rho: sm.Expr
+    rhodot: sm.Expr
+    normal_force: sm.Expr
+    stiffness: sm.Expr
+    cap: sm.Expr
+    normal_force_rate: sm.Expr
+
+
+def compliant_contact(model: Model, plane: str) -> CompliantContact:
+    """The compliant law's shared quantities on ``plane`` (CompliantContact)."""
+    point, _, normal, slip = slip_kinematics(model, plane)
+    _, _, rho, rhodot = contact_kinematics(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
+    cap = model.p["friction_coefficient"] * f_n
+    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
+    return CompliantContact(point, normal, slip, rho, rhodot, f_n, stiffness, cap, f_rate)
+
+
 def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, cap,
                         slip, normal_force_rate, dilute=True):
     """The incremental (passive) Mindlin tangential spring with a Coulomb cap.
@@ -230,7 +263,7 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     """
     sx, sy = deflection_symbols(model, plane)
     vx, vy = slip
-    k_t = model.p["tangential_stiffness_ratio"] * stiffness
+    k_t = tangential_stiffness(model, stiffness)
     size2 = sx**2 + sy**2
     ratio2 = sm.Min(k_t**2 * size2 / sm.Max(cap**2, _FORCE_FLOOR2), _RATIO2_CLIP)
     loading = sm.Max(sx*vx + sy*vy, 0) / sm.Max(size2, _LENGTH_FLOOR2)
@@ -325,7 +358,7 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     sx, sy = deflection_symbols(model, plane)
     vx, vy = slip
     ex, ey = direction
-    k_t = model.p["tangential_stiffness_ratio"] * stiffness
+    k_t = tangential_stiffness(model, stiffness)
     stiffening = rhodot / (2 * _rho_floor(rho))
     s_cap, s_cap_rate = capped_deflection(model, k_t, stiffening, normal_force,
                                           normal_force_rate)
@@ -351,12 +384,7 @@ def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
     before the kernel's code (``ContactLaw.frozen``), so the Jacobian leaves out
     de/ds ~ 1/|s|, singular at a contact that starts sliding (see JACOBIAN_FORMS)."""
     N = model.frame
-    point, _, normal, slip = slip_kinematics(model, plane)
-    _, _, rho, rhodot = contact_kinematics(model, plane)
-    rate_at_impact = latch_symbols(model, plane)[0]
-    f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
-    cap = model.p["friction_coefficient"] * f_n
-    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
+    c = compliant_contact(model, plane)
     exact = sliding_direction(model, plane) + [turn_factor(model, plane)]
     frozen = None
     held = exact
@@ -364,11 +392,12 @@ def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
         held = list(sm.symbols(f"{plane}_sliding_direction_x {plane}_sliding_direction_y "
                                f"{plane}_sliding_turn"))
         frozen = list(zip(held, exact))
-    tangential, rate, storage, _ = sliding_mindlin(model, plane, stiffness, rho, rhodot, f_n,
-                                                   cap, slip, f_rate, held[:2], held[2],
+    tangential, rate, storage, _ = sliding_mindlin(model, plane, c.stiffness, c.rho, c.rhodot,
+                                                   c.normal_force, c.cap, c.slip,
+                                                   c.normal_force_rate, held[:2], held[2],
                                                    jacobian_form)
-    force = f_n*normal + tangential[0]*N.x + tangential[1]*N.y
-    return ContactLaw(point, force, sm.S.One, deflection_rate=rate,
+    force = c.normal_force*c.normal + tangential[0]*N.x + tangential[1]*N.y
+    return ContactLaw(c.point, force, sm.S.One, deflection_rate=rate,
                       tangential_storage=storage, frozen=frozen)
 
 
@@ -382,21 +411,17 @@ def compliant_margins(model: Model, plane: str):
       mode ends where it falls below 0;
     * s_cap = mu F_n / k_t (m) and k_t (N/m): what a mode change resets to.
     """
-    _, _, _, slip = slip_kinematics(model, plane)
-    _, _, rho, rhodot = contact_kinematics(model, plane)
-    rate_at_impact = latch_symbols(model, plane)[0]
-    f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
-    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
+    c = compliant_contact(model, plane)
+    f_n, rho, rhodot, slip = c.normal_force, c.rho, c.rhodot, c.slip
     sx, sy = deflection_symbols(model, plane)
-    k_t = model.p["tangential_stiffness_ratio"] * stiffness
+    k_t = tangential_stiffness(model, c.stiffness)
     stiffening = rhodot / (2 * _rho_floor(rho))
-    s_cap, s_cap_rate = capped_deflection(model, k_t, stiffening, f_n, f_rate)
+    s_cap, s_cap_rate = capped_deflection(model, k_t, stiffening, f_n, c.normal_force_rate)
     size = sm.sqrt(sx**2 + sy**2)
     ex, ey = sliding_direction(model, plane)
     dilution = _positive(rhodot) / (2 * _rho_floor(rho))
     stretch = ex * slip[0] + ey * slip[1] - dilution * size
-    cap = model.p["friction_coefficient"] * f_n
-    yield_margin = 1 - k_t * size / sm.Max(cap, sm.sqrt(_FORCE_FLOOR2))
+    yield_margin = 1 - k_t * size / sm.Max(c.cap, sm.sqrt(_FORCE_FLOOR2))
     # with no load (F_n = 0: the contact's last instants, or its clamp) both modes apply
     # no tangential force and the deflection stands still: neither guard fires (1, and
     # 1 m/s: any positive value)
@@ -428,19 +453,15 @@ def compliant_model_force(model: Model, plane: str, jacobian_form=False):
     derivatives the Jacobian kernel holds (JACOBIAN_FORMS).
     """
     N = model.frame
-    point, _, normal, slip = slip_kinematics(model, plane)
-    _, _, rho, rhodot = contact_kinematics(model, plane)
-    rate_at_impact = latch_symbols(model, plane)[0]
-    f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
-    cap = model.p["friction_coefficient"] * f_n
-    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
-    capped, rate, storage, k_t = incremental_mindlin(model, plane, stiffness, rho, rhodot,
-                                                     f_n, cap, slip, f_rate,
+    c = compliant_contact(model, plane)
+    capped, rate, storage, k_t = incremental_mindlin(model, plane, c.stiffness, c.rho,
+                                                     c.rhodot, c.normal_force, c.cap, c.slip,
+                                                     c.normal_force_rate,
                                                      dilute=not jacobian_form)
-    viscous = capacity_damping(model, k_t, cap, capped, slip)
+    viscous = capacity_damping(model, k_t, c.cap, capped, c.slip)
     tangential = [e + v for e, v in zip(capped, viscous)]
-    force = f_n*normal + tangential[0]*N.x + tangential[1]*N.y
-    return ContactLaw(point, force, sm.S.One, deflection_rate=rate,
+    force = c.normal_force*c.normal + tangential[0]*N.x + tangential[1]*N.y
+    return ContactLaw(c.point, force, sm.S.One, deflection_rate=rate,
                       tangential_storage=storage)
 
 
@@ -449,7 +470,7 @@ def tangential_spring_energy(model: Model, plane: str):
     _, rho = plane_geometry(model, plane)
     _, stiffness = hertz_normal(model, rho)
     sx, sy = deflection_symbols(model, plane)
-    return model.p["tangential_stiffness_ratio"] * stiffness * (sx**2 + sy**2) / 2
+    return tangential_stiffness(model, stiffness) * (sx**2 + sy**2) / 2
 
 
 @dataclass

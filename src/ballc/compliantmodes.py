@@ -134,14 +134,18 @@ def decide(y, params, latch, plane: str, arming=False):
     """(mode, state) where the elastic spring meets the cap (a yield, or the arming of a
     contact's guards): "sliding" when the re-stick margin with the spring at the cap
     (along the slip velocity when it is still relaxed) is >= 0 -- the elastic law would
-    stretch it past the cap.  Then a relaxed spring, or one at the arming (whose |s|
-    the smooth yield and rounding set, not the cap), is put at the cap; a spring at a
+    stretch it past the cap.  Then a relaxed spring, or one at the arming (the
+    self-similar start, whose s the integration set with errors larger than s), is
+    put at the cap along the slip velocity; a spring at a
     yield keeps its |s| (s_cap to the integration's tolerance; the sliding law keeps
     |s| / s_cap, and booking the tolerance-sized difference could show as negative
     dissipation).  Else "elastic", with a spring beyond the cap brought back to it."""
     s = np.asarray(y)[_DEFLECTION[plane]]
     trial = at_cap(y, params, latch, plane, only_down=False)
-    relaxed = not math.hypot(*s.tolist()) > 0
+    # at the arming the contact is still in its self-similar start, s along v_t: the
+    # slip velocity gives that direction without the integration's error in s (larger
+    # than s itself there)
+    relaxed = arming or not math.hypot(*s.tolist()) > 0
     if relaxed:
         u = stickslip.slip_velocity(params, plane, y)
         speed = math.hypot(*u.tolist())
