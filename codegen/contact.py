@@ -1,24 +1,37 @@
-"""Contact laws of the seed, as sympy expressions of the contact-point kinematics.
+"""Contact laws, as sympy expressions of the contact-point kinematics, composed of parts.
 
 For a plane with unit normal ``n`` pointing towards the ball (floor: +z, ceiling: -z):
 
 * penetration ``rho = r - distance(centre, plane)`` (positive in contact),
 * penetration rate ``rhodot = -v_cp . n`` (positive while moving into the plane),
-* Hertz stiffness ``k0 = 4 / (3 (sigma_b + sigma_p)) sqrt(r)``, ``sigma = (1 - nu^2) / E``,
-* Hunt-Crossley normal force
-  ``F_n = max(0, k0 rho^(3/2) [1 + 3/2 (1 - c_tau) rhodot / |rhodot^-|])``
-  where ``rhodot^-`` is the penetration rate latched at the start of the contact.
-  The clamp at 0 (no adhesion) is ballc's addition: the seed's formula turns
-  attractive when the ball leaves faster than ``|rhodot^-| / (3/2 (1 - c_tau))``.
+* ``rhodot^-`` the penetration rate latched at the start of the contact,
+* Hertz stiffness ``k0 = 4 / (3 (sigma_b + sigma_p)) sqrt(r)``, ``sigma = (1 - nu^2) / E``.
 
-Tangential models (seed, weighted by ``mixture``):
+A law is normal x damping x tangential, as LAMMPS GRANULAR's sub-models (docs/contact_laws.md):
 
-* friction: ``(1 - mixture) (F_n n - mu F_n v_t / max(|v_t|, eps))``, with ``v_t`` the
-  slip velocity of the contact point in the plane and ``eps`` the seed's 1e-10 m/s;
-* dig-in: ``mixture F_d (-d)`` where ``d`` is the unit contact-point velocity latched
-  at impact start and ``F_d = max(0, k0 rho^(3/2) [1 + 3/2 (1 - c_tau) (v_cp . d) / |rhodot^-|])``.
+* normal: ``hertz_normal``, F_H = k0 rho^(3/2) and k_n = 3/2 k0 rho^(1/2);
+* damping: ``hunt_crossley``, the seed's bracket F_H [1 + chi rate / |rhodot^-|] with
+  chi = 3/2 (1 - c_tau); ``hunt_crossley_damping`` (F_H chi rhodot / |rhodot^-|) and
+  ``viscoelastic_damping`` (2 gamma sqrt(m* k_n) rhodot), the terms the compliant law
+  adds to F_H (``damped_normal``; the sum rounds differently from the bracket).  The
+  damped force is clamped at 0 (no adhesion: ballc's addition; the seed's formula
+  turns attractive when the ball leaves faster than ``|rhodot^-| / chi``);
+* tangential: ``coulomb_friction`` (F_n n - mu F_n v_t / max(|v_t|, eps), v_t the slip
+  velocity in the plane, eps the seed's 1e-10 m/s; or / sqrt(|v_t|^2 + eps^2) with
+  ``smooth_friction``), ``dig_in`` (-F_d d along the unit
+  contact-point velocity d latched at impact start, F_d the damped normal force on the
+  rate v_cp . d), ``no_friction`` (F_n n); the compliant law's ``incremental_mindlin``
+  (a deflection state per plane) + ``capacity_damping``.
 
-ballc's own addition, not in the seed: the compliant law (see compliant_model_force).
+Compositions (``COMPOSITIONS``, assembled by ``compose``; weights as the seed's mixture):
+
+* friction = hertz_normal x hunt_crossley x coulomb_friction, weight 1 - mixture;
+* dig-in = hertz_normal x hunt_crossley x dig_in, weight mixture;
+* mixture = friction + dig-in (the C core adds the two kernels);
+* friction_normal = hertz_normal x hunt_crossley x no_friction, weight 1 - mixture
+  (the friction law's normal share, for exact Coulomb friction);
+* compliant (ballc's own, not in the seed; ``compliant_model_force``) = hertz_normal x
+  (hunt_crossley_damping | viscoelastic_damping) x (incremental_mindlin + capacity_damping).
 """
 from __future__ import annotations
 
@@ -114,7 +127,8 @@ def no_friction(model: Model, plane: str, normal_force):
     """No tangential force: F_n n with F_n = normal_force(rhodot)."""
     normal, _ = plane_geometry(model, plane)
     _, _, _, rhodot = contact_kinematics(model, plane)
-    return normal_force(rhodot) * normal
+    f_n = normal_force(rhodot)
+    return f_n * normal
 
 
 def dig_in(model: Model, plane: str, normal_force):
@@ -346,6 +360,7 @@ class ContactLaw:
 JACOBIAN_FORMS = {
     "compliant": lambda model, plane: compliant_model_force(model, plane, jacobian_form=True),
 }
+
 
 @dataclass(frozen=True)
 class Composition:

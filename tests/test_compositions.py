@@ -8,6 +8,9 @@ Checked in numbers at random states, parameters and latches, on both planes:
   that kernels.py takes from COMPOSITIONS["friction_normal"]) is the composition of its
   table's parts: the parts evaluated one after the other on numbers, normal -> damping
   -> tangential, weighted, give the law's force;
+* and the table holds the seed's laws: each law against the seed's formula written here
+  in numpy (the compiled laws are held to the seed's own formulation by
+  test_against_seed.py);
 * the friction law's normal share is the friction law with mu = 0, and the mixture's
   two shares add up to 1.
 """
@@ -141,6 +144,25 @@ def test_parts_are_their_equations(model, plane):
                                        atol=1e-12 * np.abs(velocity).max(), err_msg=part.__name__)
 
 
+def seed_formula(name, plane, n):
+    """The seed's law ``name`` (weighted) from the numbers, in numpy."""
+    normal, rho, rhodot, velocity = kinematics(plane, n)
+    chi = 1.5 * (1 - n["c_tau"]) / n["rate_at_impact"]
+    elastic = hertz_k0(n) * rho**1.5
+    f_n = max(0.0, elastic * (1 + chi * rhodot))
+    if name == "digin":
+        d = n["direction"]
+        return n["mixture"] * max(0.0, elastic * (1 + chi * (velocity @ d))) * -d
+    force = f_n * normal
+    if name == "friction":
+        slip = velocity - (velocity @ normal) * normal
+        speed = np.hypot(slip[0], slip[1])
+        eps = n["friction_regularization_speed"]
+        size = np.hypot(speed, eps) if n["smooth_friction"] else max(speed, eps)
+        force = force - n["friction_coefficient"] * f_n * slip / size
+    return (1 - n["mixture"]) * force
+
+
 def composed_by_hand(model, plane, parts, values):
     """The law of ``parts`` evaluated part after part on numbers (not contact.compose)."""
     _, rho = contact.plane_geometry(model, plane)
@@ -183,6 +205,8 @@ def test_codegen_laws_are_their_compositions(model, plane, name):
         np.testing.assert_allclose(ours, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
         np.testing.assert_allclose(evaluate(law.weight, values), evaluate(parts.weight(model), values),
                                    rtol=1e-15)
+        seed = seed_formula(name, plane, n)
+        np.testing.assert_allclose(ours, seed, rtol=1e-9, atol=1e-9 * np.abs(seed).max())
         clamped += not np.any(expected)
     assert clamped < POINTS   # most points carry a load
 
