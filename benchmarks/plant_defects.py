@@ -47,13 +47,14 @@ class Defect:
 
 
 DEFECTS = [
-    Defect("ceiling damping sign flipped (HC normal force)", "codegen/contact.py",
-           "    return _hunt_crossley(model, rho, rhodot, rate_at_impact)\n",
-           "    return _hunt_crossley(model, rho, rhodot if plane == 'floor' else -rhodot, "
-           "rate_at_impact)\n", regenerate=True),
-    Defect("Hertz exponent 3/2 -> 1.4 (HC force)", "codegen/contact.py",
-           "k0 * _positive(rho)**sm.Rational(3, 2) * (1 + damping)",
-           "k0 * _positive(rho)**sm.Rational(7, 5) * (1 + damping)", regenerate=True),
+    Defect("ceiling damping sign flipped (HC normal force of the friction law)",
+           "codegen/contact.py",   # coulomb_friction and no_friction (its normal share)
+           "    f_n = normal_force(rhodot)\n",
+           "    f_n = normal_force(rhodot if plane == 'floor' else -rhodot)\n",
+           regenerate=True, count=2),
+    Defect("Hertz exponent 3/2 -> 1.4 (hertz_normal's force: every law)", "codegen/contact.py",
+           "    return k0 * rho_pos**sm.Rational(3, 2), ",
+           "    return k0 * rho_pos**sm.Rational(7, 5), ", regenerate=True),
     Defect("dig-in direction latched reversed", "src/ballc/modes.py",
            "    return max(rate, MIN_IMPACT_RATE), direction\n",
            "    return max(rate, MIN_IMPACT_RATE), -direction\n", regenerate=False),
@@ -73,9 +74,8 @@ DEFECTS = [
            "    viscous = [-c_t * v for v in slip]\n",
            "    viscous = [c_t * v for v in slip]\n", regenerate=True),
     Defect("compliant: dilution (loading) term dropped", "codegen/contact.py",
-           "    dilution = _positive(rhodot) / (2 * sm.Max(_positive(rho), _LENGTH_FLOOR)) "
-           "if dilute \\\n",
-           "    dilution = sm.S.Zero if dilute \\\n", regenerate=True),
+           "    dilution = _positive(rhodot) / (2 * _rho_floor(rho)) if dilute ",
+           "    dilution = sm.S.Zero if dilute ", regenerate=True),
     Defect("radau5 T[0][0] off in its 7th significant digit", "src/ballc/_radau_iia.c",
            "{0.09443876248897524, -0.14125529502095421, 0.03002919410514742}",
            "{0.09443877248897524, -0.14125529502095421, 0.03002919410514742}",

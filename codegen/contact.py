@@ -1,27 +1,41 @@
-"""Contact laws of the seed, as sympy expressions of the contact-point kinematics.
+"""Contact laws, as sympy expressions of the contact-point kinematics, composed of parts.
 
 For a plane with unit normal ``n`` pointing towards the ball (floor: +z, ceiling: -z):
 
 * penetration ``rho = r - distance(centre, plane)`` (positive in contact),
 * penetration rate ``rhodot = -v_cp . n`` (positive while moving into the plane),
-* Hertz stiffness ``k0 = 4 / (3 (sigma_b + sigma_p)) sqrt(r)``, ``sigma = (1 - nu^2) / E``,
-* Hunt-Crossley normal force
-  ``F_n = max(0, k0 rho^(3/2) [1 + 3/2 (1 - c_tau) rhodot / |rhodot^-|])``
-  where ``rhodot^-`` is the penetration rate latched at the start of the contact.
-  The clamp at 0 (no adhesion) is ballc's addition: the seed's formula turns
-  attractive when the ball leaves faster than ``|rhodot^-| / (3/2 (1 - c_tau))``.
+* ``rhodot^-`` the penetration rate latched at the start of the contact,
+* Hertz stiffness ``k0 = 4 / (3 (sigma_b + sigma_p)) sqrt(r)``, ``sigma = (1 - nu^2) / E``.
 
-Tangential models (seed, weighted by ``mixture``):
+A law is normal x damping x tangential, as LAMMPS GRANULAR's sub-models (docs/contact_laws.md):
 
-* friction: ``(1 - mixture) (F_n n - mu F_n v_t / max(|v_t|, eps))``, with ``v_t`` the
-  slip velocity of the contact point in the plane and ``eps`` the seed's 1e-10 m/s;
-* dig-in: ``mixture F_d (-d)`` where ``d`` is the unit contact-point velocity latched
-  at impact start and ``F_d = max(0, k0 rho^(3/2) [1 + 3/2 (1 - c_tau) (v_cp . d) / |rhodot^-|])``.
+* normal: ``hertz_normal``, F_H = k0 rho^(3/2) and k_n = 3/2 k0 rho^(1/2);
+* damping: ``hunt_crossley``, the seed's bracket F_H [1 + chi rate / |rhodot^-|] with
+  chi = 3/2 (1 - c_tau); ``hunt_crossley_damping`` (F_H chi rhodot / |rhodot^-|) and
+  ``viscoelastic_damping`` (2 gamma sqrt(m* k_n) rhodot), the terms the compliant law
+  adds to F_H (``damped_normal``; the sum rounds differently from the bracket).  The
+  damped force is clamped at 0 (no adhesion: ballc's addition; the seed's formula
+  turns attractive when the ball leaves faster than ``|rhodot^-| / chi``);
+* tangential: ``coulomb_friction`` (F_n n - mu F_n v_t / max(|v_t|, eps), v_t the slip
+  velocity in the plane, eps the seed's 1e-10 m/s; or / sqrt(|v_t|^2 + eps^2) with
+  ``smooth_friction``), ``dig_in`` (-F_d d along the unit
+  contact-point velocity d latched at impact start, F_d the damped normal force on the
+  rate v_cp . d), ``no_friction`` (F_n n); the compliant law's ``incremental_mindlin``
+  (a deflection state per plane) + ``capacity_damping``.
 
-ballc's own addition, not in the seed: the compliant law (see compliant_model_force).
+Compositions (``COMPOSITIONS``, assembled by ``compose``; weights as the seed's mixture):
+
+* friction = hertz_normal x hunt_crossley x coulomb_friction, weight 1 - mixture;
+* dig-in = hertz_normal x hunt_crossley x dig_in, weight mixture;
+* mixture = friction + dig-in (the C core adds the two kernels);
+* friction_normal = hertz_normal x hunt_crossley x no_friction, weight 1 - mixture
+  (the friction law's normal share, for exact Coulomb friction);
+* compliant (ballc's own, not in the seed; ``compliant_model_force``) = hertz_normal x
+  (hunt_crossley_damping | viscoelastic_damping) x (incremental_mindlin + capacity_damping).
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy as sm
@@ -67,19 +81,6 @@ def _positive(expr):
     return sm.Max(expr, 0)
 
 
-def _hunt_crossley(model, rho, rate, rate_at_impact):
-    k0 = hertz_stiffness(model)
-    damping = sm.Rational(3, 2) * (1 - model.p["c_tau"]) * rate / sm.Abs(rate_at_impact)
-    return _positive(k0 * _positive(rho)**sm.Rational(3, 2) * (1 + damping))
-
-
-def normal_force(model: Model, plane: str):
-    """Unweighted Hunt-Crossley normal force magnitude F_n >= 0 on ``plane``."""
-    _, _, rho, rhodot = contact_kinematics(model, plane)
-    rate_at_impact = latch_symbols(model, plane)[0]
-    return _hunt_crossley(model, rho, rhodot, rate_at_impact)
-
-
 def slip_kinematics(model: Model, plane: str):
     """(point, contact-point velocity, normal, in-plane slip components (sx, sy))."""
     N = model.frame
@@ -89,15 +90,28 @@ def slip_kinematics(model: Model, plane: str):
     return point, velocity, normal, (me.dot(slip, N.x), me.dot(slip, N.y))
 
 
-def friction_model_force(model: Model, plane: str):
-    """Seed's friction model: HC normal force and Coulomb friction, weight 1 - mixture.
+# --- the seed's parts (normal: hertz_normal, below); composed by compose (COMPOSITIONS) --
 
-    The Coulomb direction is ``-v_t / max(|v_t|, v_s)`` (the seed's, ``smooth_friction``
-    = 0) or ``-v_t / sqrt(|v_t|^2 + v_s^2)`` (``smooth_friction`` = 1).
+
+def hunt_crossley(model: Model, elastic, stiffness, rate, rate_at_impact):
+    """The seed's Hunt-Crossley damping, as the bracket: F_H [1 + chi rate / |rhodot^-|]
+    (N, before the no-adhesion clamp), chi = 3/2 (1 - c_tau).
+
+    The seed multiplies F_H by the bracket; F_H + hunt_crossley_damping (the compliant
+    law's sum) is the same force but rounds differently, so each law keeps its form.
     """
+    return elastic * (1 + _hunt_crossley_chi(model) * rate / sm.Abs(rate_at_impact))
+
+
+def coulomb_friction(model: Model, plane: str, normal_force):
+    """The seed's friction: F_n n + F_t with F_n = normal_force(rhodot) and regularised
+    Coulomb friction F_t = -mu F_n v_t / max(|v_t|, v_s) (the seed's, ``smooth_friction``
+    = 0) or -mu F_n v_t / sqrt(|v_t|^2 + v_s^2) (``smooth_friction`` = 1); v_t the slip
+    velocity, v_s = ``friction_regularization_speed`` (the seed's 1e-10 m/s)."""
     N = model.frame
-    point, _, normal, (sx, sy) = slip_kinematics(model, plane)
-    f_n = normal_force(model, plane)
+    _, _, normal, (sx, sy) = slip_kinematics(model, plane)
+    _, _, _, rhodot = contact_kinematics(model, plane)
+    f_n = normal_force(rhodot)
     eps = model.p["friction_regularization_speed"]
     smooth = model.p["smooth_friction"]
     # max(|v_t|, eps) written as sqrt(max(|v_t|^2, eps^2)): same value, but its
@@ -106,19 +120,36 @@ def friction_model_force(model: Model, plane: str):
     smooth_speed = sm.sqrt(sx**2 + sy**2 + eps**2)
     slip_speed = (1 - smooth)*seed_speed + smooth*smooth_speed
     tangential = -model.p["friction_coefficient"] * f_n / slip_speed * (sx*N.x + sy*N.y)
-    weight = 1 - model.p["mixture"]
-    return ContactLaw(point, weight * (f_n*normal + tangential), weight)
+    return f_n*normal + tangential
+
+
+def no_friction(model: Model, plane: str, normal_force):
+    """No tangential force: F_n n with F_n = normal_force(rhodot)."""
+    normal, _ = plane_geometry(model, plane)
+    _, _, _, rhodot = contact_kinematics(model, plane)
+    f_n = normal_force(rhodot)
+    return f_n * normal
+
+
+def dig_in(model: Model, plane: str, normal_force):
+    """The seed's dig-in: the whole force along -d, d the unit contact-point velocity
+    latched at impact start, of size F_d = normal_force(v_cp . d) (the normal law on the
+    rate along d instead of rhodot; no force along n of its own)."""
+    N = model.frame
+    _, velocity, _, _ = contact_kinematics(model, plane)
+    _, dx, dy, dz = latch_symbols(model, plane)[:4]
+    direction = dx*N.x + dy*N.y + dz*N.z
+    return normal_force(me.dot(velocity, direction)) * (-direction)
+
+
+def friction_model_force(model: Model, plane: str):
+    """The seed's friction law (COMPOSITIONS["friction"]), weight 1 - mixture."""
+    return compose(model, plane, COMPOSITIONS["friction"])
 
 
 def digin_model_force(model: Model, plane: str):
-    """Seed's dig-in model: HC force along the latched direction, weight mixture."""
-    N = model.frame
-    point, velocity, rho, _ = contact_kinematics(model, plane)
-    rate_at_impact, dx, dy, dz = latch_symbols(model, plane)[:4]
-    direction = dx*N.x + dy*N.y + dz*N.z
-    f_d = _hunt_crossley(model, rho, me.dot(velocity, direction), rate_at_impact)
-    weight = model.p["mixture"]
-    return ContactLaw(point, weight * f_d * (-direction), weight)
+    """The seed's dig-in law (COMPOSITIONS["digin"]), weight mixture."""
+    return compose(model, plane, COMPOSITIONS["digin"])
 
 
 def deflection_symbols(model: Model, plane: str):
@@ -503,6 +534,63 @@ JACOBIAN_FORMS = {
     "compliant": lambda model, plane: compliant_model_force(model, plane, jacobian_form=True),
     "compliant_sliding": lambda model, plane: compliant_sliding_force(model, plane,
                                                                       jacobian_form=True),
+}
+
+
+@dataclass(frozen=True)
+class Composition:
+    """A contact law as parts, as LAMMPS GRANULAR's sub-models (normal, damping,
+    tangential), and its weight.
+
+    * normal(model, rho) -> (elastic force F_H, tangent stiffness k_n);
+    * damping(model, F_H, k_n, rate, rhodot^-) -> the damped normal force (N) on a
+      penetration rate, before the no-adhesion clamp;
+    * tangential(model, plane, normal_force) -> the force on the ball at the contact
+      point, unweighted, with normal_force(rate) = max(0, damping(F_H, k_n, rate));
+    * weight(model) -> the law's share of the mixture (its kernel is weighted by it).
+    """
+
+    normal: Callable
+    damping: Callable
+    tangential: Callable
+    weight: Callable
+
+
+def compose(model: Model, plane: str, parts: Composition) -> ContactLaw:
+    """The law made of ``parts`` on ``plane``: weight * tangential(normal_force)."""
+    _, rho = plane_geometry(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    elastic, stiffness = parts.normal(model, rho)
+
+    def normal_force(rate):
+        return _positive(parts.damping(model, elastic, stiffness, rate, rate_at_impact))
+
+    weight = parts.weight(model)
+    force = parts.tangential(model, plane, normal_force)
+    return ContactLaw(contact_point(model, plane), weight * force, weight)
+
+
+def friction_share(model: Model):
+    """1 - mixture: the friction law's share of the seed's mixture."""
+    return 1 - model.p["mixture"]
+
+
+def digin_share(model: Model):
+    """mixture: the dig-in law's share of the seed's mixture."""
+    return model.p["mixture"]
+
+
+#: The seed's laws as compositions of parts.  The seed's mixture is no law of its own:
+#: the C core adds the friction and dig-in kernels, weighted 1 - mixture and mixture.
+#: "friction_normal" is the friction law's normal share (its kernel serves exact,
+#: event-driven Coulomb friction, which applies the tangential force itself).  The
+#: compliant law is composed by compliant_model_force: hertz_normal x damped_normal's
+#: damping (hunt_crossley_damping or viscoelastic_damping, added to F_H) x
+#: incremental_mindlin + capacity_damping.
+COMPOSITIONS = {
+    "friction": Composition(hertz_normal, hunt_crossley, coulomb_friction, friction_share),
+    "digin": Composition(hertz_normal, hunt_crossley, dig_in, digin_share),
+    "friction_normal": Composition(hertz_normal, hunt_crossley, no_friction, friction_share),
 }
 
 TANGENTIAL_LAWS = {

@@ -107,6 +107,8 @@ def derive(model: Model | None = None):
                 form = contact.JACOBIAN_FORMS[name](model, plane)
                 pieces[f"{plane}_{name}_jacobian_form"] = _law_outputs(model, plane, G, form)
                 pieces[f"{plane}_{name}_frozen"] = form.frozen or []
+        pieces[f"{plane}_friction_normal"] = _law_outputs(
+            model, plane, G, contact.compose(model, plane, contact.COMPOSITIONS["friction_normal"]))
     return model, pieces
 
 
@@ -172,9 +174,10 @@ def build_kernels():
                                            latch, extra_doc,
                                            frozen=pieces.get(f"{plane}_{law}_frozen", ())))
         # Exact (event-driven) Coulomb friction applies the tangential force itself and
-        # takes only the friction law's normal share: the law with mu = 0, whose
-        # regularised Coulomb part (two square roots and a division) then drops out.
-        outputs = pieces[f"{plane}_friction"].xreplace({model.p["friction_coefficient"]: 0})
+        # takes only the friction law's normal share: its composition with no tangential
+        # part (contact.COMPOSITIONS), the law with mu = 0, without the regularised
+        # Coulomb part's two square roots and division.
+        outputs = pieces[f"{plane}_friction_normal"]
         doc = f"{plane} contact, friction law with mu = 0 (its normal share, weighted):"
         kernels.append(Kernel(f"{plane}_friction_normal",
                               f"{doc} {describe_contact_law_layout()}.",
