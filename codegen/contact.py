@@ -453,12 +453,15 @@ def compliant_margins(model: Model, plane: str):
     dilution = _positive(rhodot) / (2 * _rho_floor(rho))
     stretch = ex * slip[0] + ey * slip[1] - dilution * size
     yield_margin = 1 - k_t * size / sm.Max(c.cap, sm.sqrt(_FORCE_FLOOR2))
-    # with no load (F_n = 0: the contact's last instants, or its clamp) both modes apply
-    # no tangential force and the deflection stands still: neither guard fires (1, and
-    # 1 m/s: any positive value)
+    # with no load (F_n = 0: past the contact's end, or at its clamp) both modes apply no
+    # tangential force and the deflection stands still.  The yield margin reads -1 there:
+    # a loaded spring's r = k_t |s| / (mu F_n) grows without bound as the load goes, so
+    # an elastic contact always yields before it ends, and a step that jumps from
+    # below the cap to past the end must still see the crossing.  The re-stick margin
+    # reads +1 (a sliding contact never re-sticks by losing its load).
     in_contact = sm.Heaviside(f_n, 0)
     idle = 1 - in_contact
-    return [in_contact * yield_margin + idle, in_contact * (stretch - s_cap_rate) + idle,
+    return [in_contact * yield_margin - idle, in_contact * (stretch - s_cap_rate) + idle,
             s_cap, k_t]
 
 

@@ -163,6 +163,8 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
             events.append(("deepest", plane, _deepest_of(plane)))
         else:
             threshold = contact_threshold(scene, plane, rho0, entering=True)
+            if compliantmodes.uses_modes(scene):   # the compliant law starts armed
+                threshold = max(threshold, compliantmodes.arm_penetration(scene, plane))
             events.append(("enter", plane, rho.shifted(-threshold, True, 1)))
         mode = coulomb[plane] if coulomb else None
         if mode in ("slip", "slip_fixed"):

@@ -128,13 +128,11 @@ class _Run:
         if self.exact:
             self.start_coulomb(plane)
         if self.compliant_modes:
+            # a contact starts where rho reaches the arming depth (events.segment_events);
+            # one that starts shallower (a scene's initial state) arms there
             self.armed[plane] = ev.penetration(plane, self.scene)(0, y) >= \
-                compliantmodes.arm_penetration(self.scene, plane)
-            if self.armed[plane]:   # a scene that starts in contact: armed at once
-                mode, self.y = compliantmodes.decide(y, self.params, self.latch, plane,
-                                                     arming=True)
-            else:
-                mode, self.y = compliantmodes.start(y, self.params, self.latch, plane)
+                0.5 * compliantmodes.arm_penetration(self.scene, plane)
+            mode, self.y = compliantmodes.start(y, self.params, self.latch, plane)
             self.set_compliant(plane, mode)
 
     def end_contact(self, plane):
