@@ -279,7 +279,7 @@ def compliant_contact(model: Model, plane: str) -> CompliantContact:
 
 
 def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, cap,
-                        slip, normal_force_rate, dilute=True):
+                        slip, normal_force_rate, dilute=True, smooth_yield=True):
     """The incremental (passive) Mindlin tangential spring with a Coulomb cap.
 
     Returns (capped elastic force F_e (2), deflection rate s' (2), the rate of the
@@ -290,7 +290,9 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     elastic law exact there), a flow growing from the cap up; the second term follows
     a cap that shrinks as rho does; the
     applied force F_e = F_el min(1, cap/|F_el|).  ``dilute=False`` leaves the middle
-    term out (the Jacobian's form: see JACOBIAN_FORMS).
+    term out (the Jacobian's form: see JACOBIAN_FORMS).  ``smooth_yield=False``: the
+    spring alone, phi = 0 and F_e = F_el (the elastic mode of the exact modes, whose
+    guard keeps it below the cap).
     """
     sx, sy = deflection_symbols(model, plane)
     vx, vy = slip
@@ -306,7 +308,7 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     relative = normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2)) - stiffening
     shrinking = _positive(-relative)
     excess = _positive(ratio2**(YIELD_EXPONENT // 2) - 1)     # 0 below the cap
-    flow = excess * loading + sm.Min(excess, 1) * shrinking
+    flow = excess * loading + sm.Min(excess, 1) * shrinking if smooth_yield else sm.S.Zero
     dilution = _positive(rhodot) / (2 * _rho_floor(rho)) if dilute else sm.S.Zero
     # the deflection only moves while the contact carries a load (F_n > 0): a contact
     # segment starts where its event located rho = 0, possibly a rounding below it, and
@@ -318,7 +320,7 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     rate = [in_contact * (v - (dilution + flow) * s) for v, s in zip((vx, vy), (sx, sy))]
     elastic = [-k_t * sx, -k_t * sy]
     size = sm.sqrt(sm.Max(k_t**2 * size2, cap**2, _FORCE_FLOOR2))
-    capped = [f * cap / size for f in elastic]      # = elastic unless above the cap
+    capped = [f * cap / size for f in elastic] if smooth_yield else elastic
     # d/dt (1/2 k_t |s|^2) = k_t s.s' + 1/2 |s|^2 dk_t/dt
     storage = k_t * (sx*rate[0] + sy*rate[1]) + k_t * size2 / 2 * stiffening
     return capped, rate, storage, k_t
@@ -477,7 +479,14 @@ def capacity_damping(model: Model, k_t, cap, capped, slip):
     return [alpha * f for f in viscous]
 
 
-def compliant_model_force(model: Model, plane: str, jacobian_form=False):
+def compliant_elastic_force(model: Model, plane: str, jacobian_form=False):
+    """The compliant law's elastic mode (``<plane>_compliant_elastic``): the law of
+    compliant_model_force without its smooth yield and cap -- below the cap they are
+    inactive, and the mode's yield guard ends it there (ballc.compliantmodes)."""
+    return compliant_model_force(model, plane, jacobian_form, smooth_yield=False)
+
+
+def compliant_model_force(model: Model, plane: str, jacobian_form=False, smooth_yield=True):
     """ballc's passive compliant law (not in the seed): docs/contact_laws.md.
 
     Normal: Hertz with Hunt-Crossley or viscoelastic damping.  Tangential: the DEM
@@ -491,7 +500,8 @@ def compliant_model_force(model: Model, plane: str, jacobian_form=False):
     capped, rate, storage, k_t = incremental_mindlin(model, plane, c.stiffness, c.rho,
                                                      c.rhodot, c.normal_force, c.cap, c.slip,
                                                      c.normal_force_rate,
-                                                     dilute=not jacobian_form)
+                                                     dilute=not jacobian_form,
+                                                     smooth_yield=smooth_yield)
     viscous = capacity_damping(model, k_t, c.cap, capped, c.slip)
     tangential = [e + v for e, v in zip(capped, viscous)]
     force = c.normal_force*c.normal + tangential[0]*N.x + tangential[1]*N.y
@@ -536,6 +546,8 @@ class ContactLaw:
 JACOBIAN_FORMS = {
     "compliant": lambda model, plane: compliant_model_force(model, plane, jacobian_form=True),
     "compliant_sliding": lambda model, plane: compliant_sliding_force(model, plane,
+                                                                      jacobian_form=True),
+    "compliant_elastic": lambda model, plane: compliant_elastic_force(model, plane,
                                                                       jacobian_form=True),
 }
 
@@ -601,6 +613,7 @@ TANGENTIAL_LAWS = {
     "digin": digin_model_force,
     "compliant": compliant_model_force,
     "compliant_sliding": compliant_sliding_force,
+    "compliant_elastic": compliant_elastic_force,
 }
 
 

@@ -187,7 +187,8 @@ def codegen_law(model, plane, name):
 
 
 def test_the_table_holds_the_seed_laws():
-    assert set(contact.TANGENTIAL_LAWS) == {"friction", "digin", "compliant", "compliant_sliding"}
+    assert set(contact.TANGENTIAL_LAWS) == {"friction", "digin", "compliant", "compliant_sliding",
+                                            "compliant_elastic"}
     assert set(contact.COMPOSITIONS) == {*SEED_LAWS, "friction_normal"}
 
 

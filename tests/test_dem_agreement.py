@@ -1,6 +1,7 @@
 """ballc's compliant law against the explicit DEM oracle (validation/dem_reference.py),
-on a few fixed impacts: fast checks that the law's parts (tangential stiffness, yield,
-tangential damping, dilution) are the oracle's (benchmarks/plant_defects.py)."""
+on a few fixed impacts: fast checks that the law's parts (tangential stiffness, the
+exact modes and the smooth yield, tangential damping, dilution) are the oracle's
+(benchmarks/plant_defects.py)."""
 import numpy as np
 import pytest
 
@@ -11,9 +12,20 @@ from validation.dem_reference import dem_impact_converged
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_random_impacts_agree_with_the_dem_oracle(seed):
-    # 12 undamped 3-D oblique spinning impacts: the issue's bar is 1 % of the impact
-    # speed; the law's worst measured over 254 such impacts (seeds 0..5) is 0.81 %
-    errors = compare(random_impacts(6, seed=seed), rel_tol=1e-4)
+    # 12 undamped 3-D oblique spinning impacts with the exact elastic/sliding modes (the
+    # default): the issue's bar is 1 % of the impact speed; measured over 300 such
+    # impacts the worst is of the order of the oracle's own convergence (rel_tol)
+    errors = compare(random_impacts(6, seed=seed), rel_tol=1e-5)
+    assert errors.max() < 1e-3, errors
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_smooth_yield_agrees_with_the_dem_oracle(seed):
+    # the law without modes (friction_regularization "smooth"): the cap by the smooth
+    # yield of exponent 64 alone; its worst over 300 impacts is 0.81 %
+    impacts = [dict(kwargs, friction_regularization="smooth")
+               for kwargs in random_impacts(6, seed=seed)]
+    errors = compare(impacts, rel_tol=1e-4)
     assert errors.max() < 0.01, errors
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ballc
-from ballc import _core
+from ballc import _core, compliantmodes
 
 STATE = {name: i for i, name in enumerate(_core.STATE_NAMES)}
 
@@ -73,7 +73,7 @@ def test_tangential_dissipation_rate_is_non_negative_at_every_state():
     """The rate itself (the kernel's output), at states sampled along random impacts and
     at random perturbations of them: -F_t.v_t - d/dt(1/2 k_t |s|^2) >= 0."""
     rng = np.random.default_rng(7)
-    n_checked = 0
+    n_checked = n_sliding = 0
     for _ in range(6):
         scene, v, w = random_impact(rng, restitution=0.6)
         hit = ballc.impact(scene, v, w, rtol=1e-8)
@@ -82,21 +82,32 @@ def test_tangential_dissipation_rate_is_non_negative_at_every_state():
         latch = np.zeros(len(_core.LATCH_NAMES))
         latch[0] = contact.penetration_rate_at_impact
         latch[1:4] = contact.digin_direction
-        flags = _core.FLAGS["floor_compliant"]
         inside = hit.result.position[2] < scene.radius
         for y in hit.result.y.T[inside]:
             for scale in (0.0, 0.3, 3.0):      # the sample, and its deflection scaled
                 z = y.copy()
                 z[STATE["floor_deflection_x"]:STATE["floor_deflection_y"] + 1] *= 1 + scale
                 z[STATE["omega_x"]:STATE["omega_z"] + 1] += scale * rng.normal(size=3) * 100
-                rates = _core.rhs(np.ascontiguousarray(z), p, latch, flags)
                 force = contact.peak_normal_force * (1 + scene.friction_coefficient)
                 speed = np.abs(z[STATE["vx"]:STATE["vz"] + 1]).max() + \
                     scene.radius * np.abs(z[STATE["omega_x"]:STATE["omega_z"] + 1]).max()
-                # >= 0 up to rounding of the impact's forces (the law's floors, 1e-12 N)
-                assert rates[STATE["dissipated_tangential"]] >= -1e-12 * force * speed
-                n_checked += 1
-    assert n_checked > 100
+                # the smooth-yield law and the elastic mode's spring, at every state
+                for flags in (_core.FLAGS["floor_compliant"],
+                              _core.FLAGS["floor_compliant_elastic"]):
+                    rates = _core.rhs(np.ascontiguousarray(z), p, latch, flags)
+                    # >= 0 up to rounding of the impact's forces (the floors, 1e-12 N)
+                    assert rates[STATE["dissipated_tangential"]] >= -1e-12 * force * speed
+                    n_checked += 1
+                # the sliding mode, where it applies: the spring at the cap, stretched
+                # by the slip faster than the cap grows (re-stick margin >= 0)
+                at_cap = compliantmodes.at_cap(z, p, latch, "floor", only_down=False)
+                margins = compliantmodes.margins(at_cap, p, latch, "floor")
+                if margins[2] > 0 and margins[1] >= 0:
+                    rates = _core.rhs(np.ascontiguousarray(at_cap), p, latch,
+                                      _core.FLAGS["floor_compliant_sliding"])
+                    assert rates[STATE["dissipated_tangential"]] >= -1e-12 * force * speed
+                    n_sliding += 1
+    assert n_checked > 200 and n_sliding > 20, (n_checked, n_sliding)
 
 
 @pytest.mark.parametrize("method", ["radau5", "dop853"])

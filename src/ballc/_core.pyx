@@ -61,6 +61,7 @@ cdef extern from "_system.h":
     int BALLC_FLOOR_SLIP, BALLC_CEILING_SLIP, BALLC_FLOOR_STICK, BALLC_CEILING_STICK
     int BALLC_FLOOR_SLIP_FIXED, BALLC_CEILING_SLIP_FIXED
     int BALLC_FLOOR_COMPLIANT_SLIDING, BALLC_CEILING_COMPLIANT_SLIDING
+    int BALLC_FLOOR_COMPLIANT_ELASTIC, BALLC_CEILING_COMPLIANT_ELASTIC
     int ballc_compliant_margins(const double *, const double *, const double *, int,
                                 double *) nogil
     int ballc_compliant_margins_prepared(const double *, const ballc_parameters_t *,
@@ -97,6 +98,8 @@ FLAGS = {
     "ceiling_slip_fixed": BALLC_CEILING_SLIP_FIXED,
     "floor_compliant_sliding": BALLC_FLOOR_COMPLIANT_SLIDING,
     "ceiling_compliant_sliding": BALLC_CEILING_COMPLIANT_SLIDING,
+    "floor_compliant_elastic": BALLC_FLOOR_COMPLIANT_ELASTIC,
+    "ceiling_compliant_elastic": BALLC_CEILING_COMPLIANT_ELASTIC,
 }
 ENERGY_NOUT = BALLC_ENERGY_NOUT
 CONTACT_KINEMATICS_NOUT = BALLC_CONTACT_KINEMATICS_NOUT

@@ -30,6 +30,8 @@ CONTACT_LAWS[] = {
     {BALLC_FLOOR_COMPLIANT, ballc_floor_compliant, ballc_floor_compliant_jac, 0, NULL, NULL},
     {BALLC_FLOOR_COMPLIANT_SLIDING, ballc_floor_compliant_sliding,
      ballc_floor_compliant_sliding_jac, 0, NULL, NULL},
+    {BALLC_FLOOR_COMPLIANT_ELASTIC, ballc_floor_compliant_elastic,
+     ballc_floor_compliant_elastic_jac, 0, NULL, NULL},
     {BALLC_CEILING_FRICTION, ballc_ceiling_friction, ballc_ceiling_friction_jac, 1,
      ballc_ceiling_friction_normal, ballc_ceiling_friction_normal_jac},
     {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac, 1, NULL, NULL},
@@ -37,6 +39,8 @@ CONTACT_LAWS[] = {
      NULL, NULL},
     {BALLC_CEILING_COMPLIANT_SLIDING, ballc_ceiling_compliant_sliding,
      ballc_ceiling_compliant_sliding_jac, 1, NULL, NULL},
+    {BALLC_CEILING_COMPLIANT_ELASTIC, ballc_ceiling_compliant_elastic,
+     ballc_ceiling_compliant_elastic_jac, 1, NULL, NULL},
 };
 #define N_CONTACT_LAWS (sizeof CONTACT_LAWS / sizeof CONTACT_LAWS[0])
 #define LAW_NOUT BALLC_CONTACT_LAW_NOUT

@@ -40,7 +40,10 @@ enum {
      * its elastic mode): the stored tangential force at the Coulomb cap, -mu F_n s/|s|
      * (codegen/contact.py, compliant_sliding_force). */
     BALLC_FLOOR_COMPLIANT_SLIDING = 8192,
-    BALLC_CEILING_COMPLIANT_SLIDING = 16384
+    BALLC_CEILING_COMPLIANT_SLIDING = 16384,
+    /* Its elastic mode once the guards are armed: the law without its smooth yield. */
+    BALLC_FLOOR_COMPLIANT_ELASTIC = 32768,
+    BALLC_CEILING_COMPLIANT_ELASTIC = 65536
 };
 
 /* Sum of the contact forces on the ball, per plane (floor x y z, ceiling x y z). */

@@ -66,11 +66,15 @@ def uses_modes(scene) -> bool:
     return scene.tangential_model == "compliant" and scene.friction_regularization == "exact"
 
 
-def mode_flags(plane: str, mode: str | None) -> int:
-    """The C flag of the compliant law on ``plane`` in ``mode`` (None: the law alone,
-    its smooth yield capping it: the elastic mode's kernels)."""
-    return _core.FLAGS[f"{plane}_compliant_sliding" if mode == "sliding"
-                       else f"{plane}_compliant"]
+def mode_flags(plane: str, mode: str | None, armed: bool = True) -> int:
+    """The C flag of the compliant law on ``plane`` in ``mode``: the sliding kernels;
+    the elastic mode's (the spring alone) once its guards are ``armed``; else (mode
+    None: no modes, or before the arming) the law with its smooth yield."""
+    if mode == "sliding":
+        return _core.FLAGS[f"{plane}_compliant_sliding"]
+    if mode == "elastic" and armed:
+        return _core.FLAGS[f"{plane}_compliant_elastic"]
+    return _core.FLAGS[f"{plane}_compliant"]
 
 
 def margins(y, params, latch, plane: str) -> np.ndarray:

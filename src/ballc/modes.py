@@ -21,19 +21,20 @@ _KIN_PER_PLANE = _core.CONTACT_KINEMATICS_NOUT // len(PLANES)
 MIN_IMPACT_RATE = 1e-9
 
 
-def flags(scene, in_contact, coulomb=None, compliant=None):
+def flags(scene, in_contact, coulomb=None, compliant=None, armed=None):
     """The C flags of a segment: the observer's kernels (when it has mass), each
     contact's laws (compliant; or friction and/or dig-in by the mixture) and, with
     ``coulomb`` (plane -> "slip", "slip_fixed", "stick" or None), each contact's
-    exact Coulomb mode; with ``compliant`` (plane -> "elastic", "sliding" or None),
-    each compliant contact's mode (ballc.compliantmodes)."""
+    exact Coulomb mode; with ``compliant`` (plane -> "elastic", "sliding" or None) and
+    ``armed`` (plane -> bool), each compliant contact's mode (ballc.compliantmodes)."""
     flags = _core.FLAGS["observer"] if scene.observer_mass != 0 else 0
     mixture = scene.effective_mixture
     for plane in PLANES:
         if not in_contact[plane]:
             continue
         if scene.tangential_model == "compliant":
-            flags |= compliantmodes.mode_flags(plane, compliant[plane] if compliant else None)
+            flags |= compliantmodes.mode_flags(plane, compliant[plane] if compliant else None,
+                                               armed[plane] if armed else False)
             continue
         if mixture < 1:
             flags |= _core.FLAGS[f"{plane}_friction"]

@@ -95,12 +95,13 @@ class _Run:
     def flags(self, with_coulomb=True):
         key = (self.in_contact["floor"], self.in_contact["ceiling"],
                self.coulomb["floor"], self.coulomb["ceiling"], with_coulomb,
-               self.compliant["floor"], self.compliant["ceiling"])
+               self.compliant["floor"], self.compliant["ceiling"],
+               self.armed["floor"], self.armed["ceiling"])
         found = self._flags.get(key)
         if found is None:   # a run visits a handful of modes: compute each once
             found = self._flags[key] = modes.flags(
                 self.scene, self.in_contact, self.coulomb if with_coulomb else None,
-                self.compliant)
+                self.compliant, self.armed)
         return found
 
     # ---- contacts ----

@@ -1,0 +1,95 @@
+"""The compliant law's exact elastic/sliding modes (ballc.compliantmodes): each checked
+against an independent oracle -- the self-similar start's closed-form ratio, the Coulomb
+cap itself, the same run at a tighter tolerance -- not against ballc's own numbers."""
+import math
+
+import numpy as np
+import pytest
+
+import ballc
+from ballc import _core, layout
+
+PLANE_FLAGS = {"sliding": _core.FLAGS["floor_compliant_sliding"],
+               "elastic": _core.FLAGS["floor_compliant_elastic"]}
+
+
+def _impact_scene(**law):
+    """A 5-mm steel-on-glass-like ball (no gravity, no observer), Hunt-Crossley."""
+    return ballc.Scene(mass=4e-3, radius=5e-3, observer_mass=0.0, gravity=0.0,
+                       ceiling_height=1.0, position=(0.0, 0.0, 0.5), velocity=(0, 0, -1),
+                       ball_youngs_modulus=2e11, ball_poisson_ratio=0.3,
+                       plane_youngs_modulus=7e10, plane_poisson_ratio=0.22,
+                       tangential_model="compliant", **law)
+
+
+@pytest.mark.parametrize("ratio", [0.8, 1.25])
+def test_a_contact_starts_in_the_mode_of_its_self_similar_start(ratio):
+    # Hunt-Crossley with chi = 3/2 (1 - c_tau): at the start rho = v_n t, F_n =
+    # k0 rho^(3/2) (1 + chi), the elastic spring s = 2/3 v_t t (dilution), so
+    # k_t |s| / (mu F_n) = kappa |v_t| / (mu (1 + chi) v_n) at every t: above 1 the
+    # contact starts sliding, below it starts elastic (sticking)
+    kappa, mu, c_tau, v_n = 0.7, 0.4, 0.5, 2.0
+    chi = 1.5 * (1 - c_tau)
+    v_t = ratio * mu * (1 + chi) * v_n / kappa
+    scene = _impact_scene(c_tau=c_tau, tangential_stiffness_ratio=kappa,
+                          friction_coefficient=mu)
+    hit = ballc.impact(scene, (v_t, 0.0, -v_n))
+    first = hit.result.contacts[0].transitions[0][1]
+    assert first == ("slip" if ratio > 1 else "stick"), hit.result.contacts[0].transitions
+
+
+def _samples(result, mode):
+    """(F_n, |F_t|) of the floor at the samples computed in ``mode``, inside contact."""
+    flags = np.asarray(result.flags)
+    inside = (flags & PLANE_FLAGS[mode]) != 0
+    latch = result.latch if result.latch.shape[0] == result.t.size else result.latch.T
+    forces = _core.contact_forces_per_sample(
+        np.ascontiguousarray(result.y.T[inside]), result.scene.parameter_vector(),
+        np.ascontiguousarray(latch[inside]), np.ascontiguousarray(flags[inside], np.intc))
+    return forces[:, 2], np.hypot(forces[:, 0], forces[:, 1])
+
+
+def test_sliding_carries_the_cap_and_elastic_stays_below_it():
+    # a spinning oblique impact that slides, sticks and slides again
+    scene = _impact_scene(c_tau=0.5, tangential_stiffness_ratio=0.6, friction_coefficient=0.3)
+    hit = ballc.impact(scene, (1.0, 0.3, -2.0), (40.0, -90.0, 30.0), rtol=1e-10)
+    phases = [phase for _, phase in hit.result.contacts[0].transitions]
+    assert "slip" in phases and "stick" in phases, phases
+    mu = scene.friction_coefficient
+    f_n, f_t = _samples(hit.result, "sliding")
+    loaded = f_n > 1e-6 * f_n.max()
+    assert loaded.sum() > 10
+    np.testing.assert_allclose(f_t[loaded], mu * f_n[loaded], rtol=1e-12)
+    f_n, f_t = _samples(hit.result, "elastic")
+    assert f_n.size > 10
+    assert np.all(f_t <= mu * f_n * (1 + 1e-5) + 1e-12 * f_n.max())
+
+
+def test_mode_changes_converge_with_the_tolerance():
+    # the seed's throw with the compliant law (observer included): the times of every
+    # contact start and mode change at rtol 1e-8 within 1e-6 s of those at 1e-11 (no
+    # decision flips with the tolerance), and the final state within 1e-4
+    scene = ballc.Scene(tangential_model="compliant")
+    loose, tight = (ballc.simulate(scene, 1.2, rtol=tol, atol=tol) for tol in (1e-8, 1e-11))
+    assert loose.status == tight.status == 0
+    assert len(loose.contacts) == len(tight.contacts) >= 3
+    for a, b in zip(loose.contacts, tight.contacts):
+        assert [p for _, p in a.transitions] == [p for _, p in b.transitions]
+        times_a = np.array([t for t, _ in a.transitions])
+        times_b = np.array([t for t, _ in b.transitions])
+        assert np.abs(times_a - times_b).max() < 1e-6, (a.transitions, b.transitions)
+    assert np.abs(loose.y[:13, -1] - tight.y[:13, -1]).max() < 1e-4
+
+
+def test_the_smooth_yield_stays_an_option_and_agrees():
+    # friction_regularization "smooth" runs the law without modes: no sliding kernel
+    # ever runs, and the rebound is within 1 % of the exact modes' (the smooth yield's
+    # measured difference from the DEM truncation)
+    kwargs = dict(c_tau=0.5, tangential_stiffness_ratio=0.6, friction_coefficient=0.3)
+    exact = ballc.impact(_impact_scene(**kwargs), (1.0, 0.3, -2.0), (40.0, -90.0, 30.0))
+    smooth = ballc.impact(_impact_scene(friction_regularization="smooth", **kwargs),
+                          (1.0, 0.3, -2.0), (40.0, -90.0, 30.0))
+    assert not np.any(np.asarray(smooth.result.flags) & PLANE_FLAGS["sliding"])
+    assert not smooth.result.contacts[0].transitions
+    speed = math.hypot(1.0, 0.3, 2.0)
+    assert np.abs(exact.velocity_after - smooth.velocity_after).max() < 0.01 * speed
