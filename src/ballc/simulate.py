@@ -15,7 +15,8 @@ import math
 
 import numpy as np
 
-from . import _core, compliantmodes, events as ev, layout, modes, outcome, resting, stickslip
+from . import (_core, automaton, compliantmodes, events as ev, layout, modes, outcome, resting,
+               stickslip)
 from ._format import plain
 from .dense import PiecewiseSolution
 from .flight import FreeFlight
@@ -77,6 +78,7 @@ class _Run:
         self.compliant: dict[str, str | None] = {plane: None for plane in PLANES}
         self.armed = {plane: False for plane in PLANES}   # the compliant guards
         self.in_contact = {plane: False for plane in PLANES}
+        self.passed: set[str] = set()   # the planes the ball passed through
         self.coulomb: dict[str, str | None] = {plane: None for plane in PLANES}
         self.approach: dict[str, float | None] = {plane: None for plane in PLANES}
         self.relatches = {plane: 0 for plane in PLANES}
@@ -106,7 +108,7 @@ class _Run:
 
     # ---- contacts ----
 
-    def begin_contact(self, plane):
+    def begin_contact(self, kind, plane):
         """Latch the contact's values at the current state; with exact Coulomb friction
         pick its first mode (the state may be projected onto zero slip)."""
         y = self.y
@@ -136,7 +138,7 @@ class _Run:
             mode, self.y = compliantmodes.start(y, self.params, self.latch, plane)
             self.set_compliant(plane, mode)
 
-    def end_contact(self, plane):
+    def end_contact(self, kind, plane):
         y = self.y
         self.rest_check.pop(plane, None)
         self.in_contact[plane] = False
@@ -368,21 +370,30 @@ class _Run:
     # ---- one event ----
 
     def handle(self, kind, plane):
-        """Apply a terminal event of the driver that fired at (self.t, self.y)."""
-        if kind == "enter":
-            self.begin_contact(plane)
-        elif kind == "leave":
-            self.end_contact(plane)
-        elif kind == "through":
-            contact = self.open.pop(plane)   # ended by passing through: no t_end
-            contact.max_penetration = self.scene.radius
-            self.status = 1
-            self.message = (f"ball passed through the {plane} at t = {self.t:.6g} s "
-                            "(penetration reached the ball's radius)")
-        elif kind in compliantmodes.GUARDS:
-            self.compliant_event(kind, plane)
-        else:
-            self.coulomb_event(kind, plane)
+        """Apply a terminal event of the driver that fired at (self.t, self.y): the
+        handler ballc.automaton's table names for it."""
+        getattr(self, automaton.handler_of(kind))(kind, plane)
+
+    def mode(self, plane):
+        """``plane``'s mode, as ballc.automaton names it."""
+        if not self.in_contact[plane]:
+            return "passed_through" if self.status == 1 and plane in self.passed else "flight"
+        contact = self.open.get(plane)
+        if contact is not None and not math.isnan(contact.t_rest):
+            return "resting"
+        if contact is not None and not math.isnan(contact.t_rolling):
+            return "rolling"
+        return self.coulomb[plane] or self.compliant[plane] or "contact"
+
+    def pass_through(self, kind, plane):
+        """The ball passed through ``plane`` (rho reached r): the run stops, status 1."""
+        contact = self.open.pop(plane)   # ended by passing through: no t_end
+        contact.max_penetration = self.scene.radius
+        self.in_contact[plane] = False
+        self.passed.add(plane)
+        self.status = 1
+        self.message = (f"ball passed through the {plane} at t = {self.t:.6g} s "
+                        "(penetration reached the ball's radius)")
 
 
 def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float = 1e-10,
@@ -477,7 +488,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     t_end, t_eval = options.t_end, options.t_eval
     for plane in PLANES:   # a scene may start in contact: latch as documented in modes
         if ev.penetration(plane, scene)(0.0, run.y) > 0:
-            run.begin_contact(plane)
+            run.begin_contact("enter", plane)
     samples = Samples()
     if t_eval is None:
         samples.add(np.array([0.0]), run.y[:, None], run.flags(), run.latch)

@@ -1,0 +1,117 @@
+"""ballc's hybrid automaton, in one table: the modes of a plane, the guards that end a
+segment, and the resets that start the next.
+
+A run is a sequence of smooth segments (simulate.py integrates one at a time).  Each
+plane is in one *mode* at a time:
+
+* ``flight``: not in contact;
+* with exact Coulomb friction (ballc.stickslip; the friction and mixture models):
+  ``slip`` (free direction), ``slip_fixed`` (direction held), ``stick``;
+* with the compliant law's exact modes (ballc.compliantmodes): ``elastic``, ``sliding``;
+* ``contact``: in contact with neither (the dig-in model; the "max" and "smooth"
+  regularisations; mu = 0);
+* end states of a run (ballc.resting; floor only): ``resting``, ``rolling``;
+  ``passed_through`` (the ball left through the plane: status 1).
+
+:data:`TRANSITIONS` lists every transition: the event kind (the name
+events.segment_events gives its guard), the modes it leaves from, the modes it may lead
+to, the guard (event function and direction), the reset, and the method of
+simulate._Run that applies it.  :data:`SIMULTANEOUS` is how simultaneous events are
+ordered.  ``simulate`` dispatches every event through :func:`handler_of`, and
+tests/test_automaton.py runs scenes that take every transition and checks each one it
+sees against this table.  docs/architecture.md draws it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+#: the modes of a contact, per model
+COULOMB_MODES = ("slip", "slip_fixed", "stick")
+COMPLIANT_MODES = ("elastic", "sliding")
+CONTACT_MODES = ("contact",) + COULOMB_MODES + COMPLIANT_MODES
+END_MODES = ("resting", "rolling", "passed_through")
+MODES = ("flight",) + CONTACT_MODES + END_MODES
+
+
+@dataclass(frozen=True)
+class Transition:
+    """One row of the automaton."""
+
+    event: str           # the event kind (events.segment_events), or a scheduled check
+    sources: tuple       # modes of the plane it leaves from
+    targets: tuple       # modes it may lead to
+    guard: str           # the event function g and its direction (terminal events)
+    reset: str           # what is latched or reset, and how the next mode is chosen
+    handler: str         # the simulate._Run method that applies it
+
+
+TRANSITIONS = (
+    Transition("enter", ("flight",), CONTACT_MODES,
+               "rho - threshold rises through 0 (threshold: 4 ulp of the plane's position, "
+               "or the compliant law's arming depth)",
+               "latch rhodot^- and the dig-in direction; deflection 0; the first Coulomb mode "
+               "(slip, slip_fixed, or settle: stick / slip_fixed) or the compliant start "
+               "mode (the self-similar start's)", "begin_contact"),
+    Transition("leave", CONTACT_MODES, ("flight",),
+               "rho + threshold falls through 0", "close the contact's record",
+               "end_contact"),
+    Transition("through", CONTACT_MODES, ("passed_through",),
+               "rho - r rises through 0", "the run stops, status 1", "pass_through"),
+    Transition("approach", ("slip",), ("slip", "slip_fixed"),
+               "u . d - clear falls through 0 (u the slip velocity, d its latched "
+               "direction)", "re-latch d and stay free (a slip passing by zero; radau5 "
+               "re-arms the event without ending the segment), else hold d",
+               "coulomb_event"),
+    Transition("stop", ("slip_fixed",), ("stick", "slip_fixed", "slip"),
+               "u . d + margin falls through 0",
+               "a slip left within 10 tolerances is removed by an impulse and the contact "
+               "settles (stick, or slip from rest along -lambda); a larger one slips on",
+               "coulomb_event"),
+    Transition("clear", ("slip_fixed",), ("slip",),
+               "u . d - 2 clear rises through 0", "the direction goes free",
+               "coulomb_event"),
+    Transition("release", ("stick",), ("slip_fixed",),
+               "mu N - |lambda| + margin falls through 0",
+               "slip from rest along -lambda (the slip removed)", "coulomb_event"),
+    Transition("arm", COMPLIANT_MODES, COMPLIANT_MODES,
+               "rho - arming depth rises through 0 (a scene that starts shallower)",
+               "arm the guards; decide at the cap", "compliant_event"),
+    Transition("yield", ("elastic",), COMPLIANT_MODES,
+               "1 - k_t |s| / (mu F_n) + offset falls through 0",
+               "decide at the cap: sliding when the re-stick margin there is >= 0, "
+               "else elastic with the spring brought back to the cap", "compliant_event"),
+    Transition("restick", ("sliding",), ("elastic",),
+               "(e . v_t - max(rhodot, 0)/(2 rho) |s|) - ds_cap/dt + offset falls "
+               "through 0", "a spring beyond the cap is brought back to it",
+               "compliant_event"),
+    Transition("rest check", CONTACT_MODES, ("resting", "rolling") + CONTACT_MODES,
+               "scheduled (not an event): 20 small-oscillation periods into a floor "
+               "contact, then at growing intervals",
+               "the rest state or uniform rolling, in closed form to t_end; else the next "
+               "check", "check_rest"),
+)
+
+#: How simultaneous events are handled: the earliest terminal event that fired ends the
+#: segment (an event at the segment's start is kept off by its threshold or offset);
+#: at equal times the first in events.segment_events' order, which is per plane (floor,
+#: then ceiling): leave / enter, through, deepest (not terminal), the Coulomb event, the
+#: compliant guard; the user's events come after the driver's.  A mode change at the
+#: time of the last one counts as stalled, and 100 in a row stop the run (status -1).
+SIMULTANEOUS = ("leave", "enter", "through", "deepest", "approach", "stop", "clear",
+                "release", "arm", "yield", "restick", "user")
+
+_HANDLERS = {transition.event: transition.handler for transition in TRANSITIONS}
+
+
+def handler_of(kind: str) -> str:
+    """The simulate._Run method that applies the event ``kind``."""
+    try:
+        return _HANDLERS[kind]
+    except KeyError:
+        raise ValueError(f"event kind {kind!r} is not in the automaton "
+                         f"({', '.join(_HANDLERS)})") from None
+
+
+def transitions_from(kind: str):
+    """The rows of event ``kind`` (one per kind)."""
+    return [transition for transition in TRANSITIONS if transition.event == kind]
