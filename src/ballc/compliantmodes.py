@@ -4,24 +4,35 @@ The DEM codes step the incremental Mindlin spring explicitly and truncate the st
 force to the cap mu F_n after each step.  In the limit dt -> 0 that is a hybrid system
 with two modes per contact (docs/contact_laws.md, "Exact elastic and sliding modes"):
 
-* **elastic** (below the cap; the ``<plane>_compliant`` kernels): the spring is elastic,
-  s' = v_t - max(rhodot, 0)/(2 rho) s, F_el = -k_t s, with viscous damping within the
-  capacity the elastic force leaves.  Guard **yield**: mu F_n - k_t |s| falls below 0
-  (the spring reaches the cap, stretched by the slip or by a cap that shrinks).
+* **elastic** (below the cap; the ``<plane>_compliant_elastic`` kernels): the spring
+  alone, s' = v_t - max(rhodot, 0)/(2 rho) s, F_el = -k_t s, with viscous damping
+  within the capacity the elastic force leaves.  Guard **yield**: 1 - k_t |s| / (mu F_n)
+  falls below 0 (the spring reaches the cap, stretched by the slip or by a cap that
+  shrinks).
 * **sliding** (at the cap; the ``<plane>_compliant_sliding`` kernels): F = -mu F_n e,
   e = s/|s|, with |s| = s_cap = mu F_n / k_t and e turning with the slip velocity:
-  s' = v_t - (e . v_t) e + e ds_cap/dt.  Guard **restick**: the elastic law would
+  s' = (v_t - (e . v_t) e) f + s d ln(s_cap)/dt (f = 1 above |s| = 1e-12 m, see
+  contact.TURN_FLOOR).  Guard **restick**: the elastic law would
   stretch the spring slower than the cap grows, (e . v_t - max(rhodot, 0)/(2 rho) |s|)
   - ds_cap/dt falls below 0.
 
-At a contact start (s = 0) the mode is the one whose solution exists: sliding when
-the spring, started at the cap along the slip velocity, would outgrow it (the
-re-stick margin there is >= 0; for Hunt-Crossley this is kappa |v_t| >= mu (1 + chi)
-rhodot^-, the ratio of the self-similar start s = 2/3 v_t t), elastic otherwise.  At a
-re-stick the deflection is reset to |s| = s_cap exactly (ds_cap/dt uses the penetration
-acceleration of a ball in one contact, -F_n/m* + g n_z, so with an observer |s| drifts
-from s_cap by the integration of that difference); the spring energy the reset removes
-or adds is booked to the tangential dissipated work, so the energy balance stays exact.
+A compliant contact begins where the penetration reaches the arming depth (ARM_ULPS
+ulp of the plane's position, and Hertz's force ARM_FORCE; the impulse before it, below
+1e-6 N for ~1e-10 s, is left out): below it rho's rounding, and the kernels' 1e-12-N
+load floor, would decide the mode changes.  It starts in the mode of its self-similar
+start (:func:`start`): sliding when the spring, at the cap along the slip velocity,
+would outgrow it (the re-stick margin there is >= 0; for Hunt-Crossley this is kappa
+|v_t| >= mu (1 + chi) rhodot^-, the ratio of the self-similar start s = 2/3 v_t t),
+elastic otherwise.  At a yield (:func:`decide`) the spring is at the cap to the
+integration's tolerance: it slides when the re-stick margin is >= 0, else stays
+elastic (it only touched the cap) and is brought back to the cap.  At a re-stick a
+spring beyond the cap is brought back to it.  Every such reset only lowers the spring
+energy 1/2 k_t |s|^2, and books what it releases to the tangential dissipated work, so
+the energy balance stays exact and the dissipated work never decreases (a sliding start
+puts (mu F_n)^2 / (2 k_t) into the spring unbooked: below 1e-12 N^2 / (2 k_t), ~1e-15 J).  The sliding
+law keeps |s| / s_cap (its radial rate is relative), so the approximate penetration
+acceleration in ds_cap/dt (-F_n/m* + g n_z; an observer makes it inexact) errs by a
+factor on |s|, never driving s through 0 before s_cap.
 
 With ``friction_regularization`` "max" or "smooth" the law runs without modes, capped
 by its smooth yield alone (contact.YIELD_EXPONENT).  This module holds the decisions at
@@ -37,7 +48,8 @@ from . import _core, layout, stickslip
 
 PLANES = ("floor", "ceiling")
 MODES = ("elastic", "sliding")
-#: The guards' event kinds: the starting mode's, the elastic mode's, the sliding mode's.
+#: The guards' event kinds: the arming's (a contact starting shallower than the arming
+#: depth), the elastic mode's, the sliding mode's.
 GUARDS = ("arm", "yield", "restick")
 _DEFLECTION = layout.DEFLECTION
 _DISSIPATED_TANGENTIAL = layout.INDEX["dissipated_tangential"]

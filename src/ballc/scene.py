@@ -114,8 +114,11 @@ class Scene:
     friction_regularization : str
         "exact" (default: Coulomb's law itself, the limit v_s -> 0 of the seed's; stick
         and slip are separate modes whose transitions are integrator events, see
-        ``ballc.stickslip``), "max" (the seed's literal v_t / max(abs(v_t), v_s)) or
-        "smooth" (v_t / sqrt(abs(v_t)^2 + v_s^2)).
+        ``ballc.stickslip``; for the compliant law, its Coulomb cap as exact elastic and
+        sliding modes, the DEM codes' truncation in the limit dt -> 0, see
+        ``ballc.compliantmodes``), "max" (the seed's literal v_t / max(abs(v_t), v_s)) or
+        "smooth" (v_t / sqrt(abs(v_t)^2 + v_s^2)); for the compliant law either of these
+        two runs it with its smooth yield instead of modes (docs/contact_laws.md).
     tangential_stiffness_ratio : float, optional
         Tangential / normal contact stiffness ratio kappa of the compliant model (1).
         Default (None): Mindlin's 4 G* / E*, from the Poisson ratios and the moduli.
