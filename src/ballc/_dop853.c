@@ -201,6 +201,7 @@ int dop853_step(solver_t *s)
         num += dk * dk;
         den += dy * dy;
     }
+    s->hlamb = den > 0 ? fabs(h) * sqrt(num / den) : 0.0;   /* for RADAU5_METHOD_AUTO */
     if (den > 0 && fabs(h) * sqrt(num / den) > 6.1) {
         s->nonstiff_steps = 0;
         if (++s->stiff_steps == 15 && isnan(s->r->stiff_at)) s->r->stiff_at = t;
@@ -215,6 +216,7 @@ int dop853_step(solver_t *s)
     s->t = t_new;
     s->dense_end = t_new;
     s->dense_ready = 0;
+    s->dense_dop853 = 1;
     s->k_stale = 0;
     s->have_sol = 1;
     s->r->nstep++;

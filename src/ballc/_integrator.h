@@ -90,13 +90,31 @@ typedef struct {
                                * to the event's time), not the dense output's value */
     const int *ev_rearm;      /* may be NULL; nonzero: the terminal event may be re-armed */
     radau5_rearm_fun rearm;   /*   by rearm (only where refine_events stepped to its time) */
-    int method;               /* RADAU5_METHOD_RADAU (0) or RADAU5_METHOD_DOP853 */
+    int method;               /* RADAU5_METHOD_RADAU (0), RADAU5_METHOD_DOP853 (1) or
+                               * RADAU5_METHOD_AUTO (2, see below) */
     int jacobian_ahead;       /* nonzero: a segment's first step whose Newton fails with the
                                * start's Jacobian retries once with the Jacobian at the
                                * step's explicit Euler end (the compliant law's contacts) */
+    int auto_implicit;        /* RADAU5_METHOD_AUTO only: nonzero starts with Radau IIA
+                               * instead of DOP853 (a segment continuing a stiff one) */
 } radau5_problem;
 
-enum { RADAU5_METHOD_RADAU = 0, RADAU5_METHOD_DOP853 = 1 };
+/* RADAU5_METHOD_AUTO: LSODA's idea with the two steps.  The call starts with DOP853
+ * (unless problem.auto_implicit) and switches to Radau IIA, before the next step, once
+ * Hairer's stiffness test has seen AUTO_STIFF_STEPS accepted steps in a row with
+ * |h lambda| > AUTO_STABILITY_BOUND (the same test that sets stiff_at); it switches
+ * back once AUTO_NONSTIFF_STEPS accepted Radau steps in a row had h rho(J) below
+ * AUTO_STABILITY_BOUND, rho(J) the spectral radius of the Radau step's Jacobian estimated
+ * by AUTO_POWER_ITERATIONS power iterations (once per Jacobian): steps that DOP853 could
+ * take as stably, at a higher order.  The new method starts from the state, right-hand
+ * side and step size in hand (Radau with a Jacobian taken there, no predictor and no
+ * step-size history).  Each step keeps its own method's interpolant (dense output,
+ * events, t_eval); result->dense_kind says which, per stored step. */
+enum { RADAU5_METHOD_RADAU = 0, RADAU5_METHOD_DOP853 = 1, RADAU5_METHOD_AUTO = 2 };
+#define AUTO_STABILITY_BOUND 6.1
+#define AUTO_STIFF_STEPS 15
+#define AUTO_NONSTIFF_STEPS 15
+#define AUTO_POWER_ITERATIONS 8
 
 /* Step control: scipy's Radau (0) or elements of Hairer & Wanner's RADAU5 (radau5.f,
  * RADCOR/ESTRAD), each a bit, for benchmarks/controllers.py.
@@ -148,10 +166,18 @@ typedef struct {
                                *   x = (t - t_old) / (t_new - t_old).  Radau (3 terms):
                                *   y(t) = y_old + sum_j Q_j x^(j+1), Q_j the j-th row.
                                *   DOP853 (7): rows F0..F6 of dop853_eval. */
-    int dense_terms;          /* 3 (Radau) or 7 (DOP853) */
+    int dense_terms;          /* 3 (Radau) or 7 (DOP853, and AUTO: the widest) */
+    int *dense_kind;          /* n_dense: each stored step's own number of terms, 3 or 7
+                               * (AUTO: a Radau step's rows 3..6 are zeros) */
     double stiff_at;          /* DOP853: the start of the step at which Hairer's stiffness
                                * test (15 steps in a row with |h lambda| > 6.1) first
                                * fired; NaN when it did not (and always for Radau) */
+    long n_switches;          /* AUTO: method switches, each at switch_t (the state in hand
+                               * there, before the step), to switch_to (a method code) */
+    double *switch_t;
+    int *switch_to;
+    int method_end;           /* the method of the last step (AUTO: the one in use) */
+    long nstep_implicit;      /* accepted Radau IIA steps (of nstep) */
     int profiled;             /* 1 in a -DRADAU5_PROFILE build */
     double prof[RADAU5_PROF_N];
 } radau5_result;

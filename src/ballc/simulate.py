@@ -447,6 +447,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     bar = progress_bar(progress, t_end)
     nfev = njev = nlu = 0
     first = options.first_step
+    implicit = False   # method="auto": the segment starts with radau5 (the step carried over)
+    switches = []      # method="auto": (t, method switched to), over the run
     stiff_at = None
     checks_rest = rest and t_eval is None and not user
 
@@ -471,8 +473,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                                 t_eval=segment_eval, max_step=options.max_step,
                                 max_nfev=remaining, first_step=first,
                                 dense_output=options.dense_output,
-                                exact_flight=options.exact_flight)
+                                exact_flight=options.exact_flight, auto_implicit=implicit)
         first = None
+        implicit = False
         # every integrator's solution is a solve_ivp-style OptimizeResult, a dict: item
         # access is a dict lookup (its attribute access goes through a Python __getattr__)
         nfev += sol["nfev"]
@@ -480,6 +483,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         nlu += sol["nlu"]
         if stiff_at is None and math.isfinite(sol.get("stiff_at", math.nan)):
             stiff_at = sol["stiff_at"]   # dop853's stiffness test fired in this segment
+        if options.method == "auto":
+            switches += sol.get("switches", ())
         t, t_events, y_events, status = sol["t"], sol["t_events"], sol["y_events"], sol["status"]
         # An event at the segment's very start ends a zero-length segment whose event
         # sample repeats t; keep only later samples so that result.t stays increasing.
@@ -537,6 +542,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     break
                 h_next = sol.get("h_next", 0)
                 first = min(h_next, options.max_step) if h_next > 0 else None
+                implicit = first is not None and sol.get("method_end") == "radau5"
                 continue
             break
         if fired < 0:
@@ -557,6 +563,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             # within a contact the dynamics do not jump at a stick/slip transition: go on
             # with the step the controller had chosen instead of a fresh start
             first = min(h_next, options.max_step)
+            # method="auto": the step carried over is the method's, so is the method
+            implicit = sol.get("method_end") == "radau5"
 
     if bar is not None:
         bar.update((t_end if run.status == 0 else run.t) - bar.n)
@@ -572,11 +580,13 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     t_events=[np.concatenate(k) if k else np.empty(0) for k in user_t],
                     y_events=[np.concatenate(k) if k else np.empty((0, _core.N_STATES))
                               for k in user_y],
-                    sol=PiecewiseSolution(pieces) if options.dense_output else None)
+                    sol=PiecewiseSolution(pieces) if options.dense_output else None,
+                    method_switches=switches if options.method == "auto" else None)
     outcome.summarize_contact_forces(result)
     result.message += outcome.tolerance_warning(options.rtol, options.atol)
     result.message += outcome.balance_warning(result, options.rtol)
-    result.message += outcome.stiffness_note(stiff_at)
+    if options.method == "dop853":   # auto switched to radau5 where the test fired
+        result.message += outcome.stiffness_note(stiff_at)
     return result
 
 
