@@ -201,7 +201,6 @@ int dop853_step(solver_t *s)
         num += dk * dk;
         den += dy * dy;
     }
-    s->hlamb = den > 0 ? fabs(h) * sqrt(num / den) : 0.0;   /* for RADAU5_METHOD_AUTO */
     if (den > 0 && fabs(h) * sqrt(num / den) > 6.1) {
         s->nonstiff_steps = 0;
         if (++s->stiff_steps == 15 && isnan(s->r->stiff_at)) s->r->stiff_at = t;

@@ -436,7 +436,7 @@ static double spectral_radius(solver_t *s)
 }
 
 /* After an accepted Radau step with AUTO: count it as calm when DOP853 could have taken
- * it stably, h rho(J) < AUTO_STABILITY_BOUND (rho estimated once per Jacobian). */
+ * it stably, and cheaper, h rho(J) < AUTO_CALM_BOUND (rho estimated once per Jacobian). */
 static void auto_observe(solver_t *s)
 {
     if (s->dop853) return;
@@ -444,7 +444,7 @@ static void auto_observe(solver_t *s)
         s->rho = spectral_radius(s);
         s->rho_njev = s->r->njev;
     }
-    if (fabs(s->t - s->t_old) * s->rho < AUTO_STABILITY_BOUND)
+    if (fabs(s->t - s->t_old) * s->rho < AUTO_CALM_BOUND)
         s->calm_steps++;
     else
         s->calm_steps = 0;

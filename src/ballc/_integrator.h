@@ -102,18 +102,27 @@ typedef struct {
 /* RADAU5_METHOD_AUTO: LSODA's idea with the two steps.  The call starts with DOP853
  * (unless problem.auto_implicit) and switches to Radau IIA, before the next step, once
  * Hairer's stiffness test has seen AUTO_STIFF_STEPS accepted steps in a row with
- * |h lambda| > AUTO_STABILITY_BOUND (the same test that sets stiff_at); it switches
- * back once AUTO_NONSTIFF_STEPS accepted Radau steps in a row had h rho(J) below
- * AUTO_STABILITY_BOUND, rho(J) the spectral radius of the Radau step's Jacobian estimated
- * by AUTO_POWER_ITERATIONS power iterations (once per Jacobian): steps that DOP853 could
- * take as stably, at a higher order.  The new method starts from the state, right-hand
- * side and step size in hand (Radau with a Jacobian taken there, no predictor and no
- * step-size history).  Each step keeps its own method's interpolant (dense output,
- * events, t_eval); result->dense_kind says which, per stored step. */
+ * |h lambda| > AUTO_STABILITY_BOUND (the same test that sets stiff_at).  It switches back
+ * once AUTO_NONSTIFF_STEPS accepted Radau steps in a row had h rho(J) < AUTO_CALM_BOUND:
+ * steps that DOP853 could take stably, with a margin for its higher cost per step;
+ * rho(J) is the spectral radius of the Radau step's Jacobian, estimated by
+ * AUTO_POWER_ITERATIONS power iterations (once per Jacobian).  The new method starts
+ * from the state, right-hand side and step size in hand (Radau with a Jacobian taken
+ * there, no predictor and no step-size history).  Each step keeps its own method's
+ * interpolant (dense output, events, t_eval); result->dense_kind says which, per stored
+ * step.  Steps taken again to a terminal event's time (refine_events) use the method in
+ * use and do not switch. */
 enum { RADAU5_METHOD_RADAU = 0, RADAU5_METHOD_DOP853 = 1, RADAU5_METHOD_AUTO = 2 };
 #define AUTO_STABILITY_BOUND 6.1
 #define AUTO_STIFF_STEPS 15
 #define AUTO_NONSTIFF_STEPS 15
+/* h rho(J) below which a Radau step counts as calm: half dop853's stability bound, since a
+ * DOP853 step costs 12 right-hand sides to Radau's 4-8 (measured, steel compliant scene at
+ * rtol 1e-4: 6.1 -> 73,723 calls, 3.0 -> 49,244, 1.0 -> 878,598; the other stiff scenes
+ * never switch back and are the same at all three: docs/auto_method.md) */
+#ifndef AUTO_CALM_BOUND
+#define AUTO_CALM_BOUND 3.0
+#endif
 #define AUTO_POWER_ITERATIONS 8
 
 /* Step control: scipy's Radau (0) or elements of Hairer & Wanner's RADAU5 (radau5.f,

@@ -84,13 +84,12 @@ typedef struct ballc_solver {
      * method may change between steps. */
     int dense_dop853;
     /* RADAU5_METHOD_AUTO (_integrator.c: auto_switch): the method may change before a
-     * step; calm_steps: Radau steps in a row with h rho(J) < AUTO_STABILITY_BOUND;
+     * step; calm_steps: Radau steps in a row with h rho(J) < AUTO_CALM_BOUND;
      * rho: the estimate for the Jacobian of njev number rho_njev (-1: none yet);
      * pw: 2 n scratch of the power iteration */
     int auto_mode, calm_steps;
     long rho_njev;
     double rho, *pw;
-    double hlamb;                         /* the last DOP853 step's |h lambda| estimate */
     size_t cap_switch;
     /* events */
     double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */

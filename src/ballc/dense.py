@@ -56,7 +56,7 @@ class CompiledInterpolant:
         t_old, t_new = self.steps[k, 0], self.steps[k, 1]
         x = ((tt - t_old) / (t_new - t_old))[:, None]
         kinds = self.kinds[k]
-        if np.all(kinds == kinds[0]) if kinds.size else True:
+        if kinds.size == 0 or np.all(kinds == kinds[0]):   # one kind: as before
             y = self._evaluate(self.q[k], x, int(kinds[0]) if kinds.size else self.terms)
         else:   # method="auto": each step by its own method's interpolant
             y = np.empty((tt.size, self.n))
