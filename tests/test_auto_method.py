@@ -34,14 +34,15 @@ def exact(A, y0, t):
 
 
 def test_auto_is_dop853_step_for_step_until_it_switches():
-    """Not stiff: no switch, and the very same run as dop853 (points, calls, no
-    Jacobian, no LU)."""
+    """Not stiff: no switch, and the very same run as dop853 (points, calls, no LU); the
+    only extra work is the stiffness probe's Jacobian every 15 steps."""
     opts = dict(rtol=1e-9, atol=1e-12)
     auto = _radau5.solve_linear(CALM_A, (0.0, 20.0), [1.0, 0.0], method="auto", **opts)
     dop = _radau5.solve_linear(CALM_A, (0.0, 20.0), [1.0, 0.0], method="dop853", **opts)
     assert auto.switches == [] and auto.method_end == "dop853"
     assert np.array_equal(auto.t, dop.t) and np.array_equal(auto.y, dop.y)
-    assert (auto.nfev, auto.njev, auto.nlu, auto.nstep) == (dop.nfev, 0, 0, dop.nstep)
+    assert (auto.nfev, auto.nlu, auto.nstep) == (dop.nfev, 0, dop.nstep)
+    assert auto.njev == dop.nstep // 15 and dop.njev == 0
     assert auto.nstep_implicit == 0
     assert np.allclose(auto.y[:, -1], exact(CALM_A, [1.0, 0.0], 20.0), rtol=0, atol=1e-7)
 
@@ -51,12 +52,12 @@ def test_auto_switches_to_radau5_on_a_stiff_system_and_stays_accurate():
     auto = _radau5.solve_linear(STIFF_A, (0.0, 20.0), STIFF_Y0, method="auto", **opts)
     dop = _radau5.solve_linear(STIFF_A, (0.0, 20.0), STIFF_Y0, method="dop853", **opts)
     assert auto.status == 0
-    # one switch, to radau5, where dop853's own test fired (stiff_at: the start of its
-    # 15th stiff step; the switch comes before the next step)
+    # one switch, to radau5, at the latest where dop853's own test fired (stiff_at: the
+    # start of its 15th stiff step, of ~6e-4 s; the probe may see it first)
     assert [m for _, m in auto.switches] == ["radau5"]
     t_switch = auto.switches[0][0]
-    assert np.isfinite(dop.stiff_at) and auto.stiff_at == dop.stiff_at
-    assert dop.stiff_at < t_switch < 0.05   # the fast decay is over within ~3 ms
+    assert np.isfinite(dop.stiff_at) and t_switch < dop.stiff_at + 1e-3
+    assert 1e-3 < t_switch < 0.05   # the fast decay is over within ~3 ms
     # up to the switch, the run is dop853's
     before = auto.t <= t_switch
     assert np.array_equal(auto.t[before], dop.t[:before.sum()])
@@ -144,14 +145,30 @@ def test_auto_on_the_stiff_scene_agrees_with_radau5_and_switches_once_settled():
     assert auto.nfev < dop.nfev / 3
 
 
-def test_auto_on_the_seed_scene_is_dop853():
-    """The seed's rubber ball is not stiff: auto never switches, and its run is dop853's."""
-    auto = ballc.simulate(ballc.Scene(), 2.0, method="auto", rtol=1e-8, atol=1e-8)
-    dop = ballc.simulate(ballc.Scene(), 2.0, method="dop853", rtol=1e-8, atol=1e-8)
+def test_auto_on_a_rubber_ball_scene_is_dop853():
+    """work_precision's conservative oblique throw (rubber ball, no friction) is not
+    stiff: auto never switches, and its run is dop853's (the probe's Jacobians aside)."""
+    scene = ballc.Scene(c_tau=1.0, friction_coefficient=0.0, mixture=0.0,
+                        velocity=(3.0, 1.0, -20.0))
+    auto = ballc.simulate(scene, 2.0, method="auto", rtol=1e-8, atol=1e-8)
+    dop = ballc.simulate(scene, 2.0, method="dop853", rtol=1e-8, atol=1e-8)
     assert auto.method_switches == []
     assert np.array_equal(auto.t, dop.t) and np.array_equal(auto.y, dop.y)
-    assert (auto.nfev, auto.njev, auto.nlu) == (dop.nfev, 0, 0)
+    assert (auto.nfev, auto.nlu) == (dop.nfev, 0)
     assert dop.method_switches is None
+
+
+def test_the_seed_scene_switches_near_zero_slip_and_agrees_with_dop853():
+    """On the seed's throw the probe finds the exact Coulomb law stiff as a slip nears
+    zero (its force's derivative mu N / |u| grows without bound), so auto hands a few
+    steps to radau5 in each contact (measured: 8 switches in 2 s at 1e-8); the result
+    is still dop853's and radau5's to the tolerance."""
+    auto = ballc.simulate(ballc.Scene(), 2.0, method="auto", rtol=1e-8, atol=1e-8)
+    radau = ballc.simulate(ballc.Scene(), 2.0, method="radau5", rtol=1e-10, atol=1e-10)
+    assert auto.status == 0 and auto.method_switches
+    assert [m for _, m in auto.method_switches[:2]] == ["radau5", "dop853"]
+    assert np.allclose(auto.y[:13, -1], radau.y[:13, -1], rtol=0, atol=1e-5)
+    assert len(auto.contacts) == len(radau.contacts)
 
 
 def test_statistics_add_up_over_segments(monkeypatch):
@@ -174,17 +191,18 @@ def test_statistics_add_up_over_segments(monkeypatch):
     to_radau = sum(1 for s in sols for _, m in s.get("switches", ()) if m == "radau5")
     assert to_radau >= 1 and result.njev >= to_radau
     assert result.method_switches == [w for s in sols for w in s.get("switches", ())]
-    # a segment without a radau5 step has no Jacobian and no LU
+    # a segment without a radau5 step has no LU, and a Jacobian only per 15 dop853
+    # steps (the stiffness probe)
     for s in sols:
         if "nstep_implicit" in s and s["nstep_implicit"] == 0 and not s["switches"]:
-            assert s["njev"] == 0 and s["nlu"] == 0
+            assert s["nlu"] == 0 and s["njev"] <= s["nstep"] // 15
 
 
 def test_a_budget_stopped_auto_run_is_an_honest_failure():
-    result = ballc.simulate(STEEL, 5.0, method="auto", rtol=1e-8, atol=1e-8, max_nfev=6000)
+    result = ballc.simulate(STEEL, 5.0, method="auto", rtol=1e-8, atol=1e-8, max_nfev=3000)
     assert result.status == -1
-    assert "max_nfev = 6000" in result.message
-    assert result.nfev >= 6000
+    assert "max_nfev = 3000" in result.message
+    assert result.nfev >= 3000
     assert result.t.size > 1 and result.t[-1] < 5.0 and np.all(np.diff(result.t) > 0)
     assert np.all(np.isfinite(result.y))
 

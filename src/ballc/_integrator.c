@@ -435,11 +435,25 @@ static double spectral_radius(solver_t *s)
     return sqrt(last * before);
 }
 
-/* After an accepted Radau step with AUTO: count it as calm when DOP853 could have taken
- * it stably, and cheaper, h rho(J) < AUTO_CALM_BOUND (rho estimated once per Jacobian). */
+/* After an accepted step with AUTO.  DOP853: the Jacobian probe (see _integrator.h).
+ * Radau: count the step as calm when DOP853 could have taken it stably, and as cheaply,
+ * h rho(J) < AUTO_CALM_BOUND (rho estimated once per Jacobian). */
 static void auto_observe(solver_t *s)
 {
-    if (s->dop853) return;
+    if (s->dop853) {
+        /* every AUTO_PROBE_STEPS DOP853 steps: the Jacobian at the state in hand, and
+         * stiff when those steps' mean size times rho(J) is above AUTO_CALM_BOUND (the
+         * mirror of the test back: Radau would take such steps at most as cheaply) */
+        if (s->probe_steps++ == 0) s->probe_t = s->t_old;
+        if (s->probe_steps < AUTO_PROBE_STEPS) return;
+        s->probe_steps = 0;
+        if (radau_iia_jacobian(s, s->t, s->y) != 0) return;   /* no verdict: go on */
+        s->rho = spectral_radius(s);
+        s->rho_njev = s->r->njev;
+        if (fabs(s->t - s->probe_t) / AUTO_PROBE_STEPS * s->rho > AUTO_CALM_BOUND)
+            s->stiff_probe = 1;
+        return;
+    }
     if (s->rho_njev != s->r->njev) {
         s->rho = spectral_radius(s);
         s->rho_njev = s->r->njev;
@@ -470,7 +484,8 @@ static int record_switch(solver_t *s, int to)
 static int auto_switch(solver_t *s)
 {
     if (s->dop853) {
-        if (s->stiff_steps < AUTO_STIFF_STEPS) return 0;
+        if (s->stiff_steps < AUTO_STIFF_STEPS && !s->stiff_probe) return 0;
+        s->stiff_probe = s->probe_steps = 0;
         if (radau_iia_jacobian(s, s->t, s->y) != 0) {
             snprintf(s->r->message, sizeof s->r->message,
                      "the Jacobian cannot be evaluated at t = %.17g (method auto, switching "
@@ -487,6 +502,7 @@ static int auto_switch(solver_t *s)
     }
     if (s->calm_steps < AUTO_NONSTIFF_STEPS) return 0;
     s->dop853 = 1;
+    s->probe_steps = 0;
     s->stiff_steps = s->nonstiff_steps = 0;
     return record_switch(s, RADAU5_METHOD_DOP853);
 }

@@ -85,9 +85,12 @@ typedef struct ballc_solver {
     int dense_dop853;
     /* RADAU5_METHOD_AUTO (_integrator.c: auto_switch): the method may change before a
      * step; calm_steps: Radau steps in a row with h rho(J) < AUTO_CALM_BOUND;
+     * probe_steps: DOP853 steps since the last probe, which began at probe_t;
+     * stiff_probe: the last probe found the steps stiff;
      * rho: the estimate for the Jacobian of njev number rho_njev (-1: none yet);
      * pw: 2 n scratch of the power iteration */
-    int auto_mode, calm_steps;
+    int auto_mode, calm_steps, probe_steps, stiff_probe;
+    double probe_t;
     long rho_njev;
     double rho, *pw;
     size_t cap_switch;
