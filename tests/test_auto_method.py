@@ -158,17 +158,15 @@ def test_auto_on_a_rubber_ball_scene_is_dop853():
     assert dop.method_switches is None
 
 
-def test_the_seed_scene_switches_near_zero_slip_and_agrees_with_dop853():
-    """On the seed's throw the probe finds the exact Coulomb law stiff as a slip nears
-    zero (its force's derivative mu N / |u| grows without bound), so auto hands a few
-    steps to radau5 in each contact (measured: 8 switches in 2 s at 1e-8); the result
-    is still dop853's and radau5's to the tolerance."""
-    auto = ballc.simulate(ballc.Scene(), 2.0, method="auto", rtol=1e-8, atol=1e-8)
-    radau = ballc.simulate(ballc.Scene(), 2.0, method="radau5", rtol=1e-10, atol=1e-10)
-    assert auto.status == 0 and auto.method_switches
-    assert [m for _, m in auto.method_switches[:2]] == ["radau5", "dop853"]
-    assert np.allclose(auto.y[:13, -1], radau.y[:13, -1], rtol=0, atol=1e-5)
-    assert len(auto.contacts) == len(radau.contacts)
+def test_auto_on_the_seed_scene_is_dop853():
+    """The seed's rubber ball is not stiff: auto never switches -- not even where a slip
+    nears zero and the exact Coulomb law's Jacobian (mu N / |u|) is large, which the
+    probe alone took for stiffness -- and its run is dop853's."""
+    auto = ballc.simulate(ballc.Scene(), 5.0, method="auto", rtol=1e-10, atol=1e-10)
+    dop = ballc.simulate(ballc.Scene(), 5.0, method="dop853", rtol=1e-10, atol=1e-10)
+    assert auto.method_switches == []
+    assert np.array_equal(auto.t, dop.t) and np.array_equal(auto.y, dop.y)
+    assert (auto.nfev, auto.nlu) == (dop.nfev, 0) and auto.njev > 0   # probes
 
 
 def test_statistics_add_up_over_segments(monkeypatch):

@@ -443,14 +443,16 @@ static void auto_observe(solver_t *s)
     if (s->dop853) {
         /* every AUTO_PROBE_STEPS DOP853 steps: the Jacobian at the state in hand, and
          * stiff when those steps' mean size times rho(J) is above AUTO_CALM_BOUND (the
-         * mirror of the test back: Radau would take such steps at most as cheaply) */
+         * mirror of the test back: Radau would take such steps at most as cheaply) and
+         * Hairer's own estimate saw at least AUTO_PROBE_EVIDENCE of them beyond 6.1 */
         if (s->probe_steps++ == 0) s->probe_t = s->t_old;
         if (s->probe_steps < AUTO_PROBE_STEPS) return;
         s->probe_steps = 0;
         if (radau_iia_jacobian(s, s->t, s->y) != 0) return;   /* no verdict: go on */
         s->rho = spectral_radius(s);
         s->rho_njev = s->r->njev;
-        if (fabs(s->t - s->probe_t) / AUTO_PROBE_STEPS * s->rho > AUTO_CALM_BOUND)
+        if (fabs(s->t - s->probe_t) / AUTO_PROBE_STEPS * s->rho > AUTO_CALM_BOUND
+            && s->stiff_steps >= AUTO_PROBE_EVIDENCE)
             s->stiff_probe = 1;
         return;
     }

@@ -2,7 +2,8 @@
 
 ``method`` "radau5" runs ballc's compiled Radau IIA (scipy's Radau, step by step in
 C) on the system's C right-hand side and Jacobian, "dop853" ballc's compiled DOP853
-(scipy's DOP853, in the same C loop, with the same events); any other is handed to scipy's
+(scipy's DOP853, in the same C loop, with the same events), "auto" the two switching in
+that loop (docs/architecture.md, "The automatic method"); any other is handed to scipy's
 ``solve_ivp`` (with the analytic Jacobian when implicit).  scipy has no call budget
 of its own: :func:`_call_budget` gives it one as a terminal event.  With
 ``exact_flight``, a free-flight segment that has an exact solution (massless observer,

@@ -365,14 +365,14 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         tangential laws, sticking with large stiffness) its steps are bounded by
         stability, not accuracy, and radau5 is the one to use.
         "auto": per segment dop853 first, switching to radau5 where Hairer's stiffness
-        test fires (15 steps in a row held at dop853's stability limit) and back where
-        radau5's steps are within dop853's stability bound for 15 steps, in the same loop
+        test fires (15 steps in a row held at dop853's stability limit) or a Jacobian
+        probe every 15 steps finds them stiff, and back where radau5's steps are within
+        half dop853's stability bound for 15 steps, in the same loop
         with the same events and output (each step keeps its own method's interpolant); a
         segment that continues the last one with its step (a stick/slip transition, a
         rest check) continues with its method too.  ``result.method_switches`` lists the
-        switches.  Where the scene is not stiff it is dop853, step for step; it is not
-        the default because at loose tolerances it inherits dop853's failures on some
-        stiff scenes (docs/auto_method.md).
+        switches.  Until it switches it is dop853, step for step.  It is not the
+        default: docs/auto_method.md has the measurements against the rule.
         Or a scipy.integrate.solve_ivp
         method: "Radau" (the reference radau5 is tested against), "BDF", "LSODA" (given
         the analytic Jacobian), "DOP853", "RK45", "RK23".
