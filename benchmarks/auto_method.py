@@ -284,13 +284,13 @@ def report(results, args, elapsed):
                               + f", error {a['err']:.1e}, {a['switches']} switches; best of "
                               f"the two {_ms(min(others))}")
     lines += ["## Where auto loses", "",
-              "Auto is dop853 until Hairer's test fires, so it inherits dop853's weaknesses "
-              "on stiff scenes at loose tolerances: where the test does not fire (steps held "
-              "near the stability bound by the error control, not 15 in a row beyond it), "
-              "where dop853's bounces before the switch are already inaccurate (the "
-              "compliant law's kinks) and where that leads the driver into stick/slip "
-              "chatter.  Runs (same tolerance) where auto cost more than twice the better "
-              "of radau5 and dop853, or failed where one of them finished:", ""]
+              "Auto is dop853 until its tests find the steps stiff, so it inherits "
+              "dop853's weaknesses on stiff scenes at loose tolerances: the steps it takes "
+              "before the tests fire, and dop853's inaccurate bounces before the switch "
+              "(the compliant law's kinks: the end state is then dop853's, wrong by "
+              "metres, and radau5 after the switch can thrash or crawl through the states "
+              "they led to).  Runs (same tolerance) where auto cost more than twice the "
+              "better of radau5 and dop853, or failed where one of them finished:", ""]
     lines += [f"- {c}" for c in costly] or ["- none"]
     lines += ["", "Measured while designing it (the same scenes, single runs, before the "
               "stiffness probe was added: the first three), and the probe itself:", "",
