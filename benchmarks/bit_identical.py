@@ -13,7 +13,10 @@ bit-identical, 1 otherwise.
 
 Cases: ``ballc.simulate(ballc.Scene(), 5)`` with method radau5 and dop853 at the default
 tolerances (rtol = atol = 1e-10) and at 1e-6 and 1e-3, and
-``Scene(tangential_model="compliant")`` for 5 s with radau5 (default and 1e-6).
+``Scene(tangential_model="compliant")`` for 5 s with radau5 (default and 1e-6); with
+radau5 and dop853 at 1e-8: work_precision's stiff steel scene with ``dense_output`` (sol
+on a grid compared too), the default scene with ``t_eval``, and the stress matrix's
+grazing impact (vz = 0).
 """
 from __future__ import annotations
 
@@ -47,6 +50,18 @@ cases = [
     ("compliant scene, radau5, 1e-6", dict(tangential_model="compliant"),
      dict(method="radau5", rtol=1e-6, atol=1e-6)),
 ]
+steel = dict(tangential_model="friction", ball_youngs_modulus=2e11, plane_youngs_modulus=2e11,
+             c_tau=0.5, observer_mass=0.0, position=(0.0, 0.0, 2.0), velocity=(0.5, 0.0, 0.0))
+for method in ("radau5", "dop853"):
+    cases += [
+        (f"steel scene, {method}, 1e-8, dense output", steel,
+         dict(method=method, rtol=1e-8, atol=1e-8, dense_output=True)),
+        (f"default scene, {method}, 1e-8, t_eval", {},
+         dict(method=method, rtol=1e-8, atol=1e-8, t_eval=np.linspace(0.0, 5.0, 501))),
+        (f"grazing (stress), {method}, 1e-8", dict(tangential_model="friction",
+         position=(0.0, 0.0, 1.0), velocity=(5.0, 0.0, 0.0)),
+         dict(method=method, rtol=1e-8, atol=1e-10)),
+    ]
 
 def plain(value):
     # numbers, strings and arrays as they are; containers and dataclasses element-wise
@@ -70,6 +85,8 @@ for name, scene_kw, kw in cases:
         "njev": r.njev, "nlu": r.nlu, "t_events": plain(r.t_events),
         "y_events": plain(r.y_events), "contacts": plain(r.contacts),
     }
+    if r.sol is not None:   # the dense output, on a fine grid
+        out[name]["sol"] = r.sol(np.linspace(0.0, r.t[-1], 2001))
 with open(sys.argv[2], "wb") as f:
     pickle.dump((ballc.__file__, out), f)
 """

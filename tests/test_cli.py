@@ -254,6 +254,18 @@ def test_run_options_override_the_simulate_table(scene_file, tmp_path):
     assert not _same_run(tmp_path / "out" / "result.npz", rtol=1e-6, method="Radau")
 
 
+def test_run_with_method_auto(scene_file, tmp_path):
+    """--method auto is simulate's method="auto"; a near miss names it."""
+    scene_file('[simulate]\nt_end = 0.3\n')
+    done = run_ballc("run", "scene.toml", "--method", "auto", "--rtol", "1e-8", "--atol",
+                     "1e-8", "--out", "out", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "method auto" in done.stdout
+    assert _same_run(tmp_path / "out" / "result.npz", rtol=1e-8, atol=1e-8, method="auto")
+    done = run_ballc("run", "scene.toml", "--method", "Auto", "--out", "out2", cwd=tmp_path)
+    assert_one_line_error(done, "method = 'Auto'", "did you mean 'auto'")
+
+
 # --- --version ---
 
 def test_version():

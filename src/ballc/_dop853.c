@@ -215,6 +215,7 @@ int dop853_step(solver_t *s)
     s->t = t_new;
     s->dense_end = t_new;
     s->dense_ready = 0;
+    s->dense_dop853 = 1;
     s->k_stale = 0;
     s->have_sol = 1;
     s->r->nstep++;

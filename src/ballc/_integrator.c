@@ -32,7 +32,7 @@ static int step(solver_t *s)
  * cannot be evaluated. */
 static int prepare_dense(solver_t *s)
 {
-    return s->dop853 ? dop853_prepare_dense(s) : 0;
+    return s->dense_dop853 ? dop853_prepare_dense(s) : 0;
 }
 
 /* common.select_initial_step with the error estimator's order (Radau 3, DOP853 7). */
@@ -124,15 +124,19 @@ static int store_dense(solver_t *s)
     radau5_result *r = s->r;
     const int n = s->n;
     if (prepare_dense(s) != 0) return -2;
-    void **buffers[] = {(void **)&r->dense_t, (void **)&r->dense_c};
-    const int terms = r->dense_terms;
-    const size_t sizes[] = {2 * sizeof(double), (1 + terms) * (size_t)n * sizeof(double)};
-    if (reserve(&s->cap_dense, r->n_dense, 256, 2, buffers, sizes) != 0) return -1;
+    void **buffers[] = {(void **)&r->dense_t, (void **)&r->dense_c, (void **)&r->dense_kind};
+    const int terms = r->dense_terms, own = dense_terms_count(s);
+    const size_t sizes[] = {2 * sizeof(double), (1 + terms) * (size_t)n * sizeof(double),
+                            sizeof(int)};
+    if (reserve(&s->cap_dense, r->n_dense, 256, 3, buffers, sizes) != 0) return -1;
     r->dense_t[2 * r->n_dense] = s->t_old;
     r->dense_t[2 * r->n_dense + 1] = s->t;
     double *c = r->dense_c + (size_t)r->n_dense * (1 + terms) * n;
     memcpy(c, s->y_old, n * sizeof(double));
-    memcpy(c + n, dense_terms(s), (size_t)terms * n * sizeof(double));
+    memcpy(c + n, dense_terms(s), (size_t)own * n * sizeof(double));
+    if (own < terms)   /* AUTO: a Radau step in rows as wide as DOP853's */
+        memset(c + (size_t)(1 + own) * n, 0, (size_t)(terms - own) * n * sizeof(double));
+    r->dense_kind[r->n_dense] = own;
     r->n_dense++;
     return 0;
 }
@@ -248,10 +252,11 @@ static double event_root(solver_t *s, int e)
     }
     const int n = s->n;
     const double *c = s->p->ev_coef + (size_t)e * n;
-    poly_t q = {s->p->ev_offset[e], {0}, s->t_old, s->t - s->t_old, s->dop853};
+    poly_t q = {s->p->ev_offset[e], {0}, s->t_old, s->t - s->t_old, s->dense_dop853};
     for (int i = 0; i < n; i++) q.a0 += c[i] * s->y_old[i];
     const double *rows = dense_terms(s);
-    for (int j = 0; j < s->r->dense_terms; j++)
+    const int terms = dense_terms_count(s);
+    for (int j = 0; j < terms; j++)
         for (int i = 0; i < n; i++) q.a[j] += c[i] * rows[j * n + i];
     return brentq(poly_at, &q, s->t_old, s->t);
 }
@@ -387,9 +392,121 @@ static int step_to_event(solver_t *s, double t_stop, double *y_stop)
                 2 * (size_t)(r->n_dense - n_dense) * sizeof(double));
         memmove(r->dense_c + (n_dense - 1) * width, r->dense_c + n_dense * width,
                 (size_t)(r->n_dense - n_dense) * width * sizeof(double));
+        memmove(r->dense_kind + (n_dense - 1), r->dense_kind + n_dense,
+                (size_t)(r->n_dense - n_dense) * sizeof(int));
         r->n_dense--;
     }
     return 1;
+}
+
+/* ---- RADAU5_METHOD_AUTO: the switch between the two steps (see _integrator.h) ---- */
+
+/* The spectral radius of s->J, estimated by AUTO_POWER_ITERATIONS power iterations from
+ * a fixed start vector: the geometric mean of the last two growth factors |J v| / |v|
+ * (for a complex pair of dominant eigenvalues, as the contact spring's, the factor
+ * alternates about the modulus; over two iterations it is the modulus squared). */
+static double spectral_radius(solver_t *s)
+{
+    const int n = s->n;
+    double *v = s->pw, *w = s->pw + n;
+    double norm = 0, last = 0, before = 0;
+    for (int c = 0; c < n; c++) {
+        v[c] = 1.0 + 0.01 * c;
+        norm += v[c] * v[c];
+    }
+    norm = sqrt(norm);
+    for (int it = 0; it < AUTO_POWER_ITERATIONS; it++) {
+        double wn = 0;
+        for (int i = 0; i < n; i++) {
+            double sum = 0;
+            const double *row = s->J + (size_t)i * n;
+            for (int c = 0; c < n; c++) sum += row[c] * v[c];
+            w[i] = sum;
+            wn += sum * sum;
+        }
+        wn = sqrt(wn);
+        if (!isfinite(wn)) return INFINITY;
+        if (wn == 0) return 0.0;   /* nilpotent on the start vector: no stiffness seen */
+        before = last;
+        last = wn / norm;
+        for (int c = 0; c < n; c++) v[c] = w[c] / wn;
+        norm = 1.0;
+    }
+    return sqrt(last * before);
+}
+
+/* After an accepted step with AUTO.  DOP853: the Jacobian probe (see _integrator.h).
+ * Radau: count the step as calm when DOP853 could have taken it stably, and as cheaply,
+ * h rho(J) < AUTO_CALM_BOUND (rho estimated once per Jacobian). */
+static void auto_observe(solver_t *s)
+{
+    if (s->dop853) {
+        /* every AUTO_PROBE_STEPS DOP853 steps: the Jacobian at the state in hand, and
+         * stiff when those steps' mean size times rho(J) is above AUTO_CALM_BOUND (the
+         * mirror of the test back: Radau would take such steps at most as cheaply) and
+         * Hairer's own estimate saw at least AUTO_PROBE_EVIDENCE of them beyond 6.1 */
+        if (s->probe_steps++ == 0) s->probe_t = s->t_old;
+        if (s->probe_steps < AUTO_PROBE_STEPS) return;
+        s->probe_steps = 0;
+        if (radau_iia_jacobian(s, s->t, s->y) != 0) return;   /* no verdict: go on */
+        s->rho = spectral_radius(s);
+        s->rho_njev = s->r->njev;
+        if (fabs(s->t - s->probe_t) / AUTO_PROBE_STEPS * s->rho > AUTO_CALM_BOUND
+            && s->stiff_steps >= AUTO_PROBE_EVIDENCE)
+            s->stiff_probe = 1;
+        return;
+    }
+    if (s->rho_njev != s->r->njev) {
+        s->rho = spectral_radius(s);
+        s->rho_njev = s->r->njev;
+    }
+    if (fabs(s->t - s->t_old) * s->rho < AUTO_CALM_BOUND)
+        s->calm_steps++;
+    else
+        s->calm_steps = 0;
+}
+
+static int record_switch(solver_t *s, int to)
+{
+    radau5_result *r = s->r;
+    void **buffers[] = {(void **)&r->switch_t, (void **)&r->switch_to};
+    const size_t sizes[] = {sizeof(double), sizeof(int)};
+    if (reserve(&s->cap_switch, r->n_switches, 8, 2, buffers, sizes) != 0) return -1;
+    r->switch_t[r->n_switches] = s->t;
+    r->switch_to[r->n_switches] = to;
+    r->n_switches++;
+    return 0;
+}
+
+/* Before a step with AUTO: change the method when its test says so.  DOP853 -> Radau
+ * IIA: the Jacobian at the state in hand (no predictor, no step-size history: as a
+ * first step, with the step size in hand); Radau IIA -> DOP853: from the state, right-
+ * hand side and step size in hand.  Returns 0, -1 when out of memory, -2 when the
+ * Jacobian cannot be evaluated (message set). */
+static int auto_switch(solver_t *s)
+{
+    if (s->dop853) {
+        if (s->stiff_steps < AUTO_STIFF_STEPS && !s->stiff_probe) return 0;
+        s->stiff_probe = s->probe_steps = 0;
+        if (radau_iia_jacobian(s, s->t, s->y) != 0) {
+            snprintf(s->r->message, sizeof s->r->message,
+                     "the Jacobian cannot be evaluated at t = %.17g (method auto, switching "
+                     "to radau5)", s->t);
+            return -2;
+        }
+        s->dop853 = 0;
+        s->current_jac = 1;
+        s->lu_valid = 0;
+        s->have_sol = 0;
+        s->have_h_abs_old = s->have_error_norm_old = s->have_acc = 0;
+        s->calm_steps = 0;
+        return record_switch(s, RADAU5_METHOD_RADAU);
+    }
+    if (s->calm_steps < AUTO_NONSTIFF_STEPS) return 0;
+    s->dop853 = 1;
+    s->probe_steps = 0;
+    s->stiff_steps = s->nonstiff_steps = 0;
+    return record_switch(s, RADAU5_METHOD_DOP853);
 }
 
 /* ---- driver (solve_ivp's loop) ---- */
@@ -398,8 +515,12 @@ void radau5_free(radau5_result *r)
 {
     free(r->t_out); free(r->y_out);
     free(r->hit_event); free(r->hit_t); free(r->hit_y);
-    free(r->dense_t); free(r->dense_c);
+    free(r->dense_t); free(r->dense_c); free(r->dense_kind);
+    free(r->switch_t); free(r->switch_to);
     r->t_out = r->y_out = r->hit_t = r->hit_y = r->dense_t = r->dense_c = NULL;
+    r->dense_kind = r->switch_to = NULL;
+    r->switch_t = NULL;
+    r->n_switches = 0;
     r->n_dense = 0;
     r->hit_event = NULL;
     r->n_out = r->n_hits = 0;
@@ -415,13 +536,14 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         snprintf(r->message, sizeof r->message, "n = %d and n_events = %d: need n > 0, n_events >= 0", n, m);
         return RADAU5_BAD_PROBLEM;
     }
-    if (p->method != RADAU5_METHOD_RADAU && p->method != RADAU5_METHOD_DOP853) {
-        snprintf(r->message, sizeof r->message, "method = %d: need RADAU5_METHOD_RADAU (0) "
-                 "or RADAU5_METHOD_DOP853 (1)", p->method);
+    if (p->method != RADAU5_METHOD_RADAU && p->method != RADAU5_METHOD_DOP853
+            && p->method != RADAU5_METHOD_AUTO) {
+        snprintf(r->message, sizeof r->message, "method = %d: need RADAU5_METHOD_RADAU (0), "
+                 "RADAU5_METHOD_DOP853 (1) or RADAU5_METHOD_AUTO (2)", p->method);
         return RADAU5_BAD_PROBLEM;
     }
-    if (p->method == RADAU5_METHOD_RADAU && p->jac == NULL) {
-        snprintf(r->message, sizeof r->message, "Radau needs a Jacobian: jac is NULL");
+    if (p->method != RADAU5_METHOD_DOP853 && p->jac == NULL) {
+        snprintf(r->message, sizeof r->message, "Radau (and auto) needs a Jacobian: jac is NULL");
         return RADAU5_BAD_PROBLEM;
     }
 
@@ -437,8 +559,11 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.p = p;
     s.r = r;
     s.n = n;
-    s.dop853 = p->method == RADAU5_METHOD_DOP853;
-    r->dense_terms = s.dop853 ? DOP853_DENSE_TERMS : 3;
+    s.auto_mode = p->method == RADAU5_METHOD_AUTO;
+    s.dop853 = p->method == RADAU5_METHOD_DOP853 || (s.auto_mode && !p->auto_implicit);
+    s.dense_dop853 = s.dop853;
+    s.rho_njev = -1;
+    r->dense_terms = (s.dop853 || s.auto_mode) ? DOP853_DENSE_TERMS : 3;
     radau_iia_init_constants(&s.k);
     s.direction = p->t_bound >= p->t0 ? 1.0 : -1.0;
     s.ctrl = p->controller;
@@ -454,7 +579,8 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
          + (size_t)n * n + (size_t)n                        /* Joc, xc */
          + (size_t)n                                        /* atol */
          + (size_t)n                                        /* inv_scale */
-         + (size_t)n * (DOP853_STAGES_EXTENDED + DOP853_DENSE_TERMS);   /* K, F */
+         + (size_t)n * (DOP853_STAGES_EXTENDED + DOP853_DENSE_TERMS)    /* K, F */
+         + 2 * (size_t)n;                                   /* pw */
     double *dblock = calloc(nd, sizeof(double));
     cplx *cblock = calloc((size_t)n * n + 2 * (size_t)n, sizeof(cplx));
     int *iblock = calloc(5 * (size_t)n + 3 * (size_t)m + 3 + (size_t)n * n, sizeof(int));
@@ -473,6 +599,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.inv_scale = d; d += n;
     s.K = d; d += (size_t)n * DOP853_STAGES_EXTENDED;
     s.Fdense = d; d += (size_t)n * DOP853_DENSE_TERMS;
+    s.pw = d; d += 2 * (size_t)n;
     for (int c = 0; c < n; c++) s.atol[c] = s.rtol * (p->atol[c] / p->rtol);
     if (!(s.ctrl & RADAU5_CTRL_TOL)) memcpy(s.atol, p->atol, n * sizeof(double));
     s.LU_complex = cblock; s.ctmp = cblock + (size_t)n * n; s.xcc = s.ctmp + n;
@@ -518,10 +645,19 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
                      s.t, r->nfev);
             break;
         }
+        if (s.auto_mode) {
+            int sw = auto_switch(&s);
+            if (sw == -1) goto oom;
+            if (sw != 0) {
+                r->status = RADAU5_FAILED;
+                break;
+            }
+        }
         if (!step(&s)) {
             r->status = RADAU5_FAILED;
             break;
         }
+        if (s.auto_mode) auto_observe(&s);
         int rc = p->dense_output ? store_dense(&s) : 0;
         if (rc == -1) goto oom;
         if (rc != 0) break;   /* status RADAU5_FAILED, message set */
@@ -581,6 +717,7 @@ oom:
     snprintf(r->message, sizeof r->message, "out of memory");
 done:
     r->h_next = s.h_abs;
+    r->method_end = s.dop853 ? RADAU5_METHOD_DOP853 : RADAU5_METHOD_RADAU;
 #ifdef RADAU5_PROFILE
     r->prof[RADAU5_PROF_TOTAL] += (double)(__rdtsc() - prof_total0);
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &prof_ts1);

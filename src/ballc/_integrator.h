@@ -90,13 +90,50 @@ typedef struct {
                                * to the event's time), not the dense output's value */
     const int *ev_rearm;      /* may be NULL; nonzero: the terminal event may be re-armed */
     radau5_rearm_fun rearm;   /*   by rearm (only where refine_events stepped to its time) */
-    int method;               /* RADAU5_METHOD_RADAU (0) or RADAU5_METHOD_DOP853 */
+    int method;               /* RADAU5_METHOD_RADAU (0), RADAU5_METHOD_DOP853 (1) or
+                               * RADAU5_METHOD_AUTO (2, see below) */
     int jacobian_ahead;       /* nonzero: a segment's first step whose Newton fails with the
                                * start's Jacobian retries once with the Jacobian at the
                                * step's explicit Euler end (the compliant law's contacts) */
+    int auto_implicit;        /* RADAU5_METHOD_AUTO only: nonzero starts with Radau IIA
+                               * instead of DOP853 (a segment continuing a stiff one) */
 } radau5_problem;
 
-enum { RADAU5_METHOD_RADAU = 0, RADAU5_METHOD_DOP853 = 1 };
+/* RADAU5_METHOD_AUTO: LSODA's idea with the two steps.  The call starts with DOP853
+ * (unless problem.auto_implicit) and switches to Radau IIA, before the next step, once
+ * Hairer's stiffness test has seen AUTO_STIFF_STEPS accepted steps in a row with
+ * |h lambda| > AUTO_STABILITY_BOUND (the same test that sets stiff_at), or once a probe
+ * finds the steps stiff: every AUTO_PROBE_STEPS accepted DOP853 steps the Jacobian is
+ * taken at the state in hand and the steps count as stiff when their mean size times
+ * rho(J) is above AUTO_CALM_BOUND and Hairer's count holds at least AUTO_PROBE_EVIDENCE
+ * steps beyond its bound (without it the probe also fired where an exact Coulomb slip
+ * nears zero, its force's derivative mu N / |u| unbounded, on the seed's rubber ball: 18
+ * needless switches in 5 s at rtol 1e-10) (Hairer's test alone missed a steel ball's contact at
+ * rtol 1e-3 and 1e-11, where DOP853's steps hovered about its bound, and a stick/slip
+ * chatter at 1e-4 that both DOP853 and auto gave up on: docs/auto_method.md).  It switches back
+ * once AUTO_NONSTIFF_STEPS accepted Radau steps in a row had h rho(J) < AUTO_CALM_BOUND:
+ * steps that DOP853 could take stably, with a margin for its higher cost per step;
+ * rho(J) is the spectral radius of the Radau step's Jacobian, estimated by
+ * AUTO_POWER_ITERATIONS power iterations (once per Jacobian).  The new method starts
+ * from the state, right-hand side and step size in hand (Radau with a Jacobian taken
+ * there, no predictor and no step-size history).  Each step keeps its own method's
+ * interpolant (dense output, events, t_eval); result->dense_kind says which, per stored
+ * step.  Steps taken again to a terminal event's time (refine_events) use the method in
+ * use and do not switch. */
+enum { RADAU5_METHOD_RADAU = 0, RADAU5_METHOD_DOP853 = 1, RADAU5_METHOD_AUTO = 2 };
+#define AUTO_STABILITY_BOUND 6.1
+#define AUTO_STIFF_STEPS 15
+#define AUTO_NONSTIFF_STEPS 15
+/* h rho(J) below which a Radau step counts as calm: half dop853's stability bound, since a
+ * DOP853 step costs 12 right-hand sides to Radau's 4-8 (measured, steel compliant scene at
+ * rtol 1e-4: 6.1 -> 73,723 calls, 3.0 -> 49,244, 1.0 -> 878,598; the other stiff scenes
+ * never switch back and are the same at all three: docs/auto_method.md) */
+#ifndef AUTO_CALM_BOUND
+#define AUTO_CALM_BOUND 3.0
+#endif
+#define AUTO_POWER_ITERATIONS 8
+#define AUTO_PROBE_STEPS 15
+#define AUTO_PROBE_EVIDENCE 1
 
 /* Step control: scipy's Radau (0) or elements of Hairer & Wanner's RADAU5 (radau5.f,
  * RADCOR/ESTRAD), each a bit, for benchmarks/controllers.py.
@@ -148,10 +185,18 @@ typedef struct {
                                *   x = (t - t_old) / (t_new - t_old).  Radau (3 terms):
                                *   y(t) = y_old + sum_j Q_j x^(j+1), Q_j the j-th row.
                                *   DOP853 (7): rows F0..F6 of dop853_eval. */
-    int dense_terms;          /* 3 (Radau) or 7 (DOP853) */
+    int dense_terms;          /* 3 (Radau) or 7 (DOP853, and AUTO: the widest) */
+    int *dense_kind;          /* n_dense: each stored step's own number of terms, 3 or 7
+                               * (AUTO: a Radau step's rows 3..6 are zeros) */
     double stiff_at;          /* DOP853: the start of the step at which Hairer's stiffness
                                * test (15 steps in a row with |h lambda| > 6.1) first
                                * fired; NaN when it did not (and always for Radau) */
+    long n_switches;          /* AUTO: method switches, each at switch_t (the state in hand
+                               * there, before the step), to switch_to (a method code) */
+    double *switch_t;
+    int *switch_to;
+    int method_end;           /* the method of the last step (AUTO: the one in use) */
+    long nstep_implicit;      /* accepted Radau IIA steps (of nstep) */
     int profiled;             /* 1 in a -DRADAU5_PROFILE build */
     double prof[RADAU5_PROF_N];
 } radau5_result;

@@ -79,6 +79,21 @@ typedef struct ballc_solver {
                                            * were not accepted (a failed step) */
     double *K, *Fdense;
     int stiff_steps, nonstiff_steps;      /* Hairer's stiffness test (dop853_step) */
+    /* The interpolant in hand (the last accepted step's) is DOP853's: set by the step
+     * that was accepted.  Equal to dop853 except with RADAU5_METHOD_AUTO, where the
+     * method may change between steps. */
+    int dense_dop853;
+    /* RADAU5_METHOD_AUTO (_integrator.c: auto_switch): the method may change before a
+     * step; calm_steps: Radau steps in a row with h rho(J) < AUTO_CALM_BOUND;
+     * probe_steps: DOP853 steps since the last probe, which began at probe_t;
+     * stiff_probe: the last probe found the steps stiff;
+     * rho: the estimate for the Jacobian of njev number rho_njev (-1: none yet);
+     * pw: 2 n scratch of the power iteration */
+    int auto_mode, calm_steps, probe_steps, stiff_probe;
+    double probe_t;
+    long rho_njev;
+    double rho, *pw;
+    size_t cap_switch;
     /* events */
     double *g, *g_new, *roots, *ev_y;   /* ev_y: scratch state of event evaluations */
     int *active;
@@ -117,16 +132,22 @@ static inline int call_fun(solver_t *s, double t, const double *y, double *f)
  * (x, x^2, x^3), or DOP853's F (once prepare_dense has computed them). */
 static inline const double *dense_terms(const solver_t *s)
 {
-    return s->dop853 ? s->Fdense : s->Q;
+    return s->dense_dop853 ? s->Fdense : s->Q;
+}
+
+/* The number of dense-output terms of the interpolant in hand: 7 (DOP853) or 3. */
+static inline int dense_terms_count(const solver_t *s)
+{
+    return s->dense_dop853 ? DOP853_DENSE_TERMS : 3;
 }
 
 /* RadauDenseOutput (or Dop853DenseOutput: its terms computed by prepare_dense) of the
- * last accepted step at time tt. */
+ * last accepted step at time tt (whichever method took it: dense_dop853). */
 static inline void dense(const solver_t *s, double tt, double *out)
 {
     const int n = s->n;
     double x = (tt - s->t_old) / (s->dense_end - s->t_old);
-    if (s->dop853) {
+    if (s->dense_dop853) {
         dop853_eval(n, x, s->y_old, s->Fdense, out);
         return;
     }

@@ -1,8 +1,9 @@
 """The compiled integrators: a thin view of ``ballc._core``.
 
 Radau IIA (order 5, ``method="radau5"``) and, in the same loop with the same events and
-output, Dormand & Prince's explicit DOP853 (order 8, ``method="dop853"``).
-Private: use ``ballc.simulate(..., method="radau5")`` (or ``"dop853"``).  The solver, its LU and the
+output, Dormand & Prince's explicit DOP853 (order 8, ``method="dop853"``), and the two
+switching by stiffness (``method="auto"``).
+Private: use ``ballc.simulate(..., method="radau5")`` (or ``"dop853"``, ``"auto"``).  The solver, its LU and the
 system it integrates are compiled once, into ``ballc._core`` (see
 ``_radau5_bridge.pxi``); this module only re-exports its entry points, so there is
 one copy of the kernels in the process, never two that could disagree.

@@ -62,6 +62,7 @@ cdef extern from "_integrator.h":
         radau5_rearm_fun rearm
         int method
         int jacobian_ahead
+        int auto_implicit
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -79,12 +80,18 @@ cdef extern from "_integrator.h":
         double *dense_t
         double *dense_c
         int dense_terms
+        int *dense_kind
         double stiff_at
+        long n_switches
+        double *switch_t
+        int *switch_to
+        int method_end
+        long nstep_implicit
         int profiled
         double prof[7]
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
     int RADAU5_DONE, RADAU5_OUT_OF_MEMORY
-    int RADAU5_METHOD_RADAU, RADAU5_METHOD_DOP853
+    int RADAU5_METHOD_RADAU, RADAU5_METHOD_DOP853, RADAU5_METHOD_AUTO
     void radau5_free(radau5_result *) nogil
 
 
@@ -413,7 +420,8 @@ cdef object _run(radau5_problem *p, int n, int m):
     cdef int rc
     cdef double[::1] tv, htv
     cdef double[:, ::1] yv, hyv, dtv, dcv
-    cdef int[::1] hev
+    cdef int[::1] hev, dkv
+    cdef Py_ssize_t i
     with nogil:
         rc = radau5_solve(p, &r)
     try:
@@ -425,13 +433,16 @@ cdef object _run(radau5_problem *p, int n, int m):
         if p.dense_output:
             dense_t = np.empty((r.n_dense, 2))
             dense_c = np.empty((r.n_dense, (1 + r.dense_terms) * n))
+            dense_kind = np.empty(r.n_dense, dtype=np.intc)
             if r.n_dense:
                 dtv = dense_t
                 dcv = dense_c
+                dkv = dense_kind
                 memcpy(&dtv[0, 0], r.dense_t, r.n_dense * 2 * sizeof(double))
                 memcpy(&dcv[0, 0], r.dense_c,
                        r.n_dense * (1 + r.dense_terms) * n * sizeof(double))
-            dense = (dense_t, dense_c, r.dense_terms)
+                memcpy(&dkv[0], r.dense_kind, r.n_dense * sizeof(int))
+            dense = (dense_t, dense_c, r.dense_terms, dense_kind)
         t = np.empty(r.n_out)
         y = np.empty((r.n_out, n))
         if r.n_out:
@@ -451,7 +462,11 @@ cdef object _run(radau5_problem *p, int n, int m):
             memcpy(&hyv[0, 0], r.hit_y, r.n_hits * n * sizeof(double))
         status, message, r_hits = r.status, r.message.decode(), r.n_hits
         counts = dict(nfev=r.nfev, njev=r.njev, nlu=r.nlu, nstep=r.nstep, nreject=r.nreject,
-                      h_next=r.h_next, n_rearmed=r.n_rearmed, stiff_at=r.stiff_at)
+                      h_next=r.h_next, n_rearmed=r.n_rearmed, stiff_at=r.stiff_at,
+                      nstep_implicit=r.nstep_implicit,
+                      method_end=_METHOD_NAMES[r.method_end],
+                      switches=[(r.switch_t[i], _METHOD_NAMES[r.switch_to[i]])
+                                for i in range(r.n_switches)])
         if r.profiled:   # a -DRADAU5_PROFILE build (benchmarks/profile_step.py)
             counts["profile"] = dict(zip(("fun", "jac", "factor", "solve", "events",
                                           "total", "total_ns"), [r.prof[i] for i in range(7)]))
@@ -500,12 +515,14 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    radau5_event_fun event_fun=NULL, int[::1] event_plane=None,
                    list users=None, bint dense_output=False, controller=None,
                    bint outputs_checked=False, bint refine_events=True,
-                   ball_ctx *ball=NULL, method="radau5", bint jacobian_ahead=False):
+                   ball_ctx *ball=NULL, method="radau5", bint jacobian_ahead=False,
+                   bint auto_implicit=False):
     """``ball``: ballc's system context (solve_system), which re-arms events;
-    ``jacobian_ahead``: radau5_problem.jacobian_ahead."""
+    ``jacobian_ahead``, ``auto_implicit``: radau5_problem's."""
     cdef radau5_problem p
     p.method = _method_code(method)
     p.jacobian_ahead = jacobian_ahead
+    p.auto_implicit = auto_implicit
     cdef int ctrl = _controller_bits(controller)
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
         raise ValueError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
@@ -578,23 +595,35 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     return _run(&p, n, m)
 
 
+#: The compiled methods' names by their C code (radau5_result.method_end, switch_to).
+_METHOD_NAMES = {RADAU5_METHOD_RADAU: "radau5", RADAU5_METHOD_DOP853: "dop853"}
+
+
 cdef int _method_code(method) except -1:
     if method == "radau5":
         return RADAU5_METHOD_RADAU
     if method == "dop853":
         return RADAU5_METHOD_DOP853
-    raise ValueError(f"method = {method!r} is not allowed: must be 'radau5' or 'dop853'")
+    if method == "auto":
+        return RADAU5_METHOD_AUTO
+    raise ValueError(f"method = {method!r} is not allowed: must be 'radau5', 'dop853' or "
+                     "'auto'")
 
 
 def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  max_step=np.inf, t_eval=None, events=(), first_step=None, max_nfev=None,
-                 dense_output=False, controller=None, refine_events=True, method="radau5"):
+                 dense_output=False, controller=None, refine_events=True, method="radau5",
+                 auto_implicit=False):
     """Integrate ballc's equations (N_STATES states) over ``t_span`` with radau5.
 
-    ``method``: "radau5" (Radau IIA, order 5: scipy's Radau) or "dop853" (Dormand &
+    ``method``: "radau5" (Radau IIA, order 5: scipy's Radau), "dop853" (Dormand &
     Prince's explicit pair of order 8: scipy's DOP853, for scenes that are not stiff;
-    ``controller`` and the Jacobian play no part); the loop, events and output are the
-    same.
+    ``controller`` and the Jacobian play no part) or "auto" (starts with dop853 --
+    with radau5 when ``auto_implicit`` -- and switches to radau5 when Hairer's
+    stiffness test fires, back when radau5's steps h rho(J) stay below dop853's
+    stability bound; see _integrator.h); the loop, events and output are the same.
+    Also returned: ``switches`` [(t, method switched to)], ``method_end`` (the method
+    in use at the end) and ``nstep_implicit`` (the radau5 steps of nstep).
 
     ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
     ``_core.System``.  ``events``: objects with ``coefficients`` (N_STATES),
@@ -616,7 +645,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     the solver's rows: shape (N_STATES, samples), Fortran order), and ``dense``: with
     ``dense_output``, (dense_t (steps x 2: t_old, t), dense_c (steps x (1 + terms)
     N_STATES: y_old, then ``terms`` rows of N_STATES: radau5 3, y = y_old + sum_j
-    row_j x^(j+1); dop853 7, scipy's Dop853DenseOutput F), terms), else None.
+    row_j x^(j+1); dop853 7, scipy's Dop853DenseOutput F), terms, kinds (steps,):
+    each step's own number of terms -- with "auto" a radau5 step (3) in rows as wide as
+    dop853's (7, the rest zeros)), else None.
     ``max_nfev``: give up (status -1, with what was computed) after that many
     right-hand-side calls.  ``controller``: the step control (private; None: the
     process's current one, see ``_set_controller``).  ``refine_events`` (default
@@ -644,7 +675,8 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  users, bool(dense_output), controller,
                  True,   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
                  bool(refine_events), &ctx, method,
-                 (flags & (BALLC_FLOOR_COMPLIANT | BALLC_CEILING_COMPLIANT)) != 0)
+                 (flags & (BALLC_FLOOR_COMPLIANT | BALLC_CEILING_COMPLIANT)) != 0,
+                 bool(auto_implicit))
     if errors:
         raise errors[0]
     return sol
@@ -652,9 +684,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
 
 def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),
                  first_step=None, max_nfev=None, controller=None, refine_events=True,
-                 method="radau5", dense_output=False):
+                 method="radau5", dense_output=False, auto_implicit=False):
     """Integrate y' = A y (A: n x n) with radau5; same result as ``solve_system``
-    (``refine_events``: see there)."""
+    (``refine_events``, ``method``, ``auto_implicit``: see there)."""
     cdef linear_ctx ctx
     A = np.ascontiguousarray(A, dtype=float)
     if A.ndim != 2 or A.shape[0] != A.shape[1] or A.shape[0] == 0:
@@ -666,7 +698,8 @@ def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, eve
     ctx.A = &av[0, 0]
     return _solve(_linear_fun, _linear_jac, &ctx, ctx.n, t_span, y0, rtol, atol,
                   max_step, t_eval, events, first_step, max_nfev, NULL, None, None,
-                  bool(dense_output), controller, False, bool(refine_events), NULL, method)
+                  bool(dense_output), controller, False, bool(refine_events), NULL, method,
+                  False, bool(auto_implicit))
 
 
 def _lu_solve(A, b):

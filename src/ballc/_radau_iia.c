@@ -444,7 +444,9 @@ int radau_iia_step(solver_t *s)
         for (int j = 0; j < 3; j++)
             s->Q[j * n + c] = Z[c] * k->P[0][j] + Z[n + c] * k->P[1][j] + Z[2 * n + c] * k->P[2][j];
     s->have_sol = 1;
+    s->dense_dop853 = 0;
     s->r->nstep++;
+    s->r->nstep_implicit++;
     return 1;
 }
 

@@ -330,7 +330,8 @@ def main(argv=None) -> int:
                      help="absolute tolerance (default: [simulate] atol, else simulate's)")
     run.add_argument("--method", default=None,
                      help="integrator: radau5, dop853 (explicit, order 8: several times "
-                          "faster at tight tolerances on scenes that are not stiff) or a "
+                          "faster at tight tolerances on scenes that are not stiff), auto "
+                          "(dop853, switching to radau5 where the scene turns stiff) or a "
                           "solve_ivp method (default: [simulate] method, else radau5)")
     run.add_argument("--no-exact-flight", action="store_true",
                      help="integrate free flight even where it has a closed form (default: "

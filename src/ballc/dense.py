@@ -28,11 +28,17 @@ class CompiledInterpolant:
     radau5 (3 terms, as scipy's ``RadauDenseOutput``): y = y_old + q1 x + q2 x^2 + q3 x^3.
     dop853 (7 terms F0..F6, as scipy's ``Dop853DenseOutput``):
     y = y_old + x (F0 + (1 - x) (F1 + x (F2 + (1 - x) (F3 + x (F4 + (1 - x) (F5 + x F6)))))).
+    method="auto" (``kinds``: each step's own number of terms): both kinds in one
+    segment, each step evaluated by its own formula.
     """
 
-    def __init__(self, steps, coefficients, terms=3):
+    def __init__(self, steps, coefficients, terms=3, kinds=None):
         self.steps = np.asarray(steps, dtype=float).reshape(-1, 2)
         self.terms = int(terms)
+        #: per step, its own number of terms: 3 (radau5) or 7 (dop853); with
+        #: method="auto" the two alternate, a radau5 step's rows padded with zeros
+        self.kinds = (np.full(len(self.steps), self.terms) if kinds is None
+                      else np.asarray(kinds, dtype=int).reshape(len(self.steps)))
         width = np.asarray(coefficients).shape[1] if np.ndim(coefficients) == 2 else 0
         self.n = width // (1 + self.terms)
         c = np.asarray(coefficients, dtype=float).reshape(len(self.steps),
@@ -49,16 +55,27 @@ class CompiledInterpolant:
         k = np.clip(np.searchsorted(self.steps[:, 1], tt, side="left"), 0, len(self.steps) - 1)
         t_old, t_new = self.steps[k, 0], self.steps[k, 1]
         x = ((tt - t_old) / (t_new - t_old))[:, None]
-        q = self.q[k]                                   # (m, terms, n)
-        y = np.zeros((tt.size, self.n))
-        if self.terms == 3:                             # Horner in x
+        kinds = self.kinds[k]
+        if kinds.size == 0 or np.all(kinds == kinds[0]):   # one kind: as before
+            y = self._evaluate(self.q[k], x, int(kinds[0]) if kinds.size else self.terms)
+        else:   # method="auto": each step by its own method's interpolant
+            y = np.empty((tt.size, self.n))
+            for kind in np.unique(kinds):
+                mask = kinds == kind
+                y[mask] = self._evaluate(self.q[k[mask]], x[mask], int(kind))
+        y = y + self.y_old[k]
+        return y[0] if scalar else y.T
+
+    def _evaluate(self, q, x, terms):
+        """The interpolants' terms at x (without y_old): q (m, terms, n), x (m, 1)."""
+        y = np.zeros((x.shape[0], self.n))
+        if terms == 3:                                  # Horner in x
             for j in range(2, -1, -1):
                 y = (y + q[:, j]) * x
         else:                                           # scipy's Dop853DenseOutput
-            for i, j in enumerate(range(self.terms - 1, -1, -1)):
+            for i, j in enumerate(range(terms - 1, -1, -1)):
                 y = (y + q[:, j]) * (x if i % 2 == 0 else 1 - x)
-        y = y + self.y_old[k]
-        return y[0] if scalar else y.T
+        return y
 
 
 class PiecewiseSolution:

@@ -2,7 +2,8 @@
 
 ``method`` "radau5" runs ballc's compiled Radau IIA (scipy's Radau, step by step in
 C) on the system's C right-hand side and Jacobian, "dop853" ballc's compiled DOP853
-(scipy's DOP853, in the same C loop, with the same events); any other is handed to scipy's
+(scipy's DOP853, in the same C loop, with the same events), "auto" the two switching in
+that loop (docs/architecture.md, "The automatic method"); any other is handed to scipy's
 ``solve_ivp`` (with the analytic Jacobian when implicit).  scipy has no call budget
 of its own: :func:`_call_budget` gives it one as a terminal event.  With
 ``exact_flight``, a free-flight segment that has an exact solution (massless observer,
@@ -20,7 +21,8 @@ from .options import COMPILED_METHODS, IMPLICIT_METHODS
 
 
 def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval, max_step,
-                      max_nfev=None, first_step=None, dense_output=False, exact_flight=False):
+                      max_nfev=None, first_step=None, dense_output=False, exact_flight=False,
+                      auto_implicit=False):
     """Integrate one smooth segment; returns a solve_ivp-style solution.
 
     This is the one seam between the driver and an integrator.  The solution has
@@ -33,7 +35,10 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
     was computed) after that many right-hand-side calls.  ``exact_flight``: propagate
     the segment in closed form when :func:`ballc.flight.applies` (then ``nfev`` is 0,
     ``first_step`` and ``max_nfev`` play no part, ``max_step`` only bounds the spacing
-    of the samples, and the solution has ``exact_flight = True``).
+    of the samples, and the solution has ``exact_flight = True``).  ``auto_implicit``
+    (method "auto" only): start with radau5 instead of dop853 (the driver's segment
+    that continues one which ended with radau5, with its step).  Method "auto" also
+    returns ``switches``, [(t, method switched to)], and ``method_end``.
     """
     events = list(events)
     if exact_flight and flight.applies(system, events):
@@ -45,7 +50,8 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
         sol = _radau5.solve_system(system.params, system.latch, system.flags, (t0, t1), y0,
                                    rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
                                    events=events, max_nfev=max_nfev, first_step=first_step,
-                                   dense_output=dense_output, method=method)
+                                   dense_output=dense_output, method=method,
+                                   auto_implicit=auto_implicit and method == "auto")
         if dense_output:
             sol.interpolant = dense.CompiledInterpolant(*sol.dense)
         return sol

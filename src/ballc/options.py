@@ -19,8 +19,10 @@ SCIPY_METHODS = ("Radau", "BDF", "LSODA", "DOP853", "RK45", "RK23")
 IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
 #: ballc's compiled integrators: "radau5", Radau IIA (order 5), scipy's Radau step by
 #: step in C; "dop853", Dormand & Prince's explicit pair of order 8, scipy's DOP853 step
-#: by step in C (for scenes that are not stiff), in the same loop with the same events.
-COMPILED_METHODS = ("radau5", "dop853")
+#: by step in C (for scenes that are not stiff), in the same loop with the same events;
+#: "auto", per segment dop853 switching to radau5 where Hairer's stiffness test fires and
+#: back where radau5's steps are within dop853's stability bound (LSODA's idea).
+COMPILED_METHODS = ("radau5", "dop853", "auto")
 METHODS = COMPILED_METHODS + SCIPY_METHODS
 
 #: Default budget of right-hand-side evaluations of one simulate call.

@@ -174,6 +174,9 @@ class Result:
     #: with ``dense_output=True``: sol(t), the continuous solution over [0, t[-1]]
     #: (a ballc.dense.PiecewiseSolution), else None
     sol: object = field(default=None, repr=False)
+    #: with ``method="auto"``: [(t, method)], each switch of the integrator (s, and
+    #: "radau5" or "dop853": the method switched to), in time order; else None
+    method_switches: list | None = field(default=None, repr=False)
 
     @property
     def success(self) -> bool:

@@ -422,6 +422,15 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         the same error.  Explicit: on stiff scenes (hard materials, compliant
         tangential laws, sticking with large stiffness) its steps are bounded by
         stability, not accuracy, and radau5 is the one to use.
+        "auto": per segment dop853 first, switching to radau5 where Hairer's stiffness
+        test fires (15 steps in a row held at dop853's stability limit) or a Jacobian
+        probe every 15 steps finds them stiff, and back where radau5's steps are within
+        half dop853's stability bound for 15 steps, in the same loop
+        with the same events and output (each step keeps its own method's interpolant); a
+        segment that continues the last one with its step (a stick/slip transition, a
+        rest check) continues with its method too.  ``result.method_switches`` lists the
+        switches.  Until it switches it is dop853, step for step.  It is not the
+        default: docs/auto_method.md has the measurements against the rule.
         Or a scipy.integrate.solve_ivp
         method: "Radau" (the reference radau5 is tested against), "BDF", "LSODA" (given
         the analytic Jacobian), "DOP853", "RK45", "RK23".
@@ -505,6 +514,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     bar = progress_bar(progress, t_end)
     nfev = njev = nlu = 0
     first = options.first_step
+    implicit = False   # method="auto": the segment starts with radau5 (the step carried over)
+    switches = []      # method="auto": (t, method switched to), over the run
     stiff_at = None
     checks_rest = rest and t_eval is None and not user
 
@@ -530,8 +541,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                                 t_eval=segment_eval, max_step=options.max_step,
                                 max_nfev=remaining, first_step=first,
                                 dense_output=options.dense_output,
-                                exact_flight=options.exact_flight)
+                                exact_flight=options.exact_flight, auto_implicit=implicit)
         first = None
+        implicit = False
         # every integrator's solution is a solve_ivp-style OptimizeResult, a dict: item
         # access is a dict lookup (its attribute access goes through a Python __getattr__)
         nfev += sol["nfev"]
@@ -539,6 +551,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         nlu += sol["nlu"]
         if stiff_at is None and math.isfinite(sol.get("stiff_at", math.nan)):
             stiff_at = sol["stiff_at"]   # dop853's stiffness test fired in this segment
+        if options.method == "auto":
+            switches += sol.get("switches", ())
         t, t_events, y_events, status = sol["t"], sol["t_events"], sol["y_events"], sol["status"]
         # An event at the segment's very start ends a zero-length segment whose event
         # sample repeats t; keep only later samples so that result.t stays increasing.
@@ -596,6 +610,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     break
                 h_next = sol.get("h_next", 0)
                 first = min(h_next, options.max_step) if h_next > 0 else None
+                implicit = first is not None and sol.get("method_end") == "radau5"
                 continue
             break
         if fired < 0:
@@ -616,6 +631,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             # within a contact the dynamics do not jump at a stick/slip transition: go on
             # with the step the controller had chosen instead of a fresh start
             first = min(h_next, options.max_step)
+            # method="auto": the step carried over is the method's, so is the method
+            implicit = sol.get("method_end") == "radau5"
 
     if bar is not None:
         bar.update((t_end if run.status == 0 else run.t) - bar.n)
@@ -631,11 +648,13 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     t_events=[np.concatenate(k) if k else np.empty(0) for k in user_t],
                     y_events=[np.concatenate(k) if k else np.empty((0, _core.N_STATES))
                               for k in user_y],
-                    sol=PiecewiseSolution(pieces) if options.dense_output else None)
+                    sol=PiecewiseSolution(pieces) if options.dense_output else None,
+                    method_switches=switches if options.method == "auto" else None)
     outcome.summarize_contact_forces(result)
     result.message += outcome.tolerance_warning(options.rtol, options.atol)
     result.message += outcome.balance_warning(result, options.rtol)
-    result.message += outcome.stiffness_note(stiff_at)
+    if options.method == "dop853":   # auto switched to radau5 where the test fired
+        result.message += outcome.stiffness_note(stiff_at)
     return result
 
 
