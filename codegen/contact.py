@@ -382,9 +382,11 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     / |s|, the truncated increment's direction (``turn`` f = 1, or less below
     TURN_FLOOR).  The radial part is relative, so that the approximate penetration
     acceleration in ds_cap/dt (normal_force_rate's) errs by a factor on |s|, never
-    driving s through 0 before s_cap; ``jacobian_form`` writes it e ds_cap/dt (the same
-    value at |s| = s_cap), whose d/ds is 0 (d ln(s_cap)/dt ~ 1/t at a start: the
-    dilution's trap, see JACOBIAN_FORMS).  Returns
+    driving s through 0 before s_cap (with the open-loop e ds_cap/dt, the seed's throw
+    with its observer drove s through 0 at a contact's end, and radau5 stalled there).
+    It is stiff as F_n -> 0 at the end (d ln(s_cap)/dt -> -inf): ``jacobian_form`` keeps
+    that decay in d/ds and leaves out the growth while the cap rises (~ +1/t at a start:
+    the dilution's trap, see JACOBIAN_FORMS).  Returns
     (applied force (2), deflection rate (2), rate of the stored energy 1/2 k_t |s|^2
     (W), k_t).  No viscous damping: it is dropped while sliding (capacity 0).
     """
@@ -397,11 +399,16 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
                                           normal_force_rate)
     along = ex * vx + ey * vy
     in_contact = normal_force / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
+    # d ln(s_cap)/dt = dF_n/dt / F_n - rhodot / (2 rho)
+    relative = normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2)) - stiffening
     if jacobian_form:
-        radial = [ex * s_cap_rate, ey * s_cap_rate]
+        # the same value where |s| = s_cap; its d/ds keeps the decay while the cap
+        # shrinks (min(relative, 0): stiff as F_n -> 0 at the contact's end, which Newton
+        # needs) and leaves out the growth while it rises (~ +1/t from the start)
+        shrinking = sm.Min(relative, 0)
+        radial = [ex * s_cap_rate + (sx - s_cap * ex) * shrinking,
+                  ey * s_cap_rate + (sy - s_cap * ey) * shrinking]
     else:
-        # d ln(s_cap)/dt = dF_n/dt / F_n - rhodot / (2 rho)
-        relative = normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2)) - stiffening
         radial = [sx * relative, sy * relative]
     rate = [in_contact * ((v - along * e) * turn + w)
             for v, e, w in zip((vx, vy), (ex, ey), radial)]
