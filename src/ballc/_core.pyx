@@ -312,16 +312,22 @@ def slip_map(const double[::1] params, int plane):
     return out[2:2 + 2 * BALLC_N_STATES].reshape(2, BALLC_N_STATES)
 
 
+cdef void _check_plane_call(const double[::1] y, const double[::1] params,
+                            const double[::1] latch, int plane) except *:
+    """The lengths of a per-plane entry point's inputs, and its plane."""
+    _check("y", y.shape[0], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check("latch", latch.shape[0], BALLC_N_LATCH)
+    _plane_index(plane)
+
+
 def stick_state(const double[::1] y, const double[::1] params, const double[::1] latch,
                 int flags, int plane):
     """(lambda_x, lambda_y, N, margin) of a sticking ``plane``: the constraint force (N)
     that holds the slip velocity, the friction share's normal force (N) and
     mu N - |lambda| (N); raises if it cannot be evaluated (flags must hold the plane's
     friction and stick flags)."""
-    _check("y", y.shape[0], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latch", latch.shape[0], BALLC_N_LATCH)
-    _plane_index(plane)
+    _check_plane_call(y, params, latch, plane)
     out = np.empty(4)
     cdef double[::1] o = out
     cdef int status = ballc_stick_state(&y[0], &params[0], &latch[0], flags, plane, &o[0])
@@ -335,10 +341,7 @@ def compliant_margins(const double[::1] y, const double[::1] params, const doubl
     """The compliant law's mode guards on ``plane`` at state y: (yield margin
     1 - k_t |s| / (mu F_n) (1), re-stick margin (m/s), s_cap = mu F_n / k_t (m), k_t (N/m));
     see codegen/contact.py, compliant_margins.  Raises if they are not finite."""
-    _check("y", y.shape[0], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latch", latch.shape[0], BALLC_N_LATCH)
-    _plane_index(plane)
+    _check_plane_call(y, params, latch, plane)
     out = np.empty(4)
     cdef double[::1] o = out
     cdef int status = ballc_compliant_margins(&y[0], &params[0], &latch[0], plane, &o[0])

@@ -162,15 +162,22 @@ class _Run:
         if not record or record[-1][1] != phase:
             record.append((self.t, phase))
 
-    def compliant_event(self, kind, plane):
-        """The compliant law's next mode after its guard ``kind`` fired on ``plane``."""
+    def settles(self, plane, what):
+        """Count a mode change of ``plane`` now; False (and the run stopped, status -1)
+        when its ``what`` transitions have reached a limit (see unsettled)."""
         self.stalled = self.stalled_at(self.t)
         self.last_transition = self.t
-        if self.unsettled(plane, self.stalled):
-            self.status = -1
-            self.message = (f"the compliant law's elastic/sliding transitions on the {plane} "
-                            f"did not settle: {self.transitions[plane]} mode changes in one "
-                            f"contact, {self.stalled} of them at t = {self.t:.17g} s")
+        if not self.unsettled(plane, self.stalled):
+            return True
+        self.status = -1
+        self.message = (f"{what} transitions on the {plane} did not settle: "
+                        f"{self.transitions[plane]} mode changes in one contact, "
+                        f"{self.stalled} of them at t = {self.t:.17g} s")
+        return False
+
+    def compliant_event(self, kind, plane):
+        """The compliant law's next mode after its guard ``kind`` fired on ``plane``."""
+        if not self.settles(plane, "the compliant law's elastic/sliding"):
             return
         if kind == "arm":
             self.armed[plane] = True
@@ -219,13 +226,7 @@ class _Run:
 
     def coulomb_event(self, kind, plane):
         """The next exact-Coulomb mode after event ``kind`` on ``plane`` (see stickslip)."""
-        self.stalled = self.stalled_at(self.t)
-        self.last_transition = self.t
-        if self.unsettled(plane, self.stalled):
-            self.status = -1
-            self.message = (f"stick-slip transitions on the {plane} did not settle: "
-                            f"{self.transitions[plane]} mode changes in one contact, "
-                            f"{self.stalled} of them at t = {self.t:.17g} s")
+        if not self.settles(plane, "stick-slip"):
             return
         u, speed, error, clear = self.slip(plane, self.y)
         direction = _unit(u, speed) if speed > 0 else None
