@@ -399,8 +399,13 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
                                           normal_force_rate)
     along = ex * vx + ey * vy
     in_contact = normal_force / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
-    # d ln(s_cap)/dt = dF_n/dt / F_n - rhodot / (2 rho)
-    relative = normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2)) - stiffening
+    # d ln(s_cap)/dt = dF_n/dt / F_n - rhodot / (2 rho); below the force floor (F_n <
+    # 1e-12 N, a contact's last instants) both terms are scaled by F_n / 1e-12 N alike
+    # (in_contact), which keeps the sign of d(F_n / k_t)/dt and stays bounded -- with the
+    # floor on the first term only, a leaving contact's -rhodot/(2 rho) made |s| grow
+    # at ~1e12 /s there and stalled the integrator (a steel ball's small bounces)
+    relative = (normal_force_rate / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
+                - in_contact * stiffening)
     if jacobian_form:
         # the same value where |s| = s_cap; its d/ds keeps the decay while the cap
         # shrinks (min(relative, 0): stiff as F_n -> 0 at the contact's end, which Newton

@@ -79,7 +79,9 @@ TRANSITIONS = (
     Transition("yield", ("elastic",), COMPLIANT_MODES,
                "1 - k_t |s| / (mu F_n) + offset falls through 0",
                "decide at the cap: sliding when the re-stick margin there is >= 0, "
-               "else elastic with the spring brought back to the cap", "compliant_event"),
+               "else elastic with the spring brought back to the cap; where the load "
+               "vanished with the spring far below the cap, elastic and disarmed (the "
+               "contact's last instants)", "compliant_event"),
     Transition("restick", ("sliding",), ("elastic",),
                "(e . v_t - max(rhodot, 0)/(2 rho) |s|) - ds_cap/dt + offset falls "
                "through 0", "a spring beyond the cap is brought back to it",

@@ -146,6 +146,16 @@ def start(y, params, latch, plane: str):
     return "elastic", y
 
 
+def load_vanished(y, params, latch, plane: str) -> bool:
+    """Whether a yield fired where the load vanished with the spring far below the cap
+    (k_t |s| < mu F_n / 2, or no load at all): the yield margin reads -1 without load,
+    so a contact whose spring is (nearly) relaxed "yields" at its last instant.  There
+    the guards are disarmed (the smooth-yield kernels take the contact to its end, the
+    load ~0), instead of sliding on a spring of rounding-level |s|."""
+    margin, _, s_cap, _ = margins(y, params, latch, plane).tolist()
+    return not s_cap > 0 or margin > 0.5
+
+
 def decide(y, params, latch, plane: str, arming=False):
     """(mode, state) where the elastic spring meets the cap (a yield, or the arming of a
     contact's guards): "sliding" when the re-stick margin with the spring at the cap

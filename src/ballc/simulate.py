@@ -181,6 +181,11 @@ class _Run:
             return
         if kind == "arm":
             self.armed[plane] = True
+        elif kind == "yield" and compliantmodes.load_vanished(self.y, self.params, self.latch,
+                                                              plane):
+            self.armed[plane] = False     # the contact's last instants: disarmed
+            self.set_compliant(plane, "elastic")
+            return
         if kind in ("arm", "yield"):
             mode, self.y = compliantmodes.decide(self.y, self.params, self.latch, plane,
                                                  arming=kind == "arm")
