@@ -278,6 +278,15 @@ def compliant_contact(model: Model, plane: str) -> CompliantContact:
     return CompliantContact(point, normal, slip, rho, rhodot, f_n, stiffness, cap, f_rate)
 
 
+def loaded(model: Model, normal_force):
+    """1 while the tangential spring can carry a force, 0 when it cannot, as a factor of
+    its deflection rate: F_n / max(F_n, 1e-12 N) (below the force floor a fraction, which
+    keeps the derivatives finite), and 0 when mu = 0 (a cap of 0: the DEM codes'
+    truncation holds the stored force at 0, and the spring stays relaxed)."""
+    return (normal_force / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
+            * sm.Heaviside(model.p["friction_coefficient"], 0))
+
+
 def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, cap,
                         slip, normal_force_rate, dilute=True, smooth_yield=True):
     """The incremental (passive) Mindlin tangential spring with a Coulomb cap.
@@ -316,7 +325,7 @@ def incremental_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal
     # truncation then holds the stored force at 0, and ballc stops the deflection: the
     # spring's energy 1/2 k_t |s|^2 goes to 0 with k_t by the contact's end and is
     # counted as dissipated (no energy is created either way)
-    in_contact = normal_force / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
+    in_contact = loaded(model, normal_force)
     rate = [in_contact * (v - (dilution + flow) * s) for v, s in zip((vx, vy), (sx, sy))]
     elastic = [-k_t * sx, -k_t * sy]
     size = sm.sqrt(sm.Max(k_t**2 * size2, cap**2, _FORCE_FLOOR2))
@@ -398,7 +407,7 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     s_cap, s_cap_rate = capped_deflection(model, k_t, stiffening, normal_force,
                                           normal_force_rate)
     along = ex * vx + ey * vy
-    in_contact = normal_force / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
+    in_contact = loaded(model, normal_force)
     # d ln(s_cap)/dt = dF_n/dt / F_n - rhodot / (2 rho); below the force floor (F_n <
     # 1e-12 N, a contact's last instants) both terms are scaled by F_n / 1e-12 N alike
     # (in_contact), which keeps the sign of d(F_n / k_t)/dt and stays bounded -- with the

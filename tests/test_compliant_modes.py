@@ -110,3 +110,20 @@ def test_a_hard_ball_s_small_bounces_end_without_stalling():
     assert np.abs(loose.y[:13, -1] - tight.y[:13, -1]).max() < 1e-6
     energy = tight.energy
     assert np.all(np.diff(energy["dissipated_tangential"]) >= -1e-12 * energy["total"][0])
+
+
+@pytest.mark.parametrize("regularization", ["exact", "smooth"])
+def test_without_friction_the_tangential_state_is_untouched(regularization):
+    # mu = 0: no tangential force (the cap is 0, the spring stays relaxed), so with a
+    # massless observer the in-plane velocity and the spin pass every contact unchanged
+    # (before: both laws crawled at the first contact, 5e6 calls, the spring turning at
+    # |v_t| / |s| with |s| ~ 1e-10 m)
+    scene = ballc.Scene(tangential_model="compliant", friction_coefficient=0.0,
+                        observer_mass=0.0, angular_velocity=(3.0, -2.0, 1.0),
+                        friction_regularization=regularization)
+    result = ballc.simulate(scene, 2.0, rtol=1e-8, atol=1e-10, max_nfev=200_000)
+    assert result.status == 0 and len(result.contacts) >= 3
+    v, w = result.y[layout.VELOCITY], result.y[layout.ANGULAR_VELOCITY]
+    assert np.abs(v[:2] - np.array(scene.velocity[:2])[:, None]).max() <= 1e-12
+    assert np.abs(w - np.array(scene.angular_velocity)[:, None]).max() <= 1e-12
+    assert result.energy["tangential_spring"].max() == 0.0

@@ -74,8 +74,10 @@ START_DEFLECTION = 1e-100
 
 
 def uses_modes(scene) -> bool:
-    """Whether ``scene``'s contacts run the compliant law as exact elastic/sliding modes."""
-    return scene.tangential_model == "compliant" and scene.friction_regularization == "exact"
+    """Whether ``scene``'s contacts run the compliant law as exact elastic/sliding modes
+    (not with mu = 0: no tangential force, the spring stays relaxed)."""
+    return (scene.tangential_model == "compliant" and scene.friction_regularization == "exact"
+            and scene.friction_coefficient > 0)
 
 
 def mode_flags(plane: str, mode: str | None, armed: bool = True) -> int:
