@@ -132,20 +132,22 @@ def guard(scene, mode: str, armed: bool, y0, params, latch, plane: str, rho0: fl
 def start(y, params, latch, plane: str):
     """(mode, state) at a contact start (s = 0): the self-similar start s = 2/3 v_t t
     (elastic; for Hunt-Crossley k_t |s| / (mu F_n) = kappa |v_t| / (mu (1 + chi)
-    rhodot^-) at all t) or at the cap (sliding): "sliding", with the spring at the cap
-    along the slip velocity, when the re-stick margin there is >= 0; else "elastic".
-    The margins' ratios do not depend on the rounding of rho (s_cap and the rates are
-    proportional to it), so the decision is sound where rho itself is not resolved."""
+    rhodot^-) at all t) or at the cap (sliding): :func:`decide` with the spring put at
+    the cap along the slip velocity.  The margins' ratios do not depend on the rounding
+    of rho (s_cap and the rates are proportional to it), so the decision is sound where
+    rho itself is not resolved."""
+    return decide(y, params, latch, plane, arming=True)
+
+
+def _along_slip(y, params, latch, plane: str):
+    """The deflection at the cap along the slip velocity (2, m), START_DEFLECTION long
+    where s_cap is 0; None without slip."""
     u = stickslip.slip_velocity(params, plane, y)
     speed = math.hypot(*u.tolist())
     if not speed > 0:
-        return "elastic", y
+        return None
     s_cap = float(margins(y, params, latch, plane)[2])
-    trial = np.array(y, dtype=float)
-    trial[_DEFLECTION[plane]] = (s_cap if s_cap > 0 else START_DEFLECTION) * u / speed
-    if margins(trial, params, latch, plane)[1] >= 0:
-        return "sliding", trial
-    return "elastic", y
+    return (s_cap if s_cap > 0 else START_DEFLECTION) * u / speed
 
 
 def load_vanished(y, params, latch, plane: str) -> bool:
@@ -175,14 +177,12 @@ def decide(y, params, latch, plane: str, arming=False):
     # than s itself there)
     relaxed = arming or not math.hypot(*s.tolist()) > 0
     if relaxed:
-        u = stickslip.slip_velocity(params, plane, y)
-        speed = math.hypot(*u.tolist())
-        if not speed > 0:
+        along = _along_slip(y, params, latch, plane)
+        if along is None:
             return "elastic", y
-        s_cap = float(margins(y, params, latch, plane)[2])
-        trial[_DEFLECTION[plane]] = (s_cap if s_cap > 0 else START_DEFLECTION) * u / speed
+        trial[_DEFLECTION[plane]] = along
     if margins(trial, params, latch, plane)[1] >= 0:
-        return "sliding", (trial if relaxed or arming else y)
+        return "sliding", (trial if relaxed else y)
     return "elastic", at_cap(y, params, latch, plane)
 
 

@@ -238,11 +238,12 @@ class CompliantGuard:
 
     KINDS = ("yield", "restick")
     __slots__ = ("plane", "kind", "system_event", "offset", "terminal", "direction",
-                 "_params", "_latch")
+                 "_params", "_latch", "_margin")
 
     def __init__(self, plane: str, kind: str, params, latch, offset: float):
         self.plane, self.kind = PLANES.index(plane), kind
-        self.system_event = 2 + 2 * self.KINDS.index(kind) + self.plane
+        self._margin = self.KINDS.index(kind)   # its row of compliantmodes.margins
+        self.system_event = 2 + 2 * self._margin + self.plane
         self.offset = float(offset)
         self.terminal = True
         self.direction = -1
@@ -252,7 +253,7 @@ class CompliantGuard:
     def __call__(self, t, y):
         y = np.ascontiguousarray(y, dtype=float)
         margins = _core.compliant_margins(y, self._params, self._latch, self.plane)
-        return float(margins[self.KINDS.index(self.kind)]) + self.offset
+        return float(margins[self._margin]) + self.offset
 
     def __repr__(self):
         return f"CompliantGuard({PLANES[self.plane]} {self.kind} + {self.offset:g})"

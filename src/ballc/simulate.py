@@ -157,7 +157,11 @@ class _Run:
         phases as Coulomb's: "slip" (sliding, at the cap) and "stick" (elastic)."""
         self.compliant[plane] = mode
         self.transitions[plane] += 1
-        phase = "slip" if mode == "sliding" else "stick"
+        self.record_phase(plane, "slip" if mode == "sliding" else "stick")
+
+    def record_phase(self, plane, phase):
+        """The contact on ``plane`` enters ``phase`` ("slip" or "stick") now, unless it
+        is in it already (its record of phase starts)."""
         record = self.open[plane].transitions
         if not record or record[-1][1] != phase:
             record.append((self.t, phase))
@@ -209,9 +213,7 @@ class _Run:
         self.transitions[plane] += 1
         if direction is not None:
             stickslip.set_slip_direction(self.latch, plane, direction)
-        record = self.open[plane].transitions
-        if not record or record[-1][1] != phase:
-            record.append((self.t, phase))
+        self.record_phase(plane, phase)
 
     def settle(self, plane):
         mode, direction, self.y = stickslip.settle(self.scene, self.params, self.latch,
