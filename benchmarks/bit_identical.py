@@ -13,7 +13,10 @@ bit-identical, 1 otherwise.
 
 Cases: ``ballc.simulate(ballc.Scene(), 5)`` with method radau5 and dop853 at the default
 tolerances (rtol = atol = 1e-10) and at 1e-6 and 1e-3, and
-``Scene(tangential_model="compliant")`` for 5 s with radau5 (default and 1e-6); with
+``Scene(tangential_model="compliant")`` for 5 s with radau5 (default and 1e-6); the
+compliant law's modes (the seed's compliant scene, dop853, and stiffness ratio 2/7 with
+mu = 1, both methods, at 1e-4, 1e-6, 1e-9); five cells of the comeback map (mixture, mu)
+with both methods at 1e-3; with
 radau5 and dop853 at 1e-8: work_precision's stiff steel scene with ``dense_output`` (sol
 on a grid compared too), the default scene with ``t_eval``, and the stress matrix's
 grazing impact (vz = 0).
@@ -50,6 +53,25 @@ cases = [
     ("compliant scene, radau5, 1e-6", dict(tangential_model="compliant"),
      dict(method="radau5", rtol=1e-6, atol=1e-6)),
 ]
+# the compliant law's modes with both methods (benchmarks.compliant_cost's scenes)
+ratio = dict(tangential_model="compliant", tangential_stiffness_ratio=2 / 7,
+             friction_coefficient=1.0)
+for tol in (1e-4, 1e-6, 1e-9):
+    cases += [
+        (f"compliant scene, dop853, {tol:g}", dict(tangential_model="compliant"),
+         dict(method="dop853", rtol=tol, atol=tol)),
+        (f"compliant ratio 2/7 mu 1, dop853, {tol:g}", ratio,
+         dict(method="dop853", rtol=tol, atol=tol)),
+        (f"compliant ratio 2/7 mu 1, radau5, {tol:g}", ratio,
+         dict(method="radau5", rtol=tol, atol=tol)),
+    ]
+# cells of the comeback map (benchmarks.comeback_map: 1.2-s throws at 1e-3, run for 5 s
+# here), both methods
+for mixture, mu in ((0.0, 0.0), (0.0, 0.5), (0.3, 0.2), (0.7, 1.0), (1.0, 0.6)):
+    for method in ("radau5", "dop853"):
+        cases.append((f"map cell mixture {mixture} mu {mu}, {method}, 1e-3",
+                      dict(mixture=mixture, friction_coefficient=mu),
+                      dict(method=method, rtol=1e-3, atol=1e-3)))
 steel = dict(tangential_model="friction", ball_youngs_modulus=2e11, plane_youngs_modulus=2e11,
              c_tau=0.5, observer_mass=0.0, position=(0.0, 0.0, 2.0), velocity=(0.5, 0.0, 0.0))
 for method in ("radau5", "dop853"):

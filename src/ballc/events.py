@@ -137,14 +137,15 @@ def contact_threshold(scene, plane, rho0, entering):
 
 
 def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
-                    clear=0.0, approach=None, rearm=None, compliant=None, armed=None):
+                   clear=0.0, approach=None, rearm=None, compliant=None, armed=None):
     """Events of one segment starting at state y0: [(kind, plane, event)].
 
     ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
     see ballc.stickslip), ``clear`` the slip speed (m/s) below which the slip
-    direction is held fixed, ``approach`` (optional, per plane) the speed at which a
-    free slip's approach event fires when it is not ``clear`` (a slip passing by
-    zero).  The stop and release events sit a rounding-level margin past their zero,
+    direction is held fixed (a callable () -> that speed is also taken: it is then
+    asked only when a plane slips), ``approach`` (optional, per plane) the speed at
+    which a free slip's approach event fires when it is not ``clear`` (a slip passing
+    by zero).  The stop and release events sit a rounding-level margin past their zero,
     so that a segment starting on it (slip from rest, a stick that starts at the cone)
     does not fire at once.  ``rearm`` (optional): plane -> the ``rearm`` callable of
     that plane's approach event (see :class:`LinearEvent`).  ``compliant`` (optional,
@@ -152,49 +153,78 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
     ballc.compliantmodes), whose guard ends the segment; ``armed`` (per plane): whether
     that guard is armed (else the arming depth is the guard).
     """
-    events = []
-    for plane in PLANES:
-        rho = penetration(plane, scene)
-        rho0 = rho(0.0, y0)
-        if in_contact[plane]:
-            threshold = contact_threshold(scene, plane, rho0, entering=False)
-            events.append(("leave", plane, rho.shifted(threshold, True, -1)))
-            events.append(("through", plane, rho.shifted(-scene.radius, True, 1)))
-            events.append(("deepest", plane, _deepest_of(plane)))
-        else:
-            threshold = contact_threshold(scene, plane, rho0, entering=True)
-            if compliantmodes.uses_modes(scene):   # the compliant law starts armed
-                threshold = max(threshold, compliantmodes.arm_penetration(scene, plane))
-            events.append(("enter", plane, rho.shifted(-threshold, True, 1)))
-        mode = coulomb[plane] if coulomb else None
-        if mode in ("slip", "slip_fixed"):
-            along = stickslip.slip_stop_coefficients(params, plane,
-                                                     stickslip.slip_direction(latch, plane))
-            if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
-                speed = approach.get(plane) if approach else None
-                speed = clear if speed is None else speed
-                event = LinearEvent.over(along, -speed, True, -1)
-                if rearm is not None:
-                    event.rearm = rearm(plane)
-                events.append(("approach", plane, event))
-            else:                # fixed direction: stop at u . d = 0, or go free at 2 clear
-                margin = 4 * math.ulp(stickslip.speed_scale(scene, y0))
-                events.append(("stop", plane, LinearEvent.over(along, margin, True, -1)))
-                events.append(("clear", plane, LinearEvent.over(along, -2 * clear, True, 1)))
-        elif mode == "stick":
-            load = _core.stick_state(y0, params, latch, flags, PLANES.index(plane))[2]
-            events.append(("release", plane, StickRelease(
-                plane, params, latch, flags, stickslip.force_scale(scene, load))))
-        law_mode = compliant[plane] if compliant else None
-        if law_mode is not None:
-            kind, offset = compliantmodes.guard(scene, law_mode, armed[plane], y0, params,
-                                                latch, plane, rho0)
-            if kind == "arm":     # the penetration rising through the arming depth
-                events.append((kind, plane, rho.shifted(offset, True, 1)))
+    return SegmentEvents(scene)(in_contact, y0, coulomb, params, latch, flags, clear,
+                                approach, rearm, compliant, armed)
+
+
+class SegmentEvents:
+    """:func:`segment_events` for one scene, with what does not change between the
+    segments of a run worked out once (the driver makes one per run): per plane its
+    penetration, deepest-point and passing-through events, the rounding margin of its
+    contact threshold and the compliant law's arming depth.  Same events, same bits."""
+
+    def __init__(self, scene):
+        self.scene = scene
+        self.modes = compliantmodes.uses_modes(scene)
+        self.planes = []
+        for plane in PLANES:
+            rho = penetration(plane, scene)
+            boundary = scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
+            self.planes.append((
+                plane, rho, rho._index, rho._scale, rho.offset,
+                4 * math.ulp(boundary),                            # contact_threshold's base
+                compliantmodes.arm_penetration(scene, plane) if self.modes else None,
+                rho.shifted(-scene.radius, True, 1),               # passing through
+                _deepest_of(plane)))
+
+    def __call__(self, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
+                 clear=0.0, approach=None, rearm=None, compliant=None, armed=None):
+        scene = self.scene
+        events = []
+        append = events.append
+        for plane, rho, index, scale, offset, base, arm, through, deepest in self.planes:
+            rho0 = scale * y0[index] + offset                      # rho(0, y0)
+            if in_contact[plane]:
+                # contact_threshold(scene, plane, rho0, entering=False)
+                threshold = max(base, -rho0 + base)
+                append(("leave", plane, rho.shifted(threshold, True, -1)))
+                append(("through", plane, through))
+                append(("deepest", plane, deepest))
             else:
-                events.append((kind, plane, CompliantGuard(plane, kind, params, latch,
-                                                           offset)))
-    return events
+                threshold = max(base, rho0 + base)                 # entering=True
+                if arm is not None:   # the compliant law starts armed
+                    threshold = max(threshold, arm)
+                append(("enter", plane, rho.shifted(-threshold, True, 1)))
+            mode = coulomb[plane] if coulomb else None
+            if mode == "slip" or mode == "slip_fixed":
+                if callable(clear):
+                    clear = clear()
+                along = stickslip.slip_stop_coefficients(params, plane,
+                                                         stickslip.slip_direction(latch, plane))
+                if mode == "slip":   # free direction: freeze it when u . d falls to `clear`
+                    speed = approach.get(plane) if approach else None
+                    speed = clear if speed is None else speed
+                    event = LinearEvent.over(along, -speed, True, -1)
+                    if rearm is not None:
+                        event.rearm = rearm(plane)
+                    append(("approach", plane, event))
+                else:                # fixed direction: stop at u . d = 0, or go free at 2 clear
+                    margin = 4 * math.ulp(stickslip.speed_scale(scene, y0))
+                    append(("stop", plane, LinearEvent.over(along, margin, True, -1)))
+                    append(("clear", plane, LinearEvent.over(along, -2 * clear, True, 1)))
+            elif mode == "stick":
+                load = _core.stick_state(y0, params, latch, flags, PLANES.index(plane))[2]
+                append(("release", plane, StickRelease(
+                    plane, params, latch, flags, stickslip.force_scale(scene, load))))
+            law_mode = compliant[plane] if compliant else None
+            if law_mode is not None:
+                kind, offset = compliantmodes.guard(scene, law_mode, armed[plane], y0, params,
+                                                    latch, plane, rho0)
+                if kind == "arm":     # the penetration rising through the arming depth
+                    append((kind, plane, rho.shifted(offset, True, 1)))
+                else:
+                    append((kind, plane, CompliantGuard(plane, kind, params, latch, offset)))
+        return events
 
 
 class StickRelease:

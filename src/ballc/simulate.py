@@ -92,6 +92,8 @@ class _Run:
         self.rest_check: dict[str, float] = {}   # plane -> the time of its next rest check
         self.t_rest = None                        # when the ball came to rest (ballc.resting)
         self._flags: dict[tuple, int] = {}
+        self.segment_events = ev.SegmentEvents(scene)
+        self.resting_plane = resting.resting_plane(scene)
         self._slip_terms = {plane: stickslip.slip_terms(self.params, plane) for plane in PLANES}
 
     def flags(self, with_coulomb=True):
@@ -327,7 +329,7 @@ class _Run:
     def rest_candidate(self):
         """(plane, time of its next rest check) when the ball is in contact with the
         resting plane alone, else (None, inf)."""
-        plane = resting.resting_plane(self.scene)
+        plane = self.resting_plane
         if plane is None or not self.in_contact[plane] or any(
                 self.in_contact[other] for other in PLANES if other != plane):
             return None, math.inf
@@ -532,10 +534,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             bar.update(run.t - bar.n)
         flags = run.flags()
         system = _core.System(run.params, run.latch, flags)
-        driver_events = ev.segment_events(scene, run.in_contact, run.y, run.coulomb,
-                                          run.params, run.latch, flags, run.clear_speed(),
-                                          run.approach, run.rearm_approach, run.compliant,
-                                          run.armed)
+        driver_events = run.segment_events(run.in_contact, run.y, run.coulomb, run.params,
+                                           run.latch, flags, run.clear_speed, run.approach,
+                                           run.rearm_approach, run.compliant, run.armed)
         run.rearmed = []
         rest_plane, t_stop = run.rest_candidate() if checks_rest else (None, math.inf)
         t_stop = min(t_stop, t_end)   # a rest check ends the segment there
@@ -543,7 +544,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
         remaining = None if options.max_nfev is None else max(options.max_nfev - nfev, 1)
-        events = [event for _, _, event in driver_events] + users.for_segment()
+        events = [event for _, _, event in driver_events]
+        if user:
+            events += users.for_segment()
         sol = integrate_segment(system, run.t, t_stop, run.y, events,
                                 method=options.method, rtol=options.rtol, atol=options.atol,
                                 t_eval=segment_eval, max_step=options.max_step,
@@ -577,11 +580,12 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             elif 0 < _core.terminal_count(events[i].terminal) <= len(hits) \
                     and hits[-1] < t_fired:   # stopped at its last occurrence left
                 fired, t_fired = i, float(hits[-1])
-        users.count(t_events[n_driver:])
-        for k in range(len(user)):
-            user_t[k].append(np.asarray(t_events[n_driver + k], dtype=float))
-            user_y[k].append(np.asarray(y_events[n_driver + k], dtype=float).reshape(
-                -1, _core.N_STATES))
+        if user:
+            users.count(t_events[n_driver:])
+            for k in range(len(user)):
+                user_t[k].append(np.asarray(t_events[n_driver + k], dtype=float))
+                user_y[k].append(np.asarray(y_events[n_driver + k], dtype=float).reshape(
+                    -1, _core.N_STATES))
 
         if status == -1:
             run.status = -1
