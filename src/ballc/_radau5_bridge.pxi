@@ -254,6 +254,16 @@ cdef const double[::1] _checked_row(str name, value, Py_ssize_t n):
     return v
 
 
+cdef inline bint _is_row(value, Py_ssize_t n):
+    """Whether ``value`` is already n contiguous float64s (then a view, no copy)."""
+    return (type(value) is np.ndarray and (<object>value).dtype is _FLOAT64
+            and (<object>value).ndim == 1 and (<object>value).shape[0] == n
+            and (<object>value).flags.c_contiguous)
+
+
+_FLOAT64 = np.dtype(np.float64)
+
+
 def _vector(name, value, n):
     a = np.ascontiguousarray(value, dtype=float)
     if a.shape != (n,):
@@ -342,8 +352,13 @@ def _event_arrays(events, int n):
         e = events[k]
         c = getattr(e, "coefficients", None)   # the driver's events are LinearEvents
         if c is not None:
-            row = _checked_row(f"events[{k}].coefficients", c, n)
-            cv[k, :] = row
+            if _is_row(c, n):
+                row = c
+                if not _finite(row):
+                    _checked_row(f"events[{k}].coefficients", c, n)   # raises, naming it
+            else:
+                row = _checked_row(f"events[{k}].coefficients", c, n)
+            memcpy(&cv[k, 0], &row[0], n * sizeof(double))
             offset[k] = float(getattr(e, "offset", 0.0))
         elif hasattr(e, "system_event"):
             iv[2, k] = int(e.system_event)
@@ -450,10 +465,11 @@ cdef object _run(radau5_problem *p, int n, int m):
             yv = y
             memcpy(&tv[0], r.t_out, r.n_out * sizeof(double))
             memcpy(&yv[0, 0], r.y_out, r.n_out * n * sizeof(double))
-        hit_event = np.empty(r.n_hits, dtype=np.intc)
-        hit_t = np.empty(r.n_hits)
-        hit_y = np.empty((r.n_hits, n))
+        hit_event = hit_t = hit_y = None
         if r.n_hits:
+            hit_event = np.empty(r.n_hits, dtype=np.intc)
+            hit_t = np.empty(r.n_hits)
+            hit_y = np.empty((r.n_hits, n))
             hev = hit_event
             htv = hit_t
             hyv = hit_y
@@ -472,7 +488,11 @@ cdef object _run(radau5_problem *p, int n, int m):
                                           "total", "total_ns"), [r.prof[i] for i in range(7)]))
     finally:
         radau5_free(&r)
-    t_events, y_events = _group_hits(hit_event, hit_t, hit_y, m, n)
+    if r_hits:
+        t_events, y_events = _group_hits(hit_event, hit_t, hit_y, m, n)
+    else:   # no event hit (most segments of a scene without events)
+        no_t, no_y = np.empty(0), np.empty((0, n))
+        t_events, y_events = [no_t] * m, [no_y] * m
     return OptimizeResult(t=t, y=y.T, t_events=t_events,
                           y_events=y_events, status=status, message=message,
                           success=status >= 0, sol=None, dense=dense, **counts)

@@ -97,6 +97,9 @@ def margins(y, params, latch, plane: str) -> np.ndarray:
                                    PLANES.index(plane))
 
 
+_EPS = float(np.finfo(float).eps)
+
+
 def _boundary(scene, plane):
     return scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
 
@@ -111,7 +114,7 @@ def arm_penetration(scene, plane: str) -> float:
 def _rounding(scene, plane, rho0):
     """The relative rounding of margins computed from rho >= rho0: a few ulp of the
     plane's position over rho0, and never below 64 eps."""
-    return max(64 * np.finfo(float).eps, 8 * math.ulp(_boundary(scene, plane)) / max(rho0, 1e-300))
+    return max(64 * _EPS, 8 * math.ulp(_boundary(scene, plane)) / max(rho0, 1e-300))
 
 
 def guard(scene, mode: str, armed: bool, y0, params, latch, plane: str, rho0: float):

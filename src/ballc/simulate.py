@@ -94,6 +94,9 @@ class _Run:
         self._flags: dict[tuple, int] = {}
         self.segment_events = ev.SegmentEvents(scene)
         self.resting_plane = resting.resting_plane(scene)
+        self.rho = {plane: ev.penetration(plane, scene) for plane in PLANES}   # rho(t, y)
+        self.arm_depth = {plane: compliantmodes.arm_penetration(scene, plane)
+                          for plane in PLANES} if self.compliant_modes else None
         self._slip_terms = {plane: stickslip.slip_terms(self.params, plane) for plane in PLANES}
 
     def flags(self, with_coulomb=True):
@@ -123,20 +126,19 @@ class _Run:
         contact = Contact(plane=plane, t_start=self.t, velocity_before=y[layout.VELOCITY].copy(),
                           angular_velocity_before=y[layout.ANGULAR_VELOCITY].copy(),
                           penetration_rate_at_impact=rate, digin_direction=direction)
-        record_depth(contact, ev.penetration(plane, self.scene)(0, y), y)
+        record_depth(contact, self.rho[plane](0, y), y)
         self.open[plane] = contact
         self.contacts.append(contact)
         self.dissipated_at_start[plane] = y[_DISSIPATED].copy()
         self.relatches[plane] = self.transitions[plane] = 0
         self.rest_check[plane] = resting.first_check(self.scene, self.t) \
-            if plane == resting.resting_plane(self.scene) else math.inf
+            if plane == self.resting_plane else math.inf
         if self.exact:
             self.start_coulomb(plane)
         if self.compliant_modes:
             # a contact starts where rho reaches the arming depth (events.segment_events);
             # one that starts shallower (a scene's initial state) arms there
-            self.armed[plane] = ev.penetration(plane, self.scene)(0, y) >= \
-                0.5 * compliantmodes.arm_penetration(self.scene, plane)
+            self.armed[plane] = self.rho[plane](0, y) >= 0.5 * self.arm_depth[plane]
             mode, self.y = compliantmodes.start(y, self.params, self.latch, plane)
             self.set_compliant(plane, mode)
 
@@ -576,7 +578,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             if i < n_driver and driver_events[i][0] == "deepest":
                 plane = driver_events[i][1]
                 for yy in y_events[i]:
-                    record_depth(run.open[plane], ev.penetration(plane, scene)(0, yy), yy)
+                    record_depth(run.open[plane], run.rho[plane](0, yy), yy)
             elif 0 < _core.terminal_count(events[i].terminal) <= len(hits) \
                     and hits[-1] < t_fired:   # stopped at its last occurrence left
                 fired, t_fired = i, float(hits[-1])
