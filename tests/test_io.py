@@ -89,3 +89,29 @@ def test_load_refuses_other_suffixes(result, tmp_path):
     (tmp_path / "r.npz").rename(tmp_path / "r.h5")    # even an npz under another name
     with pytest.raises(ValueError, match=r"r\.h5.*must end in \.npz .*or \.nc"):
         ballc.load(tmp_path / "r.h5")
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".nc"])
+def test_method_switches_round_trip(tmp_path, suffix):
+    """method="auto"'s switches are saved (they were dropped before); a run of another
+    method saves None."""
+    if suffix == ".nc":
+        pytest.importorskip("xarray", reason="netCDF output is the optional 'netcdf' extra")
+    run = ballc.simulate(ballc.Scene(velocity=(0.0, 0.0, 1.0)), 0.2, method="dop853")
+    run.save(tmp_path / f"plain{suffix}")
+    assert ballc.load(tmp_path / f"plain{suffix}").method_switches is None
+    run.method_switches = [(0.015625, "radau5"), (0.1, "dop853")]
+    run.save(tmp_path / f"switched{suffix}")
+    assert ballc.load(tmp_path / f"switched{suffix}").method_switches == run.method_switches
+
+
+def test_a_file_saved_before_switches_were_kept_loads(result, tmp_path):
+    result.save(tmp_path / "r.npz")
+    with np.load(tmp_path / "r.npz") as data:
+        arrays = dict(data)
+    header = json.loads(str(arrays["header"]))
+    del header["method_switches"]
+    arrays["header"] = np.array(json.dumps(header))
+    np.savez(tmp_path / "old.npz", **arrays)
+    again = ballc.load(tmp_path / "old.npz")
+    assert again.method_switches is None and np.array_equal(again.y, result.y)

@@ -37,7 +37,12 @@ def provenance() -> dict:
 def _header(result) -> dict:
     return {"scene": json.dumps(result.scene.to_dict()), "provenance": json.dumps(provenance()),
             "status": int(result.status), "message": str(result.message),
-            "nfev": int(result.nfev), "njev": int(result.njev), "nlu": int(result.nlu)}
+            "nfev": int(result.nfev), "njev": int(result.njev), "nlu": int(result.nlu),
+            # method="auto"'s switches, [(t, method)], or null (JSON: a netCDF attribute
+            # is a string or a number)
+            "method_switches": json.dumps(None if result.method_switches is None else
+                                          [[float(t), str(m)] for t, m in
+                                           result.method_switches])}
 
 
 def _check_provenance(path, stored: dict, state_names) -> None:
@@ -112,7 +117,7 @@ def read(path) -> tuple[dict, dict, dict]:
 
 #: The arrays every ballc .npz holds (besides contact_* and latch_names).
 NPZ_ARRAYS = ("header", "t", "y", "state_names", "flags", "latch")
-#: The keys of a file's header.
+#: The keys of a file's header (files of earlier versions lack "method_switches").
 HEADER_KEYS = ("scene", "provenance", "status", "message", "nfev", "njev", "nlu")
 
 

@@ -428,4 +428,12 @@ def load(path) -> Result:
                   nfev=int(header["nfev"]), njev=int(header["njev"]), nlu=int(header["nlu"]),
                   contacts=_contacts_from(contacts),
                   state_names=tuple(str(s) for s in arrays["state_names"]),
-                  flags=flags if flags.size else None, latch=latch if latch.size else None)
+                  flags=flags if flags.size else None, latch=latch if latch.size else None,
+                  method_switches=_switches_from(header.get("method_switches")))
+
+
+def _switches_from(text) -> list | None:
+    """A saved run's ``method_switches`` ([(t, method)], or None: not method="auto", or
+    a file written before they were saved)."""
+    found = json.loads(str(text)) if text is not None else None
+    return None if found is None else [(float(t), str(method)) for t, method in found]
