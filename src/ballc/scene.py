@@ -349,10 +349,19 @@ class Scene:
 
     def initial_state(self) -> np.ndarray:
         """State vector in the generated layout order (``ballc._core.STATE_NAMES``)."""
-        mechanical = np.concatenate([quaternion_from_angles_123(self.angles), self.position,
+        mechanical = np.concatenate([_quaternion_of(*map(float, self.angles)), self.position,
                                      self.angular_velocity, self.velocity])
         auxiliary = np.zeros(_core.N_STATES - mechanical.size)   # dissipated work, deflections
         return np.concatenate([mechanical, auxiliary])
+
+
+@functools.lru_cache(maxsize=256)
+def _quaternion_of(q1: float, q2: float, q3: float) -> np.ndarray:
+    """quaternion_from_angles_123 of the seed's three angles (rad), kept: a sweep asks
+    for the same few initial orientations thousands of times (read-only: callers copy)."""
+    found = quaternion_from_angles_123(np.array([q1, q2, q3]))
+    found.flags.writeable = False
+    return found
 
 
 _DAMPING_INPUTS = ("c_tau", "restitution", "damping_ratio")
