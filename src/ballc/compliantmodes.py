@@ -100,6 +100,35 @@ def margins(y, params, latch, plane: str) -> np.ndarray:
 _EPS = float(np.finfo(float).eps)
 
 
+#: A compliant contact with modes is integrated in steps of at most its Hertz time over
+#: this, for IMPACT_SPAN Hertz times from its start (see step_bound).
+STEPS_PER_CONTACT = 16
+IMPACT_SPAN = 4
+
+
+def contact_time(scene, rate: float) -> float:
+    """The elastic Hertz contact time (s) at impact rate ``rate`` (m/s):
+    t_c = 3.2145 (m / k0)^(2/5) v^(-1/5) (as ballc.impact.hertz_contact_time)."""
+    m = scene.mass + scene.observer_mass
+    return 3.2145 * (m / scene.hertz_stiffness) ** 0.4 * rate ** -0.2
+
+
+def step_bound(scene, rate: float, t_start: float) -> tuple[float, float]:
+    """(largest step (s), until when (s)) within a compliant contact that starts at
+    ``t_start`` with impact rate (the latched rhodot^-, m/s) ``rate``: t_c /
+    STEPS_PER_CONTACT for IMPACT_SPAN t_c (t_c: :func:`contact_time`).  The guards of
+    the modes are found by their sign at the ends of steps: a phase shorter than a step
+    (a re-stick and the slide after it inside one step) would be stepped over unseen --
+    measured, dop853 at rtol 1e-4 on the seed's compliant throw took the ceiling contact
+    in 3 steps and missed its stick phase (0.014 s of 0.062 s), final error 0.63 -- so an
+    impact is resolved by at least STEPS_PER_CONTACT steps, as DEM codes take their time
+    step a fraction of t_c.  A contact that outlasts IMPACT_SPAN t_c (a ball coming to
+    rest, rolling) goes on with the tolerance's steps: bounded for ever, a steel ball's
+    resting contact took 2e7 calls by 3.3 s."""
+    t_c = contact_time(scene, rate)
+    return t_c / STEPS_PER_CONTACT, t_start + IMPACT_SPAN * t_c
+
+
 def _boundary(scene, plane):
     return scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
 

@@ -97,6 +97,8 @@ class _Run:
         self.rho = {plane: ev.penetration(plane, scene) for plane in PLANES}   # rho(t, y)
         self.arm_depth = {plane: compliantmodes.arm_penetration(scene, plane)
                           for plane in PLANES} if self.compliant_modes else None
+        # plane -> (the largest step in its contact's impact, the time that bound ends)
+        self.contact_step: dict[str, tuple[float, float]] = {}
         self._slip_terms = {plane: stickslip.slip_terms(self.params, plane) for plane in PLANES}
 
     def flags(self, with_coulomb=True):
@@ -141,10 +143,12 @@ class _Run:
             self.armed[plane] = self.rho[plane](0, y) >= 0.5 * self.arm_depth[plane]
             mode, self.y = compliantmodes.start(y, self.params, self.latch, plane)
             self.set_compliant(plane, mode)
+            self.contact_step[plane] = compliantmodes.step_bound(self.scene, rate, self.t)
 
     def end_contact(self, kind, plane):
         y = self.y
         self.rest_check.pop(plane, None)
+        self.contact_step.pop(plane, None)
         self.in_contact[plane] = False
         self.coulomb[plane] = self.approach[plane] = self.compliant[plane] = None
         contact = self.open.pop(plane)
@@ -153,6 +157,21 @@ class _Run:
         contact.angular_velocity_after = y[layout.ANGULAR_VELOCITY].copy()
         lost = y[_DISSIPATED] - self.dissipated_at_start.pop(plane)
         contact.energy_lost_normal, contact.energy_lost_tangential = map(float, lost)
+
+    def max_step(self):
+        """The largest step (s) of the next segment: the user's, and within a compliant
+        contact's impact a fraction of its Hertz time (compliantmodes.step_bound)."""
+        step = self.options.max_step
+        for bound, until in self.contact_step.values():
+            if until > self.t:
+                step = min(step, bound)
+        return step
+
+    def step_bound_end(self):
+        """When the next compliant contact's step bound ends (s; inf without one): a
+        segment ends there, so that a persistent contact goes on with the user's."""
+        return min([until for _, until in self.contact_step.values() if until > self.t],
+                   default=math.inf)
 
     # ---- the compliant law's modes (ballc.compliantmodes) ----
 
@@ -540,8 +559,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                                            run.latch, flags, run.clear_speed, run.approach,
                                            run.rearm_approach, run.compliant, run.armed)
         run.rearmed = []
-        rest_plane, t_stop = run.rest_candidate() if checks_rest else (None, math.inf)
-        t_stop = min(t_stop, t_end)   # a rest check ends the segment there
+        rest_plane, t_check = run.rest_candidate() if checks_rest else (None, math.inf)
+        # a rest check, or the end of a compliant contact's step bound, ends the segment
+        t_stop = min(t_check, t_end, run.step_bound_end())
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
@@ -551,7 +571,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             events += users.for_segment()
         sol = integrate_segment(system, run.t, t_stop, run.y, events,
                                 method=options.method, rtol=options.rtol, atol=options.atol,
-                                t_eval=segment_eval, max_step=options.max_step,
+                                t_eval=segment_eval, max_step=run.max_step(),
                                 max_nfev=remaining, first_step=first,
                                 dense_output=options.dense_output,
                                 exact_flight=options.exact_flight, auto_implicit=implicit)
@@ -605,8 +625,11 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             if options.dense_output:
                 pieces.append((run.t, t_stop, sol.interpolant))
             run.t = t_stop
-            if t_stop < t_end:   # a rest check
+            if t_stop < t_end:   # a rest check (or a step bound's end)
                 run.y = np.array(sol["y"][:, -1])
+                if t_stop != t_check:   # only a step bound ended: go on with a fresh step
+                    first, implicit = None, sol.get("method_end") == "radau5"
+                    continue
                 if run.check_rest(rest_plane):
                     samples.add(np.array([t_end]), run.y[:, None], flags, run.latch)
                     if options.dense_output:
@@ -647,7 +670,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if kind in CARRY_STEP and h_next > 0:
             # within a contact the dynamics do not jump at a stick/slip transition: go on
             # with the step the controller had chosen instead of a fresh start
-            first = min(h_next, options.max_step)
+            first = min(h_next, run.max_step())
             # method="auto": the step carried over is the method's, so is the method
             implicit = sol.get("method_end") == "radau5"
 
