@@ -174,12 +174,14 @@ def start(y, params, latch, plane: str):
 def _along_slip(y, params, latch, plane: str):
     """The deflection at the cap along the slip velocity (2, m), START_DEFLECTION long
     where s_cap is 0; None without slip."""
-    u = stickslip.slip_velocity(params, plane, y)
-    speed = math.hypot(*u.tolist())
+    values = y.tolist() if isinstance(y, np.ndarray) else list(y)
+    ux, uy = stickslip.slip_velocity_of(stickslip.slip_terms(params, plane), values)
+    speed = math.hypot(ux, uy)
     if not speed > 0:
         return None
     s_cap = float(margins(y, params, latch, plane)[2])
-    return (s_cap if s_cap > 0 else START_DEFLECTION) * u / speed
+    length = s_cap if s_cap > 0 else START_DEFLECTION
+    return [length * ux / speed, length * uy / speed]
 
 
 def load_vanished(y, params, latch, plane: str) -> bool:

@@ -16,8 +16,19 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import _radau5, dense, flight
+from typing import NamedTuple
+
+from . import _core, _radau5, dense, flight
 from .options import COMPILED_METHODS, IMPLICIT_METHODS
+
+
+class Segment(NamedTuple):
+    """What a segment integrates: the parameter vector, the latched values and the flags
+    of ``_core.System``, held as they are (no copies: the compiled integrators copy
+    what they may write, and scipy's methods get a ``_core.System`` built from it)."""
+    params: np.ndarray
+    latch: np.ndarray
+    flags: int
 
 
 def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval, max_step,
@@ -28,7 +39,8 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
     This is the one seam between the driver and an integrator.  The solution has
     ``t, y, t_events, y_events, status (0 reached t1, 1 terminal event, -1 failure),
     message, nfev, njev, nlu`` and, with ``dense_output``, ``interpolant``: a callable
-    y(t) over [t0, t_last] (see ballc.dense).  Events are callables g(t, y) with
+    y(t) over [t0, t_last] (see ballc.dense).  ``system``: a ``_core.System``, or a
+    :class:`Segment` (the same inputs, not copied).  Events are callables g(t, y) with
     ``terminal`` and ``direction``: :class:`ballc.events.LinearEvent` and
     :class:`ballc.events.StickRelease`, which radau5 evaluates in C, or any other
     (a user's), which it calls back.  ``max_nfev``: give up (status -1, keeping what
@@ -55,6 +67,8 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
         if dense_output:
             sol.interpolant = dense.CompiledInterpolant(*sol.dense)
         return sol
+    if isinstance(system, Segment):
+        system = _core.System(system.params, system.latch, system.flags)
     options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
     if first_step is not None:
         options["first_step"] = first_step

@@ -20,7 +20,7 @@ from . import (_core, automaton, compliantmodes, events as ev, layout, modes, ou
 from ._format import plain
 from .dense import PiecewiseSolution
 from .flight import FreeFlight
-from .integrate import failure_hint, integrate_segment
+from .integrate import Segment, failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
 from .result import Contact, Result
@@ -162,6 +162,8 @@ class _Run:
         """The largest step (s) of the next segment: the user's, and within a compliant
         contact's impact a fraction of its Hertz time (compliantmodes.step_bound)."""
         step = self.options.max_step
+        if not self.contact_step:
+            return step
         for bound, until in self.contact_step.values():
             if until > self.t:
                 step = min(step, bound)
@@ -170,6 +172,8 @@ class _Run:
     def step_bound_end(self):
         """When the next compliant contact's step bound ends (s; inf without one): a
         segment ends there, so that a persistent contact goes on with the user's."""
+        if not self.contact_step:
+            return math.inf
         return min([until for _, until in self.contact_step.values() if until > self.t],
                    default=math.inf)
 
@@ -554,7 +558,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if bar is not None:
             bar.update(run.t - bar.n)
         flags = run.flags()
-        system = _core.System(run.params, run.latch, flags)
+        system = Segment(run.params, run.latch, flags)
         driver_events = run.segment_events(run.in_contact, run.y, run.coulomb, run.params,
                                            run.latch, flags, run.clear_speed, run.approach,
                                            run.rearm_approach, run.compliant, run.armed)
@@ -660,7 +664,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             pieces.append((run.t, t_fired, sol.interpolant))
         run.t = t_fired
         run.y = state = np.array(y_events[fired][-1])
-        state[_QUATERNION] /= math.hypot(*state[_QUATERNION].tolist())
+        quaternion = state[_QUATERNION]   # a view: normalised in place
+        np.divide(quaternion, math.hypot(*quaternion.tolist()), out=quaternion)
         if fired >= n_driver:   # a terminal user event
             run.status, run.message = 1, "A termination event occurred."
             break
