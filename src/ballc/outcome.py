@@ -152,35 +152,43 @@ def summarize_contact_forces(result):
     stored samples (solver steps, or t_eval: the resolution is that of the samples);
     with exact Coulomb friction the sticking and slipping times come from the
     transition events instead."""
+    contacts = result.contacts
+    if not contacts:
+        return
     scene = result.scene
-    params = scene.parameter_vector()
     mu = scene.friction_coefficient
-    # one row per sample (views: Result.y and latch are Fortran-ordered)
-    states = np.ascontiguousarray(result.y.T)
-    latches = np.ascontiguousarray(result.latch.T)
-    flags = np.ascontiguousarray(result.flags, dtype=np.int32)
-    for contact in result.contacts:
-        end = contact.t_end if np.isfinite(contact.t_end) else result.t[-1]
-        # the samples with t_start <= t <= end: one run of them, result.t is increasing
-        first = np.searchsorted(result.t, contact.t_start, side="left")
-        stop = np.searchsorted(result.t, end, side="right")
+    t = result.t
+    ends = [c.t_end if np.isfinite(c.t_end) else t[-1] for c in contacts]
+    # each contact's samples, t_start <= t <= end: one run of them (t is increasing)
+    firsts = np.searchsorted(t, [c.t_start for c in contacts], side="left").tolist()
+    stops = np.searchsorted(t, ends, side="right").tolist()
+    runs = [(first, stop) for first, stop in zip(firsts, stops) if stop > first]
+    if not runs:
+        return
+    # one C call over every contact's samples, each with its segment's latch and flags
+    # (rows of result.y and latch: views, they are Fortran-ordered)
+    rows = np.concatenate([np.arange(first, stop) for first, stop in runs])
+    forces = _core.contact_forces_per_sample(
+        np.ascontiguousarray(result.y.T[rows]), scene.parameter_vector(),
+        np.ascontiguousarray(result.latch.T[rows]),
+        np.ascontiguousarray(result.flags[rows], dtype=np.int32))
+    offset = 0
+    for contact, end, first, stop in zip(contacts, ends, firsts, stops):
         if stop <= first:
             continue
-        inside = slice(first, stop)
         k = PLANES.index(contact.plane)
         normal = 1.0 if contact.plane == "floor" else -1.0
-        # one C call over the contact's samples, each with its segment's latch and flags
-        forces = _core.contact_forces_per_sample(states[inside], params, latches[inside],
-                                                 flags[inside])[:, 3 * k:3 * k + 3]
-        f_n = forces[:, 2] * normal
-        f_t = np.hypot(forces[:, 0], forces[:, 1])
+        block = forces[offset:offset + stop - first, 3 * k:3 * k + 3]
+        offset += stop - first
+        f_n = block[:, 2] * normal
         contact.peak_normal_force = float(f_n.max())
         if contact.transitions:   # exact Coulomb friction: the phases are events
             contact.time_sticking, contact.time_slipping = _phase_times(contact, end)
             continue
+        f_t = np.hypot(block[:, 0], block[:, 1])
         slipping = (f_t >= STICK_SLIP_THRESHOLD * mu * f_n) & (f_n > 0)
-        t = result.t[inside]
-        dt = np.diff(t)
+        times = t[first:stop]
+        dt = np.diff(times)
         slip_fraction = 0.5 * (slipping[1:].astype(float) + slipping[:-1])
         contact.time_slipping = float(np.sum(dt * slip_fraction))
         contact.time_sticking = float(np.sum(dt) - contact.time_slipping)
@@ -188,8 +196,8 @@ def summarize_contact_forces(result):
 
 def _phase_times(contact, end):
     """(time sticking, time slipping) from a contact's transition events (s)."""
-    starts = [t for t, _ in contact.transitions] + [end]
-    durations = np.diff(starts)
+    starts = [float(t) for t, _ in contact.transitions] + [float(end)]
+    durations = [b - a for a, b in zip(starts, starts[1:])]   # np.diff's, in floats
     sticking = sum(d for d, (_, phase) in zip(durations, contact.transitions) if phase == "stick")
     return float(sticking), float(end - contact.t_start - sticking)
 
