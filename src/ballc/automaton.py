@@ -17,7 +17,11 @@ plane is in one *mode* at a time:
 events.segment_events gives its guard), the modes it leaves from, the modes it may lead
 to, the guard (event function and direction), the reset, and the method of
 simulate._Run that applies it.  :data:`SIMULTANEOUS` is how simultaneous events are
-ordered.  ``simulate`` dispatches every event through :func:`handler_of`, and
+ordered.  One scheduled segment end changes no mode and is not a row: a compliant
+contact's step bound (steps of at most t_c/16 for its first 4 t_c,
+compliantmodes.step_bound) ends a segment where it ends, and the next goes on in the
+same modes with the tolerance's steps.  ``simulate`` dispatches every event through
+:func:`handler_of`, and
 tests/test_automaton.py runs scenes that take every transition and checks each one it
 sees against this table.  docs/architecture.md draws it.
 """
