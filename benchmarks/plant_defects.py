@@ -82,9 +82,9 @@ DEFECTS = [
     Defect("compliant modes: a yield never slides (the re-stick margin ignored)",
            "src/ballc/compliantmodes.py",
            "    if margins(trial, params, latch, plane)[1] >= 0:\n        return \"sliding\", "
-           "(trial if relaxed or arming else y)\n",
+           "(trial if relaxed else y)\n",
            "    if margins(trial, params, latch, plane)[1] >= 1e300:\n        return "
-           "\"sliding\", (trial if relaxed or arming else y)\n", regenerate=False),
+           "\"sliding\", (trial if relaxed else y)\n", regenerate=False),
     Defect("compliant modes: the sliding spring does not turn with the slip",
            "codegen/contact.py",
            "    rate = [in_contact * ((v - along * e) * turn + w)\n",
