@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 import ballc
 from ballc import SceneError
@@ -68,6 +69,32 @@ def test_rigid_limits_of_the_tangential_restitution():
     np.testing.assert_allclose(hit.velocity_after, rigid.velocity, atol=1e-6)
     # rolling exit: e_t = 0
     assert ballc.impact(scene, (0.3, 0.0, -1.0)).e_t == pytest.approx(0.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("angle, spin", [(75.0, 0.0), (80.0, 0.0), (60.0, -300.0)])
+def test_tangential_restitution_in_gross_sliding(angle, spin):
+    """Coulomb friction sliding through the whole impact (a solid sphere, no gravity):
+    the friction impulse mu (1 + e) m v_n opposes the slip u and changes the contact
+    point's velocity 1 + m r^2 / I = 7/2 times as much as the centre's, so
+    u' = u (1 - 3.5 mu (1 + e) v_n / |u|) and e_t = -u'.u/|u|^2 = -(1 - 3.5 mu (1+e) v_n/|u|),
+    with e = -v_z'/v_z from the velocities (and Hunt-Crossley's root of
+    chi (1+e) = ln((1+chi)/(1-chi e)), chi = 3/2 (1 - c_tau))."""
+    mu = 0.3
+    scene = steel(gravity=0.0, tangential_model="friction", friction_coefficient=mu)
+    theta = math.radians(angle)
+    hit = ballc.impact(scene, (math.sin(theta), 0.0, -math.cos(theta)), (0.0, spin, 0.0))
+    (contact,) = hit.result.contacts
+    assert [phase for _, phase in contact.transitions] == ["slip"]     # never sticks
+    vb, va, wb = hit.velocity_before, hit.velocity_after, hit.angular_velocity_before
+    v_n, e = -vb[2], -va[2] / vb[2]
+    chi = 1.5 * (1 - scene.c_tau)
+    assert e == pytest.approx(brentq(lambda x: chi * (1 + x) - math.log((1 + chi) / (1 - chi * x)),
+                                     0.5, 1.0), abs=1e-8)
+    u = math.hypot(vb[0] - scene.radius * wb[1], vb[1] + scene.radius * wb[0])
+    assert 3.5 * mu * (1 + e) * v_n < 0.7 * u          # sliding to the end, with margin
+    expected = -(1 - 3.5 * mu * (1 + e) * v_n / u)
+    assert expected < -0.2                              # far from 0 (rolling) and from +
+    assert hit.e_t == pytest.approx(expected, abs=1e-8)
 
 
 @pytest.mark.parametrize("kwargs, message", [

@@ -185,6 +185,44 @@ def test_contact_table_energy_matches_the_balance():
     assert list(frame["plane"]) == [c.plane for c in result.contacts]
 
 
+@pytest.mark.parametrize("case", ["vertical drop", "mu = 0, oblique and spinning",
+                                  "slides, then rolls"])
+def test_contact_energy_split_between_normal_and_tangential(case):
+    """Each contact's energy_lost_normal and _tangential separately.  Gravity off, no
+    observer, a solid sphere: the normal motion is decoupled from the tangential one, so
+    the normal force dissipates 1/2 m (vz^2 - vz'^2) (energy balance of the normal
+    motion); the tangential force dissipates 0 without slip or without friction, and
+    1/2 (2/7 m) |u|^2 = m |u|^2 / 7 when the contact-point slip u ends at rolling (the
+    relative motion's kinetic energy, reduced mass 2/7 m); both add up to the drop of
+    kinetic energy."""
+    velocity, spin, mu = {"vertical drop": ((0.0, 0.0, -3.0), (0.0, 0.0, 0.0), 0.3),
+                          "mu = 0, oblique and spinning": ((2.0, -1.0, -3.0),
+                                                           (1.0, 4.0, 2.0), 0.0),
+                          "slides, then rolls": ((2.0, 0.0, -3.0), (0.0, 4.0, 1.0), 0.3),
+                          }[case]
+    scene, contact = normal_impact(SOFT, 3.0, 0.9, tangential_model="friction",
+                                   friction_coefficient=mu, velocity=velocity,
+                                   angular_velocity=spin)
+    m, r = scene.mass, scene.radius
+    vb, va = contact.velocity_before, contact.velocity_after
+    wb, wa = contact.angular_velocity_before, contact.angular_velocity_after
+    kinetic = [0.5 * m * v @ v + 0.5 * (0.4 * m * r ** 2) * w @ w for v, w in ((vb, wb), (va, wa))]
+    normal = 0.5 * m * (vb[2] ** 2 - va[2] ** 2)
+    assert normal > 0.1 * 0.5 * m * vb[2] ** 2     # a real loss, not rounding
+    # u = v_t + w x (-r e_z) of the contact point, before
+    u = np.array([vb[0] - r * wb[1], vb[1] + r * wb[0]])
+    if case == "slides, then rolls":
+        assert contact.transitions[-1][1] == "stick"        # exits rolling:
+        assert abs(va[0] - r * wa[1]) < 1e-9 and abs(va[1] + r * wa[0]) < 1e-9
+        tangential = m * (u @ u) / 7
+    else:
+        tangential = 0.0
+    assert contact.energy_lost_normal == pytest.approx(normal, rel=1e-7)
+    assert contact.energy_lost_tangential == pytest.approx(tangential, rel=1e-7,
+                                                          abs=1e-9 * kinetic[0])
+    assert normal + tangential == pytest.approx(kinetic[0] - kinetic[1], rel=1e-7)
+
+
 def seed_throw(**changes):
     return ballc.simulate(ballc.Scene(**changes), 5.0)
 
