@@ -160,3 +160,36 @@ def test_steps_within_a_compliant_contact_are_a_fraction_of_its_hertz_time(metho
         t_c = hertz_contact_time(scene, contact.penetration_rate_at_impact)
         assert steps.size >= 8
         assert steps.max() <= t_c / ballc.compliantmodes.STEPS_PER_CONTACT * (1 + 1e-12)
+
+
+def test_the_sliding_spring_turns_with_the_slip_as_the_dem_truncation_does():
+    # Oracle: the DEM codes' truncation step (validation/dem_reference.py's algorithm),
+    # written out here.  At the cap the elastic force is F = -k_t s with |k_t s| = mu F_n;
+    # one step adds the slip, s_trial = s + v_t dt, and the force is put back on the cap
+    # along s_trial: the direction e = s/|s| turns at de/dt = (v_t - (e . v_t) e) / |s|,
+    # so the part of ds/dt across e is the part of v_t across e, whatever happens to |s|.
+    # A spring held in its direction while sliding (the slip turning, not the force)
+    # leaves that part 0.  State: a sliding floor contact with s along y and the slip
+    # along x (no spin, so the slip is the centre's velocity), |s| = 1 um.
+    scene = ballc.Scene(tangential_model="compliant", observer_mass=0.0)
+    y = scene.initial_state()
+    rho, v_t = 1e-3 * scene.radius, (0.7, 0.0)
+    y[layout.INDEX["z"]] = scene.radius - rho
+    y[layout.VELOCITY] = (v_t[0], v_t[1], -0.5)
+    y[layout.ANGULAR_VELOCITY] = 0.0
+    s = np.array([0.0, 1e-6])
+    y[layout.DEFLECTION["floor"]] = s
+    latch = np.zeros(_core.N_LATCH)
+    latch[0], latch[1:4] = 1.0, (1.0, 0.0, 0.0)   # the impact's rate and dig-in direction
+    flags = ballc.modes.flags(scene, {"floor": True, "ceiling": False},
+                              compliant={"floor": "sliding", "ceiling": None},
+                              armed={"floor": True, "ceiling": False})
+    assert flags & _core.FLAGS["floor_compliant_sliding"]
+    rate = _core.System(scene.parameter_vector(), latch, flags)(0.0, y)[
+        layout.DEFLECTION["floor"]]
+    # the DEM step, dt -> 0: e(dt) = (s + v_t dt) / |s + v_t dt|
+    dt = 1e-9 * np.linalg.norm(s) / np.linalg.norm(v_t)
+    trial = s + np.array(v_t) * dt
+    turned = (trial / np.linalg.norm(trial) - s / np.linalg.norm(s)) / dt * np.linalg.norm(s)
+    assert rate[0] == pytest.approx(turned[0], rel=1e-6)    # across e: v_t's part
+    assert rate[0] == pytest.approx(v_t[0], rel=1e-6)
