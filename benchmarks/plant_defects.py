@@ -82,13 +82,38 @@ DEFECTS = [
     Defect("compliant modes: a yield never slides (the re-stick margin ignored)",
            "src/ballc/compliantmodes.py",
            "    if margins(trial, params, latch, plane)[1] >= 0:\n        return \"sliding\", "
-           "(trial if relaxed or arming else y)\n",
+           "(trial if relaxed else y)\n",
            "    if margins(trial, params, latch, plane)[1] >= 1e300:\n        return "
-           "\"sliding\", (trial if relaxed or arming else y)\n", regenerate=False),
+           "\"sliding\", (trial if relaxed else y)\n", regenerate=False),
     Defect("compliant modes: the sliding spring does not turn with the slip",
            "codegen/contact.py",
            "    rate = [in_contact * ((v - along * e) * turn + w)\n",
            "    rate = [in_contact * ((v - along * e) * 0 + w)\n", regenerate=True),
+    Defect("sweep rows stored in completion order (local pool)", "src/ballc/sweep.py",
+           "    rows = [None] * len(tasks)\n"
+           "    bar = _bar(None, progress, len(tasks)) if progress else None\n"
+           "    with ProcessPoolExecutor(max_workers=workers) as pool:\n"
+           "        futures = {pool.submit(_run_batch, batch): start for start, batch in batches}\n"
+           "        for future in as_completed(futures):\n"
+           "            start = futures[future]\n"
+           "            done = future.result()\n"
+           "            for offset, row in enumerate(done):\n"
+           "                rows[start + offset] = row\n",
+           "    rows = []\n"
+           "    bar = _bar(None, progress, len(tasks)) if progress else None\n"
+           "    with ProcessPoolExecutor(max_workers=workers) as pool:\n"
+           "        futures = {pool.submit(_run_batch, batch): start for start, batch in batches}\n"
+           "        for future in as_completed(futures):\n"
+           "            start = futures[future]\n"
+           "            done = future.result()\n"
+           "            rows.extend(done)\n", regenerate=False),
+    Defect("Coulomb cone off by 2 (stick holds until |lambda| = 2 mu N)", "src/ballc/_system.c",
+           "    out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
+           "    out[3] = 2 * params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
+           regenerate=False),
+    Defect("slip from rest starts along +lambda (settle)", "src/ballc/stickslip.py",
+           '    return "slip_fixed", -np.array([lam_x, lam_y]) / size, y0\n',
+           '    return "slip_fixed", np.array([lam_x, lam_y]) / size, y0\n', regenerate=False),
     Defect("radau5 T[0][0] off in its 7th significant digit", "src/ballc/_radau_iia.c",
            "{0.09443876248897524, -0.14125529502095421, 0.03002919410514742}",
            "{0.09443877248897524, -0.14125529502095421, 0.03002919410514742}",
