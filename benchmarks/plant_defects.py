@@ -99,6 +99,31 @@ DEFECTS = [
     Defect("impact's tangential restitution e_t sign flipped", "src/ballc/impact.py",
            "    e_t = -float(ua @ ub) / slip2 if ",
            "    e_t = float(ua @ ub) / slip2 if ", regenerate=False),
+    Defect("sweep rows stored in completion order (local pool)", "src/ballc/sweep.py",
+           "    rows = [None] * len(tasks)\n"
+           "    bar = _bar(None, progress, len(tasks)) if progress else None\n"
+           "    with ProcessPoolExecutor(max_workers=workers) as pool:\n"
+           "        futures = {pool.submit(_run_batch, batch): start for start, batch in batches}\n"
+           "        for future in as_completed(futures):\n"
+           "            start = futures[future]\n"
+           "            done = future.result()\n"
+           "            for offset, row in enumerate(done):\n"
+           "                rows[start + offset] = row\n",
+           "    rows = []\n"
+           "    bar = _bar(None, progress, len(tasks)) if progress else None\n"
+           "    with ProcessPoolExecutor(max_workers=workers) as pool:\n"
+           "        futures = {pool.submit(_run_batch, batch): start for start, batch in batches}\n"
+           "        for future in as_completed(futures):\n"
+           "            start = futures[future]\n"
+           "            done = future.result()\n"
+           "            rows.extend(done)\n", regenerate=False),
+    Defect("Coulomb cone off by 2 (stick holds until |lambda| = 2 mu N)", "src/ballc/_system.c",
+           "    out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
+           "    out[3] = 2 * params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
+           regenerate=False),
+    Defect("slip from rest starts along +lambda (settle)", "src/ballc/stickslip.py",
+           '    return "slip_fixed", -np.array([lam_x, lam_y]) / size, y0\n',
+           '    return "slip_fixed", np.array([lam_x, lam_y]) / size, y0\n', regenerate=False),
     Defect("radau5 T[0][0] off in its 7th significant digit", "src/ballc/_radau_iia.c",
            "{0.09443876248897524, -0.14125529502095421, 0.03002919410514742}",
            "{0.09443877248897524, -0.14125529502095421, 0.03002919410514742}",

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import ballc
-from ballc import _core, stickslip
+from ballc import _core, layout, stickslip
 from ballc.modes import latch_values as _latch_values
 
 G = 9.81
@@ -457,3 +457,152 @@ def test_each_sample_keeps_the_slip_direction_it_was_computed_with():
             assert u @ d > 0, (plane, result.t[k], u, d)
             checked += 1
     assert checked > 50
+
+
+# --- issue 21, section 6: the stick release and a slip from rest against closed forms ---
+#
+# The scene: a plain solid sphere (no observer, I = 2/5 m r^2, gravity off) hits the
+# floor at v = (u0, 0, -w0) without spin, with the mixture law: the friction share
+# (1 - m) x [Hertz-Hunt-Crossley normal + Coulomb] plus the dig-in share m, a force
+# -F_d d along the contact-point velocity d latched at impact, d = (u0, 0, -w0) / |v|
+# (codegen/contact.py: dig_in).  Written out here from the laws' definitions:
+#
+#   friction share's normal force  N   = (1 - m) F_H (1 + chi s),   s = rhodot / w0
+#   dig-in force                   F_d = m F_H (1 + chi a s),       a = w0 / |v| = |d_z|
+#
+# F_H = k0 rho^(3/2), chi = 3/2 (1 - c_tau), rhodot = -v_z (the contact point is at
+# -r e_z: its normal velocity is v_z).  Every tangential force acts at -r e_z, so with
+# the contact point held (stick) the sphere needs no net tangential force at all
+# (m a_t = T, I alpha = r T and a_t = r alpha give T = 0): the stick force is
+# lambda = -(dig-in's tangential part) = +m F_H (1 + chi a s) b e_x, b = u0 / |v|, and
+# the Coulomb cone |lambda| <= mu N reads, with A = m b and B = mu (1 - m),
+#
+#   A (1 + chi a s) <= B (1 + chi s).
+#
+# F_H cancels: stick holds down to the rate s* = (B - A) / (chi (a A - B)), where the
+# contact must release -- a closed form for v_z at the release, v_z = -s* w0.
+
+def _mixture_throw(mu, m, c_tau, u0=1.0, w0=1.0):
+    return ballc.Scene(observer_mass=0.0, gravity=0.0, tangential_model="mixture",
+                       mixture=m, c_tau=c_tau, friction_coefficient=mu,
+                       position=(0.0, 0.0, 1.0 + 1e-3), velocity=(u0, 0.0, -w0))
+
+
+@pytest.mark.parametrize("s_star", [0.3, -0.2])
+def test_stick_releases_where_the_coulomb_cone_says(s_star):
+    """Oracle: the cone condition above, in closed form.  mu is chosen so that stick
+    must end at the rate s = s* (0.3: while the ball still moves in; -0.2: on its way
+    out, Hunt-Crossley e = 0.663 at c_tau = 0.5): the release must come at
+    v_z = -s* w0 (measured: within 2e-11 m/s at 1e-10), with |lambda| / mu N, computed
+    from the state with the laws above, below 1 at every stick sample and 1 at the
+    release.  Through the stick the centre's tangential velocity and the spin stay
+    constant (T = 0).  A cone off by 2 (|lambda| <= 2 mu N) releases at s = -1.00 / -1.05
+    here, after the contact has ended: no release at all."""
+    m, c_tau, u0, w0 = 0.5, 0.5, 1.0, 1.0
+    chi = 1.5 * (1 - c_tau)
+    speed = math.hypot(u0, w0)
+    a, b = w0 / speed, u0 / speed
+    A = m * b
+    B = A * (1 + chi * a * s_star) / (1 + chi * s_star)     # so that the release is at s*
+    mu = B / (1 - m)
+    assert (B - A) / (chi * (a * A - B)) == pytest.approx(s_star, rel=1e-12)
+    scene = _mixture_throw(mu, m, c_tau, u0, w0)
+    result = ballc.simulate(scene, 0.15, rtol=1e-10, atol=1e-10)
+    assert result.status == 0, result.message
+    (contact,) = result.contacts
+    assert [phase for _, phase in contact.transitions] == ["slip", "stick", "slip"]
+    t_stick, t_release = contact.transitions[1][0], contact.transitions[2][0]
+
+    r = scene.radius
+    sigma = ((1 - scene.ball_poisson_ratio ** 2) / scene.ball_youngs_modulus
+             + (1 - scene.plane_poisson_ratio ** 2) / scene.plane_youngs_modulus)
+    k0 = 4 / 3 / sigma * math.sqrt(r)
+
+    def cone_ratio(k):
+        """|lambda| / (mu N) at sample k, from the state and the laws written above."""
+        rho = r - result.position[2, k]
+        s = -result.velocity[2, k] / w0
+        f_h = k0 * rho ** 1.5
+        return (m * f_h * (1 + chi * a * s) * b) / (mu * (1 - m) * f_h * (1 + chi * s))
+
+    release = np.flatnonzero(result.t == t_release)[0]     # the state at the event
+    assert -result.velocity[2, release] / w0 == pytest.approx(s_star, abs=1e-8)
+    assert cone_ratio(release) == pytest.approx(1.0, abs=1e-8)
+    sticking = np.flatnonzero((result.t >= t_stick) & (result.t < t_release))
+    assert len(sticking) > 10
+    assert max(cone_ratio(k) for k in sticking) < 1
+    # stuck: no net tangential force, the contact point at rest
+    for row in (result.velocity[0], result.angular_velocity[1]):
+        assert np.ptp(row[sticking]) <= 1e-9
+    slip = result.velocity[0] - r * result.angular_velocity[1]
+    assert np.max(np.abs(slip[sticking])) <= 1e-12
+    # after the release the contact point slips back, along -lambda = -e_x
+    after = result.t > t_release
+    assert slip[after][-1] < -1e-3
+
+
+def test_a_slip_from_rest_leaves_along_minus_lambda_and_friction_dissipates(monkeypatch):
+    """Oracle: closed forms of the same scene with c_tau = 1 (chi = 0: N = (1 - m) F_H,
+    F_d = m F_H, both proportional to F_H, and the normal force conservative: v_z goes
+    from -w0 to +w0).  mu = 0.3 < m b / (1 - m) = 0.71: the cone cannot hold the
+    contact point, so where the slip has come to rest (settle) it slips on from rest
+    along -lambda = -e_x, the way dig-in's tangential part pushes it, and friction
+    turns round to +e_x, opposing that slip (dissipating: power mu N u_x < 0).  With
+    the solid sphere's du = 3.5 dv_x and impulse ratios dv_x / dv_z =
+    -(A +- B) / ((1 - m) + m a) before / after the settle:
+
+        u after = 3.5 R_after (2 w0 - u0 / (3.5 |R_before|))   (= -1.2651 m/s)
+        v_x after = u0 - u0 / 3.5 + u_after / 3.5              (= 0.35283 m/s)
+
+    Measured: both within 1e-9 at 1e-10.  A slip from rest started along +lambda puts
+    friction along the slip (it would inject energy): the slip turns against its
+    direction at once and the run stalls (100,000 mode changes, status -1)."""
+    m, mu, u0, w0 = 0.5, 0.3, 1.0, 1.0
+    speed = math.hypot(u0, w0)
+    a, b = w0 / speed, u0 / speed
+    A, B = m * b, mu * (1 - m)
+    assert A > B                                   # outside the cone: no stick
+    r_before = -(A + B) / ((1 - m) + m * a)
+    r_after = -(A - B) / ((1 - m) + m * a)
+    settles = []
+    original = stickslip.settle
+
+    def recording(scene, params, latch, flags, plane, y):
+        found = original(scene, params, latch, flags, plane, y)
+        settles.append((found[0], None if found[1] is None else np.array(found[1]),
+                        float(y[layout.INDEX["vz"]])))
+        return found
+    monkeypatch.setattr(stickslip, "settle", recording)
+    scene = _mixture_throw(mu, m, 1.0, u0, w0)
+    result = ballc.simulate(scene, 0.15, rtol=1e-10, atol=1e-10, max_nfev=100_000)
+
+    # the path: one settle, a slip from rest along -lambda / |lambda| = -e_x
+    assert len(settles) >= 1
+    mode, direction, vz_at_settle = settles[0]
+    assert mode == "slip_fixed"
+    np.testing.assert_allclose(direction, [-1.0, 0.0], atol=1e-12)
+    # ... reached when u0 / 3.5 of tangential speed is gone, at dv_z = that / |R_before|
+    assert vz_at_settle + w0 == pytest.approx(u0 / 3.5 / abs(r_before), rel=1e-8)
+    assert len(settles) == 1 and result.status == 0, result.message
+    (contact,) = result.contacts
+    r = scene.radius
+    slip = result.velocity[0] - r * result.angular_velocity[1]
+    t_settle = result.t[np.argmin(np.abs(result.velocity[2] - vz_at_settle))]
+    out = (result.t > t_settle) & (result.t <= contact.t_end)
+    # the slip grows along -e_x from rest, and only grows (friction never drives it)
+    assert np.all(slip[out] <= 1e-12) and np.all(np.diff(slip[out]) <= 1e-12)
+    u_after = 3.5 * r_after * (2 * w0 - u0 / 3.5 / abs(r_before))
+    assert contact.velocity_after[2] == pytest.approx(w0, abs=1e-9)
+    assert slip[-1] == pytest.approx(u_after, abs=1e-9)
+    # friction's share of the tangential impulse after the settle (the total, minus
+    # dig-in's -A int F_H dt, int F_H dt = dv_z / ((1 - m) + m a)) points along +e_x,
+    # against the slip (u_x <= 0 throughout): its power mu N u_x is <= 0, it dissipates
+    k = np.flatnonzero(result.t == t_settle)[-1]
+    dvx = contact.velocity_after[0] - result.velocity[0, k]
+    dvz = contact.velocity_after[2] - result.velocity[2, k]
+    friction_impulse = scene.mass * (dvx + A * dvz / ((1 - m) + m * a))
+    assert friction_impulse == pytest.approx(scene.mass * B * dvz / ((1 - m) + m * a),
+                                             rel=1e-8)
+    assert friction_impulse > 0
+    assert contact.velocity_after[0] == pytest.approx(u0 - u0 / 3.5 + u_after / 3.5,
+                                                      abs=1e-9)
