@@ -110,26 +110,53 @@ def test_friction_model_approaches_rigid_coulomb_impact(u_over_vn, mu, regulariz
     np.testing.assert_allclose(contact.velocity_after, rigid.velocity, atol=1e-3 * scale)
     np.testing.assert_allclose(contact.angular_velocity_after * scene.radius,
                                rigid.angular_velocity * scene.radius, atol=1e-3 * scale)
+    # and against the solid sphere's closed form, written here (no spin before, so the
+    # contact point moves with v_t): tangential impulse per unit mass p = -2/7 v_t
+    # (rolls) or -mu (1 + e) v_n v_t / |v_t| (slides); at (0, 0, -r) it changes the
+    # spin by (-r z) x p m / I = (5/2) (p_y, -p_x, 0) / r  (I = 2/5 m r^2)
+    v_t = np.array([*contact.velocity_before[:2], 0.0])
+    p = -2 / 7 * v_t if rolls else -mu * (1 + e) * v_n * v_t / u
+    np.testing.assert_allclose(contact.velocity_after, v_t + p + [0, 0, e * v_n],
+                               atol=1e-3 * scale)
+    np.testing.assert_allclose(contact.angular_velocity_after * scene.radius,
+                               2.5 * np.array([p[1], -p[0], 0.0]), atol=1e-3 * scale)
     # rolling at the end <=> the contact point's tangential velocity vanished
     w, v = contact.angular_velocity_after, contact.velocity_after
     slip = v[:2] + np.cross(w, [0, 0, -scene.radius])[:2]
     assert (np.linalg.norm(slip) < 1e-3 * scale) == rolls
 
 
-def test_rigid_map_rolling_threshold_is_three_and_a_half_mu_one_plus_e():
-    """The closed-form threshold of a solid sphere, checked on the map itself."""
+@pytest.mark.parametrize("shape, ratio", [("solid", 2 / 5), ("hollow", 2 / 3)])
+def test_rigid_map_rolling_threshold_is_three_and_a_half_mu_one_plus_e(shape, ratio):
+    """The closed-form threshold |u| = mu (1 + e) v_n (1 + m r^2 / I) -- 3.5 mu (1 + e) v_n
+    for a solid sphere, 2.5 for a hollow one -- checked on the map itself, with
+    r = 0.37 and m = 2.3 (r, r^2 and m no longer coincide with 1).  The solid sphere
+    takes rigid_impact's default inertia, the hollow one I = 2/3 m r^2 given."""
     e, mu, v_n = 0.7, 0.2, 2.0
-    threshold = 3.5 * mu * (1 + e) * v_n
+    r, m = 0.37, 2.3
+    inertia = ratio * m * r ** 2
+    threshold = mu * (1 + e) * v_n * (1 + m * r ** 2 / inertia)
+    assert threshold == pytest.approx((3.5 if shape == "solid" else 2.5) * mu * (1 + e) * v_n)
     for u, sticks in ((0.999 * threshold, True), (1.001 * threshold, False)):
-        impact = ballc.rigid_impact([u, 0, -v_n], [0, 0, 0], restitution=e,
-                                    friction_coefficient=mu)
+        impact = ballc.rigid_impact([u, 0, -v_n], [0, 0, 0], mass=m, radius=r,
+                                    inertia=None if shape == "solid" else inertia,
+                                    restitution=e, friction_coefficient=mu)
         assert impact.sticking == sticks
         assert impact.velocity[2] == pytest.approx(e * v_n)
         # angular momentum about the contact point is conserved in a rigid impact
-        r, m, inertia = 1.0, 1.0, 0.4
         before = m * np.cross([0, 0, r], [u, 0, -v_n])
         after = m * np.cross([0, 0, r], impact.velocity) + inertia * impact.angular_velocity
         np.testing.assert_allclose(after[:2], before[:2], atol=1e-12)
+        # the closed-form rebound (tangential impulse per unit mass p along x, acting at
+        # (0, 0, -r): it changes wy by -r m p / I):
+        # sticking: the contact point leaves rolling, p = -u / (1 + m r^2 / I);
+        # sliding: p = -mu (1 + e) v_n
+        p = -u / (1 + m * r ** 2 / inertia) if sticks else -mu * (1 + e) * v_n
+        np.testing.assert_allclose(impact.velocity, [u + p, 0.0, e * v_n], atol=1e-12)
+        np.testing.assert_allclose(impact.angular_velocity, [0.0, -r * m * p / inertia, 0.0],
+                                   atol=1e-12)
+        if sticks:   # rolling: vx' = r wy'
+            assert impact.velocity[0] == pytest.approx(r * impact.angular_velocity[1])
 
 
 @pytest.mark.parametrize("model", ["mixture", "friction", "dig-in", "compliant"])
@@ -227,34 +254,105 @@ def seed_throw(**changes):
     return ballc.simulate(ballc.Scene(**changes), 5.0)
 
 
+#: Garwin's ratio K = I / (m r^2): 2/5 for a solid sphere.
+SOLID = 2 / 5
+
+
+def garwin_map(v_t, r_w, e_t, k=SOLID):
+    """Garwin's superball map (Am. J. Phys. 37, 88 (1969)): a no-slip impact that returns
+    the contact point's tangential velocity u = v_t - r w reversed, u' = -e_t u:
+
+        v_t' = [(1 - K e_t) v_t + K (1 + e_t) r w] / (1 + K)
+        r w' = [(1 + e_t) v_t + (K - e_t) r w] / (1 + K)
+
+    Derivation (per tangential axis): a tangential impulse P (per unit mass p = P/m)
+    changes v_t by p and r w by -p r^2 m / I = -p / K (the torque of P at the contact
+    point, below), so u changes by p (1 + 1/K); u' = -e_t u needs
+    p = -K (1 + e_t) u / (1 + K), which gives the two lines above."""
+    return (((1 - k * e_t) * v_t + k * (1 + e_t) * r_w) / (1 + k),
+            ((1 + e_t) * v_t + (k - e_t) * r_w) / (1 + k))
+
+
+def garwin_impact(v, w, radius, e, e_t, plane, k=SOLID):
+    """One impact of ballc's 3-D ball by Garwin's map, in ballc's conventions.
+
+    The plane's normal n towards the ball is +z (floor) or -z (ceiling); the contact
+    point is at -r n, so its tangential velocity u = v_t + w x (-r n) is
+    floor: (vx - r wy, vy + r wx), ceiling: (vx + r wy, vy - r wx).  With s = +1 (floor)
+    or -1 (ceiling) that is u = v_t - (r w)_G with Garwin's spin (r w)_G =
+    (s r wy, -s r wx): an impulse P at -r n changes w by (-r n) x P / I, i.e. (r w)_G
+    by -r^2 P / I on both planes, as garwin_map assumes.  w_z (about the normal) is
+    unchanged; the normal velocity leaves with -e times its approach."""
+    s = 1.0 if plane == "floor" else -1.0
+    v, w = np.asarray(v, float), np.asarray(w, float)
+    r_w = np.array([s * radius * w[1], -s * radius * w[0]])
+    v_t, r_w = garwin_map(v[:2], r_w, e_t, k)
+    return (np.array([v_t[0], v_t[1], -e * v[2]]),
+            np.array([-s * r_w[1] / radius, s * r_w[0] / radius, w[2]]))
+
+
 def garwin_signs(scene, planes):
-    """Signs of vx after each impact of the ideal superball (Garwin 1969): the rigid map
-    with tangential restitution 1 (the contact point's slip reverses), Hunt-Crossley's
-    normal restitution, no slip limit; flights change neither vx nor the spin."""
-    e = ballc.hunt_crossley_restitution(scene.c_tau)
-    v, w, signs = np.array(scene.velocity, dtype=float), np.zeros(3), []
+    """Signs of vx after each impact of the ideal superball: Garwin's map (e_t = 1, no
+    slip limit) with Hunt-Crossley's normal restitution (the formula above, not
+    ballc's); flights change neither the horizontal velocity nor the spin (no observer
+    mass: the centre is the centre of mass)."""
+    assert scene.observer_mass == 0.0
+    assert scene.inertia[0] == pytest.approx(SOLID * scene.mass * scene.radius ** 2)
+    e = hc_restitution_formula(scene.c_tau)
+    v, w, signs = np.array(scene.velocity, float), np.array(scene.angular_velocity, float), []
     for plane in planes:
         v[2] = -abs(v[2]) if plane == "floor" else abs(v[2])
-        impact = ballc.rigid_impact(v, w, mass=scene.mass, radius=scene.radius,
-                                    inertia=scene.inertia[0], restitution=e,
-                                    friction_coefficient=1e9, tangential_restitution=1.0,
-                                    plane=plane)
-        v, w = impact.velocity, impact.angular_velocity
+        v, w = garwin_impact(v, w, scene.radius, e, 1.0, plane)
         signs.append(float(np.sign(v[0])))
     return signs
 
 
-def test_compliant_superball_comes_back():
+@pytest.mark.parametrize("plane", ["floor", "ceiling"])
+@pytest.mark.parametrize("e_t", [1.0, 0.4, -0.5])
+def test_rigid_map_is_garwins_superball_map(e_t, plane):
+    """ballc.rigid_impact with no slip limit (mu = 1e9) against Garwin's closed form,
+    written above, for a 3-D spinning ball with r = 0.37 (r and r^2 differ), m = 2.3,
+    I = 2/5 m r^2 (the default) and also given explicitly."""
+    r, m, e = 0.37, 2.3, 0.8
+    v = np.array([1.2, -0.7, -2.0 if plane == "floor" else 2.0])
+    w = np.array([4.0, -9.0, 3.0])
+    expected_v, expected_w = garwin_impact(v, w, r, e, e_t, plane)
+    for inertia in (None, SOLID * m * r ** 2):
+        impact = ballc.rigid_impact(v, w, mass=m, radius=r, inertia=inertia, restitution=e,
+                                    friction_coefficient=1e9, tangential_restitution=e_t,
+                                    plane=plane)
+        assert impact.sticking
+        np.testing.assert_allclose(impact.velocity, expected_v, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(impact.angular_velocity, expected_w, rtol=0, atol=1e-12)
+    # the contact point's tangential velocity is reversed with e_t (Garwin's definition)
+    n = np.array([0.0, 0.0, 1.0 if plane == "floor" else -1.0])
+    u_before = (v + np.cross(w, -r * n))[:2]
+    u_after = (expected_v + np.cross(expected_w, -r * n))[:2]
+    np.testing.assert_allclose(u_after, -e_t * u_before, atol=1e-12)
+
+
+@pytest.mark.parametrize("spin", [(0.0, 0.0, 0.0), (0.0, 10.0, 0.0), (0.0, -20.0, 0.0)],
+                         ids=["no-spin", "topspin", "backspin"])
+def test_compliant_superball_comes_back(spin):
     """kappa = 2/7 makes the tangential and normal contact frequencies equal for a solid
     sphere, so the compliant contact returns the slip reversed -- Garwin's ideal
     superball.  The signs of vx after floor, ceiling, floor are then those of Garwin's
-    rigid map (-, +, +: the ball comes back), computed here by that map."""
+    rigid map, written in this file (garwin_impact).  The ball has r = 0.37 (the seed's
+    soft ball scaled: E / r^3 keeps its deepest penetration ~0.5 r) and no observer
+    mass.  Without spin it comes back (-, +, +); the spins were chosen so that the map
+    evaluated with r^2 in place of r (spin -20 rad/s: -, +, + instead of -, -, +) or 1 in
+    place of r (10 rad/s: +, +, + instead of -, +, +) would give other signs."""
+    r = 0.37
     scene = ballc.Scene(tangential_model="compliant", tangential_stiffness_ratio=2 / 7,
-                        friction_coefficient=1.0)
+                        friction_coefficient=1.0, radius=r, inertia=(SOLID * r ** 2,) * 3,
+                        ball_youngs_modulus=6e4, observer_mass=0.0, angular_velocity=spin)
     result = ballc.simulate(scene, 5.0)
+    assert result.status == 0
     signs = [np.sign(c.velocity_after[0]) for c in result.contacts[:3]]
     assert [c.plane for c in result.contacts[:3]] == ["floor", "ceiling", "floor"]
-    assert signs == garwin_signs(scene, ["floor", "ceiling", "floor"]) == [-1, 1, 1]
+    assert signs == garwin_signs(scene, ["floor", "ceiling", "floor"])
+    if spin == (0.0, 0.0, 0.0):
+        assert signs == [-1, 1, 1]
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.1, 0.3, 1.0, 3.0])

@@ -568,7 +568,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         t_stop = min(t_check, t_end, run.step_bound_end())
         segment_eval = None
         if t_eval is not None:
-            segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_end)]
+            segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_stop)]
         remaining = None if options.max_nfev is None else max(options.max_nfev - nfev, 1)
         events = [event for _, _, event in driver_events]
         if user:
