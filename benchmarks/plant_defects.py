@@ -100,23 +100,8 @@ DEFECTS = [
            "    e_t = -float(ua @ ub) / slip2 if ",
            "    e_t = float(ua @ ub) / slip2 if ", regenerate=False),
     Defect("sweep rows stored in completion order (local pool)", "src/ballc/sweep.py",
-           "    rows = [None] * len(tasks)\n"
-           "    bar = _bar(None, progress, len(tasks)) if progress else None\n"
-           "    with ProcessPoolExecutor(max_workers=workers) as pool:\n"
-           "        futures = {pool.submit(_run_batch, batch): start for start, batch in batches}\n"
-           "        for future in as_completed(futures):\n"
-           "            start = futures[future]\n"
-           "            done = future.result()\n"
-           "            for offset, row in enumerate(done):\n"
            "                rows[start + offset] = row\n",
-           "    rows = []\n"
-           "    bar = _bar(None, progress, len(tasks)) if progress else None\n"
-           "    with ProcessPoolExecutor(max_workers=workers) as pool:\n"
-           "        futures = {pool.submit(_run_batch, batch): start for start, batch in batches}\n"
-           "        for future in as_completed(futures):\n"
-           "            start = futures[future]\n"
-           "            done = future.result()\n"
-           "            rows.extend(done)\n", regenerate=False),
+           "                rows[rows.index(None)] = row\n", regenerate=False),
     Defect("Coulomb cone off by 2 (stick holds until |lambda| = 2 mu N)", "src/ballc/_system.c",
            "    out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
            "    out[3] = 2 * params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
