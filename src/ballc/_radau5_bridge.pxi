@@ -240,28 +240,20 @@ cdef bint _finite_nonnegative(const double[::1] a) noexcept:
     return True
 
 
-cdef const double[::1] _checked_row(str name, value, Py_ssize_t n):
-    """``value`` as n finite float64s (one view; ``_vector`` for anything else)."""
+cdef const double[::1] _checked_row(str name, value, Py_ssize_t n, Py_ssize_t index=-1):
+    """``value`` as n finite float64s (one view; ``_vector`` for anything else).
+    ``index`` >= 0: ``name`` is a format with one field, filled with it only where a
+    message needs the name (a per-event check builds no string on the good path)."""
     cdef const double[::1] v
     cdef Py_ssize_t i
     if not (type(value) is np.ndarray and value.dtype == np.float64 and value.shape == (n,)
             and value.flags.c_contiguous):
-        value = _vector(name, value, n)
+        value = _vector(name.format(index) if index >= 0 else name, value, n)
     v = value
     for i in range(n):
         if not isfinite(v[i]):
-            _vector(name, value, n)   # raises, naming it
+            _vector(name.format(index) if index >= 0 else name, value, n)   # raises, naming it
     return v
-
-
-cdef inline bint _is_row(value, Py_ssize_t n):
-    """Whether ``value`` is already n contiguous float64s (then a view, no copy)."""
-    return (type(value) is np.ndarray and (<object>value).dtype is _FLOAT64
-            and (<object>value).ndim == 1 and (<object>value).shape[0] == n
-            and (<object>value).flags.c_contiguous)
-
-
-_FLOAT64 = np.dtype(np.float64)
 
 
 def _vector(name, value, n):
@@ -352,12 +344,7 @@ def _event_arrays(events, int n):
         e = events[k]
         c = getattr(e, "coefficients", None)   # the driver's events are LinearEvents
         if c is not None:
-            if _is_row(c, n):
-                row = c
-                if not _finite(row):
-                    _checked_row(f"events[{k}].coefficients", c, n)   # raises, naming it
-            else:
-                row = _checked_row(f"events[{k}].coefficients", c, n)
+            row = _checked_row("events[{}].coefficients", c, n, k)
             memcpy(&cv[k, 0], &row[0], n * sizeof(double))
             offset[k] = float(getattr(e, "offset", 0.0))
         elif hasattr(e, "system_event"):

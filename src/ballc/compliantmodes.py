@@ -108,7 +108,7 @@ IMPACT_SPAN = 4
 
 def contact_time(scene, rate: float) -> float:
     """The elastic Hertz contact time (s) at impact rate ``rate`` (m/s):
-    t_c = 3.2145 (m / k0)^(2/5) v^(-1/5) (as ballc.impact.hertz_contact_time)."""
+    t_c = 3.2145 (m / k0)^(2/5) v^(-1/5) (ballc.impact.hertz_contact_time)."""
     m = scene.mass + scene.observer_mass
     return 3.2145 * (m / scene.hertz_stiffness) ** 0.4 * rate ** -0.2
 
@@ -129,21 +129,22 @@ def step_bound(scene, rate: float, t_start: float) -> tuple[float, float]:
     return t_c / STEPS_PER_CONTACT, t_start + IMPACT_SPAN * t_c
 
 
-def _boundary(scene, plane):
+def plane_position(scene, plane: str) -> float:
+    """The centre's height z (m) at which the ball touches ``plane`` (rho = 0)."""
     return scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
 
 
 def arm_penetration(scene, plane: str) -> float:
     """The penetration (m) at which the guards of a contact with ``plane`` are armed:
     ARM_ULPS ulp of the plane's position, and Hertz's force ARM_FORCE."""
-    return max(ARM_ULPS * math.ulp(_boundary(scene, plane)),
+    return max(ARM_ULPS * math.ulp(plane_position(scene, plane)),
                (ARM_FORCE / scene.hertz_stiffness) ** (2.0 / 3.0))
 
 
 def _rounding(scene, plane, rho0):
     """The relative rounding of margins computed from rho >= rho0: a few ulp of the
     plane's position over rho0, and never below 64 eps."""
-    return max(64 * _EPS, 8 * math.ulp(_boundary(scene, plane)) / max(rho0, 1e-300))
+    return max(64 * _EPS, 8 * math.ulp(plane_position(scene, plane)) / max(rho0, 1e-300))
 
 
 def guard(scene, mode: str, armed: bool, y0, params, latch, plane: str, rho0: float):

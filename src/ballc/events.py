@@ -130,9 +130,16 @@ def contact_threshold(scene, plane, rho0, entering):
     crossing within the first step cannot be masked by a second one.  The thresholds
     are of order 1e-15 .. 1e-13 m: the contact force they leave out is negligible.
     """
-    boundary = scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
-    base = 4 * math.ulp(boundary)
-    far_side = rho0 if entering else -rho0
+    return _past(threshold_base(scene, plane), rho0 if entering else -rho0)
+
+
+def threshold_base(scene, plane):
+    """The least contact threshold on ``plane`` (m): 4 ulp of its position."""
+    return 4 * math.ulp(compliantmodes.plane_position(scene, plane))
+
+
+def _past(base, far_side):
+    """contact_threshold from its base and how far the segment starts on the far side."""
     return max(base, far_side + base)
 
 
@@ -161,19 +168,22 @@ class SegmentEvents:
     """:func:`segment_events` for one scene, with what does not change between the
     segments of a run worked out once (the driver makes one per run): per plane its
     penetration, deepest-point and passing-through events, the rounding margin of its
-    contact threshold and the compliant law's arming depth.  Same events, same bits."""
+    contact threshold and the compliant law's arming depth.  Same events, same bits.
+    ``rho`` (plane -> its penetration, a LinearEvent) and ``arm_depth`` (plane -> the
+    arming depth, m; None without the compliant modes) serve the driver too."""
 
     def __init__(self, scene):
         self.scene = scene
-        self.modes = compliantmodes.uses_modes(scene)
+        self.rho = {plane: penetration(plane, scene) for plane in PLANES}
+        self.arm_depth = ({plane: compliantmodes.arm_penetration(scene, plane)
+                           for plane in PLANES}
+                          if compliantmodes.uses_modes(scene) else None)
         self.planes = []
         for plane in PLANES:
-            rho = penetration(plane, scene)
-            boundary = scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
+            rho = self.rho[plane]
             self.planes.append((
-                plane, rho, rho._index, rho._scale, rho.offset,
-                4 * math.ulp(boundary),                            # contact_threshold's base
-                compliantmodes.arm_penetration(scene, plane) if self.modes else None,
+                plane, rho, rho._index, rho._scale, rho.offset, threshold_base(scene, plane),
+                self.arm_depth[plane] if self.arm_depth else None,
                 rho.shifted(-scene.radius, True, 1),               # passing through
                 _deepest_of(plane)))
 
@@ -184,14 +194,13 @@ class SegmentEvents:
         append = events.append
         for plane, rho, index, scale, offset, base, arm, through, deepest in self.planes:
             rho0 = scale * y0[index] + offset                      # rho(0, y0)
-            if in_contact[plane]:
-                # contact_threshold(scene, plane, rho0, entering=False)
-                threshold = max(base, -rho0 + base)
+            if in_contact[plane]:                                  # contact_threshold's
+                threshold = _past(base, -rho0)
                 append(("leave", plane, rho.shifted(threshold, True, -1)))
                 append(("through", plane, through))
                 append(("deepest", plane, deepest))
             else:
-                threshold = max(base, rho0 + base)                 # entering=True
+                threshold = _past(base, rho0)
                 if arm is not None:   # the compliant law starts armed
                     threshold = max(threshold, arm)
                 append(("enter", plane, rho.shifted(-threshold, True, 1)))

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import compliantmodes
 from .result import Result
 from .scene import Scene, SceneError
 from .simulate import simulate
@@ -106,9 +107,9 @@ def _vector(name, value):
 
 def hertz_contact_time(scene: Scene, speed: float) -> float:
     """Duration (s) of an elastic Hertz impact at normal ``speed`` (m/s):
-    t_c = 3.2145 (m / k0)^(2/5) v^(-1/5), k0 = scene.hertz_stiffness."""
-    m = scene.mass + scene.observer_mass
-    return 3.2145 * (m / scene.hertz_stiffness) ** 0.4 * speed ** -0.2
+    t_c = 3.2145 (m / k0)^(2/5) v^(-1/5), k0 = scene.hertz_stiffness
+    (:func:`ballc.compliantmodes.contact_time`)."""
+    return compliantmodes.contact_time(scene, speed)
 
 
 def _default_atol(scene, speed):

@@ -80,9 +80,6 @@ def check_method(method) -> str:
 
 def check_tolerances(rtol, atol):
     """(rtol, atol) as float and float-or-array, or SceneError naming the bad one."""
-    if (type(rtol) is float and type(atol) is float and math.isfinite(rtol)
-            and math.isfinite(atol) and rtol >= MIN_RTOL and atol > 0):
-        return rtol, atol   # the usual case, checked without numpy (once per run)
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not _is_number_like(value):
             raise SceneError(f"{name} = {plain(value)} is not allowed: must be a number "

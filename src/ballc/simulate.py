@@ -93,10 +93,9 @@ class _Run:
         self.t_rest = None                        # when the ball came to rest (ballc.resting)
         self._flags: dict[tuple, int] = {}
         self.segment_events = ev.SegmentEvents(scene)
+        self.rho = self.segment_events.rho            # plane -> rho(t, y)
+        self.arm_depth = self.segment_events.arm_depth
         self.resting_plane = resting.resting_plane(scene)
-        self.rho = {plane: ev.penetration(plane, scene) for plane in PLANES}   # rho(t, y)
-        self.arm_depth = {plane: compliantmodes.arm_penetration(scene, plane)
-                          for plane in PLANES} if self.compliant_modes else None
         # plane -> (the largest step in its contact's impact, the time that bound ends)
         self.contact_step: dict[str, tuple[float, float]] = {}
         self._slip_terms = {plane: stickslip.slip_terms(self.params, plane) for plane in PLANES}
@@ -665,7 +664,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         run.t = t_fired
         run.y = state = np.array(y_events[fired][-1])
         quaternion = state[_QUATERNION]   # a view: normalised in place
-        np.divide(quaternion, math.hypot(*quaternion.tolist()), out=quaternion)
+        quaternion /= math.hypot(*quaternion.tolist())
         if fired >= n_driver:   # a terminal user event
             run.status, run.message = 1, "A termination event occurred."
             break
