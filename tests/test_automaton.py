@@ -13,24 +13,33 @@ simulate_module = importlib.import_module("ballc.simulate")
 
 
 def _record(monkeypatch):
-    """Wrap the driver's handler: [(event, plane, mode before, mode after)]."""
+    """Wrap the driver's handler and its checks: [(event, plane, mode before, mode
+    after)]."""
     seen = []
-    handle, check_rest = simulate_module._Run.handle, simulate_module._Run.check_rest
+    handle = simulate_module._Run.handle
 
     def recording_handle(run, kind, plane):
         before = run.mode(plane)
         handle(run, kind, plane)
         seen.append((kind, plane, before, run.mode(plane)))
 
-    def recording_check(run, plane):
-        before = run.mode(plane)
-        rested = check_rest(run, plane)
-        seen.append(("rest check", plane, before, run.mode(plane)))
-        return rested
-
     monkeypatch.setattr(simulate_module._Run, "handle", recording_handle)
-    monkeypatch.setattr(simulate_module._Run, "check_rest", recording_check)
+    for kind in ("rest check", "uniform check", "orbit check"):
+        _record_check(monkeypatch, seen, kind)
     return seen
+
+
+def _record_check(monkeypatch, seen, kind):
+    name = automaton.handler_of(kind)
+    check = getattr(simulate_module._Run, name)
+
+    def recording_check(run, plane, *args):
+        before = run.mode(plane)
+        found = check(run, plane, *args)
+        seen.append((kind, plane, before, run.mode(plane)))
+        return found
+
+    monkeypatch.setattr(simulate_module._Run, name, recording_check)
 
 
 def _shallow_start():
@@ -53,6 +62,13 @@ SCENES = {
     "compliant": (lambda: (ballc.Scene(tangential_model="compliant"), None), 2.5),
     "compliant, shallow start": (_shallow_start, 0.01),                         # arm
     "rest": (lambda: (ballc.Scene(velocity=(0, 0, 0), observer_mass=0.0), None), 200.0),
+    # the end states in motion: uniform rolling and sliding (massless observer), and the
+    # seed's wobbling roll (ballc.orbit; its trial ends at ~63 s)
+    "rolling": (lambda: (ballc.Scene(tangential_model="friction", observer_mass=0.0), None),
+                100.0),
+    "sliding": (lambda: (ballc.Scene(tangential_model="friction", friction_coefficient=0.0,
+                                     observer_mass=0.0), None), 100.0),
+    "seed, long": (lambda: (ballc.Scene(), None), 100.0),
 }
 
 
@@ -81,6 +97,11 @@ def test_the_default_run_takes_every_row(transitions):
     taken = {kind for kind, *_ in transitions}
     assert taken == {row.event for row in automaton.TRANSITIONS}, (
         {row.event for row in automaton.TRANSITIONS} - taken)
+
+
+def test_the_default_run_reaches_every_end_state(transitions):
+    reached = {after for *_, after in transitions}
+    assert set(automaton.END_MODES) <= reached, set(automaton.END_MODES) - reached
 
 
 def test_every_handler_exists_and_modes_are_named():

@@ -10,8 +10,10 @@ plane is in one *mode* at a time:
 * with the compliant law's exact modes (ballc.compliantmodes): ``elastic``, ``sliding``;
 * ``contact``: in contact with neither (the dig-in model; the "max" and "smooth"
   regularisations; mu = 0);
-* end states of a run (ballc.resting; floor only): ``resting``, ``rolling``;
-  ``passed_through`` (the ball left through the plane: status 1).
+* end states of a run (floor only), each continued in closed form to t_end:
+  ``resting`` (ballc.resting), ``rolling`` and ``free_sliding`` (uniform: ballc.resting;
+  with the wobble of an eccentric observer: ballc.orbit); ``passed_through`` (the ball
+  left through the plane: status 1).
 
 :data:`TRANSITIONS` lists every transition: the event kind (the name
 events.segment_events gives its guard), the modes it leaves from, the modes it may lead
@@ -33,7 +35,7 @@ from dataclasses import dataclass
 COULOMB_MODES = ("slip", "slip_fixed", "stick")
 COMPLIANT_MODES = ("elastic", "sliding")
 CONTACT_MODES = ("contact",) + COULOMB_MODES + COMPLIANT_MODES
-END_MODES = ("resting", "rolling", "passed_through")
+END_MODES = ("resting", "rolling", "free_sliding", "passed_through")
 MODES = ("flight",) + CONTACT_MODES + END_MODES
 
 
@@ -90,11 +92,22 @@ TRANSITIONS = (
                "(e . v_t - max(rhodot, 0)/(2 rho) |s|) - ds_cap/dt + offset falls "
                "through 0", "a spring beyond the cap is brought back to it",
                "compliant_event"),
-    Transition("rest check", CONTACT_MODES, ("resting", "rolling") + CONTACT_MODES,
+    Transition("rest check", CONTACT_MODES, ("resting",) + CONTACT_MODES,
                "scheduled (not an event): 20 small-oscillation periods into a floor "
-               "contact, then at growing intervals",
-               "the rest state or uniform rolling, in closed form to t_end; else the next "
-               "check", "check_rest"),
+               "contact, then at growing intervals, and at the end of an orbit's trial",
+               "the rest state, in closed form to t_end; else the next check",
+               "check_rest"),
+    Transition("uniform check", CONTACT_MODES, ("rolling", "free_sliding") + CONTACT_MODES,
+               "at a rest check that found no rest",
+               "uniform rolling or sliding (massless observer, isotropic inertia; "
+               "ballc.resting), in closed form to t_end; else go on",
+               "check_rolling"),
+    Transition("orbit check", CONTACT_MODES, ("rolling", "free_sliding") + CONTACT_MODES,
+               "at a rest check that found neither rest nor uniform motion, when it ends "
+               "an orbit's trial (TRIAL_PERIODS periods integrated in one mode)",
+               "the relative periodic orbit of an eccentric observer's wobble "
+               "(ballc.orbit), in closed form to t_end; else a new trial",
+               "check_orbit"),
 )
 
 #: How simultaneous events are handled: the earliest terminal event that fired ends the

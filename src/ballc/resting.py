@@ -183,19 +183,20 @@ def rolling_state(scene, y):
 
 
 def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, flags):
-    """The uniform rolling state when the contact with ``plane`` (since ``t_start``)
-    rolls uniformly at state y and time t, else None.
+    """(the uniform state, "rolling" or "free_sliding") when the contact with ``plane``
+    (since ``t_start``) moves uniformly at state y and time t, else None.
 
     Criterion: the scene has an exact free rotation (ballc.flight.scene_allows:
     massless observer, isotropic inertia); the contact has lasted REST_PERIODS T0;
-    the slip speed ``slip_speed`` is at most REST_FACTOR dv; the energy above the
-    rolling state (vertical kinetic energy, Hertz spring plus gravity above rho_eq,
-    tangential spring) is below :func:`energy_threshold`; and the rolling state is a
-    steady state of the segment's equations (flags, latch): its accelerations, linear
-    and angular (times r), and the deflection rates are at rounding level
-    (1e3 eps g).  Then the motion is the exact uniform rolling: v and omega constant,
-    the centre on a straight line at z_eq, the orientation turning at omega
-    (ballc.flight.FreeFlight with g = 0)."""
+    the energy above the uniform state (vertical kinetic energy, Hertz spring plus
+    gravity above rho_eq, tangential spring) is below :func:`energy_threshold`; and the
+    uniform state is a steady state of the segment's equations (flags, latch): its
+    accelerations, linear and angular (times r), and the deflection rates are at
+    rounding level (1e3 eps g).  Then the motion is exact: v and omega constant, the
+    centre on a straight line at z_eq, the orientation turning at omega
+    (ballc.flight.FreeFlight with g = 0).  It is *rolling* when the slip speed
+    ``slip_speed`` is at most REST_FACTOR dv, else *free sliding* (a slip that no
+    force opposes: mu = 0, or a tangential law without friction)."""
     from . import flight
     if plane != resting_plane(scene) or t - t_start < REST_PERIODS * oscillation_period(scene):
         return None
@@ -203,8 +204,6 @@ def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, fl
         return None
     largest_atol = float(np.max(atol))
     dv = REST_FACTOR * (largest_atol + rtol * math.sqrt(scene.gravity * scene.radius))
-    if not slip_speed <= dv:
-        return None
     e = _core.energies(np.ascontiguousarray(y[None, :]), params)[0]
     rho_eq = equilibrium_penetration(scene)
     x = (scene.radius - y[_Z] - rho_eq) / rho_eq
@@ -224,7 +223,7 @@ def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, fl
             or np.max(np.abs(rate[_DEFLECTION["floor"]])) > level
             or np.max(np.abs(rate[_DEFLECTION["ceiling"]])) > level):
         return None
-    return roll
+    return roll, ("rolling" if slip_speed <= dv else "free_sliding")
 
 
 def rolling_samples(t0, t1, rate):

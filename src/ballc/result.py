@@ -71,8 +71,12 @@ class Contact:
     transitions: list = field(default_factory=list)
     #: when the contact came to rest (ballc.resting), NaN if it did not (s)
     t_rest: float = np.nan
-    #: when the contact began to roll uniformly (ballc.resting), NaN if it did not (s)
+    #: when the contact's rolling was continued in closed form -- uniform
+    #: (ballc.resting) or the wobble of an eccentric observer (ballc.orbit) -- NaN if
+    #: it was not (s)
     t_rolling: float = np.nan
+    #: likewise for a contact sliding with no force opposing the slip (mu = 0) (s)
+    t_sliding: float = np.nan
 
     @property
     def duration(self) -> float:
@@ -91,7 +95,8 @@ class Contact:
                "energy_lost_tangential": self.energy_lost_tangential,
                "time_sticking": self.time_sticking, "time_slipping": self.time_slipping,
                "penetration_rate_at_impact": self.penetration_rate_at_impact,
-               "t_rest": self.t_rest, "t_rolling": self.t_rolling}
+               "t_rest": self.t_rest, "t_rolling": self.t_rolling,
+               "t_sliding": self.t_sliding}
         for name in ("velocity_before", "velocity_after", "angular_velocity_before",
                      "angular_velocity_after"):
             for axis, value in zip("xyz", getattr(self, name)):
@@ -105,7 +110,7 @@ CONTACT_UNITS = {
     "contact_point_x": "m", "contact_point_y": "m", "peak_normal_force": "N",
     "energy_lost_normal": "J", "energy_lost_tangential": "J", "time_sticking": "s",
     "time_slipping": "s", "penetration_rate_at_impact": "m/s", "t_rest": "s",
-    "t_rolling": "s",
+    "t_rolling": "s", "t_sliding": "s",
     **{f"{name}_{axis}": unit for name, unit in (
         ("velocity_before", "m/s"), ("velocity_after", "m/s"),
         ("angular_velocity_before", "rad/s"), ("angular_velocity_after", "rad/s"))
@@ -366,9 +371,10 @@ class Result:
                          f"{vb[1]:10.3f} {va[1]:9.3f} {vb[2]:10.3f} {va[2]:9.3f}")
         lines += [f"contact {i}: at rest from t = {c.t_rest:.6g} s (ballc.resting)"
                   for i, c in enumerate(self.contacts, 1) if c.t_rest == c.t_rest]
-        lines += [f"contact {i}: rolling uniformly from t = {c.t_rolling:.6g} s "
-                  "(ballc.resting)" for i, c in enumerate(self.contacts, 1)
-                  if c.t_rolling == c.t_rolling]
+        lines += [f"contact {i}: {what} from t = {when:.6g} s, in closed form"
+                  for i, c in enumerate(self.contacts, 1)
+                  for what, when in (("rolling", c.t_rolling), ("sliding freely", c.t_sliding))
+                  if when == when]
         return "\n".join(lines)
 
     def __repr__(self):

@@ -15,8 +15,8 @@ import math
 
 import numpy as np
 
-from . import (_core, automaton, compliantmodes, events as ev, layout, modes, outcome, resting,
-               stickslip)
+from . import (_core, automaton, compliantmodes, events as ev, layout, modes, orbit, outcome,
+               resting, stickslip)
 from ._format import plain
 from .dense import PiecewiseSolution
 from .flight import FreeFlight
@@ -91,6 +91,10 @@ class _Run:
         self.rearmed: list[tuple[float, np.ndarray]] = []   # this segment's: (t, latch before)
         self.rest_check: dict[str, float] = {}   # plane -> the time of its next rest check
         self.t_rest = None                        # when the ball came to rest (ballc.resting)
+        # ballc.orbit: the ball's axis when the scene is Routh's sphere, and the trial
+        # under way (the segments integrated to measure an orbit)
+        self.orbit_axis = orbit.body_axis(scene) if orbit.applies(scene) else None
+        self.orbit_trial: orbit.Trial | None = None
         self._flags: dict[tuple, int] = {}
         self.segment_events = ev.SegmentEvents(scene)
         self.rho = self.segment_events.rho            # plane -> rho(t, y)
@@ -370,25 +374,98 @@ class _Run:
         return self.enter_rest(plane)
 
     def check_rolling(self, plane):
-        """At a rest check that found no rest: the uniform rolling state (a new state)
-        when the contact rolls uniformly (resting.rolls), else None."""
+        """At a rest check that found no rest: the uniform state (a new state) when the
+        contact rolls or slides freely and uniformly (resting.rolls), else None."""
         contact = self.open[plane]
         speed = self.slip(plane, self.y)[1]
-        roll = resting.rolls(self.scene, self.y, plane, contact.t_start, self.t,
-                             self.options.rtol, self.options.atol, speed, self.params,
-                             self.latch, self.flags())
-        if roll is None:
+        found = resting.rolls(self.scene, self.y, plane, contact.t_start, self.t,
+                              self.options.rtol, self.options.atol, speed, self.params,
+                              self.latch, self.flags())
+        if found is None:
             return None
-        self.y = roll
-        contact.t_rolling = self.t
-        contact.transitions.append((self.t, "rolling"))
-        v = float(np.hypot(*roll[layout.VELOCITY][:2]))
-        self.message = (f"{SUCCESS} The ball rolls uniformly on the {plane} from t = "
-                        f"{self.t:.9g} s at {v:.6g} m/s (ballc.resting: no slip, static "
-                        f"Hertz equilibrium, penetration "
+        self.y, kind = found
+        self.enter_motion(plane, kind)
+        v = float(np.hypot(*self.y[layout.VELOCITY][:2]))
+        what = "rolls uniformly" if kind == "rolling" else (
+            "slides uniformly (no force opposes its slip)")
+        self.message = (f"{SUCCESS} The ball {what} on the {plane} from t = "
+                        f"{self.t:.9g} s at {v:.6g} m/s (ballc.resting: static Hertz "
+                        f"equilibrium, penetration "
                         f"{resting.equilibrium_penetration(self.scene):.6g} m); from there "
-                        "to t_end the state is that rolling, in closed form.")
-        return roll
+                        f"to t_end the state is that {kind.replace('free_', '')}, in "
+                        "closed form.")
+        return self.y
+
+    def enter_motion(self, plane, kind):
+        """Record that ``plane``'s contact goes on in closed form as ``kind``
+        ("rolling" or "free_sliding") from now."""
+        contact = self.open[plane]
+        if kind == "rolling":
+            contact.t_rolling = self.t
+        else:
+            contact.t_sliding = self.t
+        contact.transitions.append((self.t, kind))
+
+    # ---- the periodic end state (ballc.orbit) ----
+
+    def plan_orbit_trial(self, plane, t_end):
+        """At a rest check that found neither rest nor uniform motion, with no trial
+        under way: start an orbit's trial (ballc.orbit) when the scene is Routh's sphere
+        and its equations are equivariant here (criteria 1-2) and the trial ends before
+        t_end; the next rest check is at the latest at the trial's end."""
+        if self.orbit_axis is None or self.orbit_trial is not None:
+            return
+        omega = self.y[layout.ANGULAR_VELOCITY]
+        rate = math.sqrt(float(omega.dot(omega)))
+        if not rate > 0:
+            return
+        guess = 2 * math.pi / rate
+        t_to = self.t + orbit.TRIAL_PERIODS * guess
+        if not t_to < t_end or not orbit.equivariant(self.params, self.latch, self.flags(),
+                                                     self.y, self.orbit_axis):
+            return
+        self.orbit_trial = orbit.Trial(plane, self.t, t_to, guess)
+        self.rest_check[plane] = min(self.rest_check[plane], t_to)
+
+    def check_orbit(self, plane, t_end):
+        """At a rest check: when it ends the trial under way, the relative periodic
+        orbit from self.t to t_end (ballc.orbit.RelativePeriodicOrbit) if criteria 3-5
+        hold, else None (and the trial is over); before the trial's end, None and the
+        next check at the latest at its end."""
+        trial = self.orbit_trial
+        if trial is None or trial.plane != plane:
+            return None
+        if self.t < trial.t_to:
+            self.rest_check[plane] = min(self.rest_check[plane], trial.t_to)
+            return None
+        self.orbit_trial = None
+        interpolant = trial.solution(self.t)
+        if interpolant is None:
+            return None
+        options = self.options
+        found = orbit.measure(interpolant, trial.t_from, self.t, self.orbit_axis, trial.guess,
+                              options.rtol, options.atol,
+                              resting.energy_threshold(self.scene, options.rtol, options.atol),
+                              self.params)
+        if found is None:
+            return None
+        c0, period, motion, rate = found
+        _, speed, error, _ = self.slip(plane, self.y)
+        # sticking (Coulomb's stick, the compliant law's elastic mode) is rolling
+        kind = "rolling" if self.mode(plane) in ("stick", "elastic") or (
+            speed <= resting.REST_FACTOR * error) else "free_sliding"
+        self.enter_motion(plane, kind)
+        what = "rolls" if kind == "rolling" else "slides freely"
+        kinetic = float(_core.energies(np.ascontiguousarray(self.y[None, :]), self.params)[0, 0])
+        neglected = -rate * (t_end - self.t)
+        self.message = (
+            f"{SUCCESS} The ball {what} on the {plane} from t = {self.t:.9g} s with the "
+            f"wobble of its eccentric observer, a relative periodic orbit (ballc.orbit): "
+            f"every {period:.9g} s its state repeats turned by {motion.phi:.6g} rad about "
+            f"the vertical; from there to t_end the state is that orbit, in closed form. "
+            f"It neglects the energy the contact dissipates: measured at {-rate:.2g} W, "
+            f"{neglected:.2g} J by t_end ({neglected / kinetic:.2g} of the kinetic energy).")
+        return orbit.RelativePeriodicOrbit(self.t, t_end, c0, period, motion, interpolant)
 
     def enter_rest(self, plane):
         contact = self.open[plane]
@@ -417,6 +494,8 @@ class _Run:
             return "resting"
         if contact is not None and not math.isnan(contact.t_rolling):
             return "rolling"
+        if contact is not None and not math.isnan(contact.t_sliding):
+            return "free_sliding"
         return self.coulomb[plane] or self.compliant[plane] or "contact"
 
     def pass_through(self, kind, plane):
@@ -565,6 +644,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         rest_plane, t_check = run.rest_candidate() if checks_rest else (None, math.inf)
         # a rest check, or the end of a compliant contact's step bound, ends the segment
         t_stop = min(t_check, t_end, run.step_bound_end())
+        t_from = run.t
+        trial = run.orbit_trial is not None   # an orbit's trial needs dense output
         segment_eval = None
         if t_eval is not None:
             segment_eval = t_eval[(t_eval > run.t) & (t_eval <= t_stop)]
@@ -576,7 +657,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                                 method=options.method, rtol=options.rtol, atol=options.atol,
                                 t_eval=segment_eval, max_step=run.max_step(),
                                 max_nfev=remaining, first_step=first,
-                                dense_output=options.dense_output,
+                                dense_output=options.dense_output or trial,
                                 exact_flight=options.exact_flight, auto_implicit=implicit)
         first = None
         implicit = False
@@ -624,6 +705,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             if options.dense_output and t.size:
                 pieces.append((run.t, float(t[-1]), sol.interpolant))
             break
+        if trial:
+            run.orbit_trial.add(t_from, t_stop if status == 0 else None, sol.get("interpolant"))
         if status == 0:
             if options.dense_output:
                 pieces.append((run.t, t_stop, sol.interpolant))
@@ -648,6 +731,16 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                     run.y = samples.last_state.copy()
                     run.t = t_end
                     break
+                periodic = run.check_orbit(rest_plane, t_end)
+                if periodic is not None:
+                    times = orbit.sample_times(run.t, t_end, periodic.period)
+                    samples.add(times, periodic(times), flags, run.latch)
+                    if options.dense_output:
+                        pieces.append((run.t, t_end, periodic))
+                    run.y = samples.last_state.copy()
+                    run.t = t_end
+                    break
+                run.plan_orbit_trial(rest_plane, t_end)
                 # the next segment starts with its own first step: a step carried over
                 # from a segment cut at the check made radau5 crawl in a steel ball's
                 # sticking contact (tests/test_stress.py, the ball at rest for 60 s:
