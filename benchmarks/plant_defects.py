@@ -106,6 +106,11 @@ DEFECTS = [
            "    out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
            "    out[3] = 2 * params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
            regenerate=False),
+    Defect("compliant sliding: the rho'' share of ds_cap/dt left out (the contact's own "
+           "acceleration only)", "src/ballc/_system.c",
+           "            for (int i = 0; i < 4; i++) xdot[target[i]] += coefficients[i] * rho_dd;\n",
+           "            for (int i = 0; i < 4; i++) xdot[target[i]] += 0 * coefficients[i] * rho_dd;\n",
+           regenerate=False),
     Defect("slip from rest starts along +lambda (settle)", "src/ballc/stickslip.py",
            '    return "slip_fixed", -np.array([lam_x, lam_y]) / size, y0\n',
            '    return "slip_fixed", np.array([lam_x, lam_y]) / size, y0\n', regenerate=False),

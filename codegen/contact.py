@@ -226,15 +226,27 @@ def damped_normal(model: Model, rho, rhodot, rate_at_impact):
     return _positive(elastic + damping), stiffness
 
 
-def normal_force_rate(model: Model, plane: str, rho, rhodot, rate_at_impact, f_n):
+def penetration_acceleration(plane: str):
+    """The symbol of rho'' on ``plane`` (m/s^2): the exact penetration acceleration,
+    which the C core computes from the solved accelerations (-a_z on the floor, +a_z on
+    the ceiling) and supplies to the kernels whose rates are affine in it
+    (ACCELERATION_LAWS, compliant_margins)."""
+    return sm.Symbol(f"{plane}_rho_acceleration")
+
+
+def normal_force_rate(model: Model, plane: str, rho, rhodot, rate_at_impact, f_n,
+                      accel=None):
     """dF_n/dt (N/s) of the damped normal force ``f_n`` (damped_normal's) while it is
-    positive, with the penetration's acceleration taken as the contact's own:
-    rho'' = -F_n/m* + g n_z (exact for a ball in one contact without observer; the
-    yield's shrinking term only)."""
+    positive, affine in the penetration's acceleration ``accel`` (rho'', m/s^2).
+    Without it, rho'' is taken as the contact's own, -F_n/m* + g n_z: exact for a ball
+    in one contact without observer, and what the Jacobian forms and the regularised
+    law's yield use; the sliding mode and its re-stick guard get the exact rho''
+    (penetration_acceleration)."""
     elastic, stiffness = hertz_normal(model, rho)
     normal, _ = plane_geometry(model, plane)
     mass = effective_mass(model)
-    accel = -f_n / mass + model.p["gravity"] * me.dot(normal, model.frame.z)
+    if accel is None:
+        accel = -f_n / mass + model.p["gravity"] * me.dot(normal, model.frame.z)
     select = model.p["normal_damping_model"]
     # Hunt-Crossley: P = F_H (1 + chi rhodot / |v-|)
     chi = _hunt_crossley_chi(model) / sm.Abs(rate_at_impact)
@@ -267,14 +279,15 @@ class CompliantContact:
     normal_force_rate: sm.Expr
 
 
-def compliant_contact(model: Model, plane: str) -> CompliantContact:
-    """The compliant law's shared quantities on ``plane`` (CompliantContact)."""
+def compliant_contact(model: Model, plane: str, accel=None) -> CompliantContact:
+    """The compliant law's shared quantities on ``plane`` (CompliantContact); dF_n/dt
+    with the penetration acceleration ``accel`` (normal_force_rate)."""
     point, _, normal, slip = slip_kinematics(model, plane)
     _, _, rho, rhodot = contact_kinematics(model, plane)
     rate_at_impact = latch_symbols(model, plane)[0]
     f_n, stiffness = damped_normal(model, rho, rhodot, rate_at_impact)
     cap = model.p["friction_coefficient"] * f_n
-    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n)
+    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n, accel)
     return CompliantContact(point, normal, slip, rho, rhodot, f_n, stiffness, cap, f_rate)
 
 
@@ -389,10 +402,13 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     it: s' = (v_t - (e . v_t) e) f + s d ln(s_cap)/dt, which keeps |s| / s_cap constant
     (1: a mode change puts the spring at the cap) and gives de/dt = (v_t - (e . v_t) e)
     / |s|, the truncated increment's direction (``turn`` f = 1, or less below
-    TURN_FLOOR).  The radial part is relative, so that the approximate penetration
-    acceleration in ds_cap/dt (normal_force_rate's) errs by a factor on |s|, never
-    driving s through 0 before s_cap (with the open-loop e ds_cap/dt, the seed's throw
-    with its observer drove s through 0 at a contact's end, and radau5 stalled there).
+    TURN_FLOOR).  The radial part is relative, so that s never passes through 0 before
+    s_cap does (with the open-loop e ds_cap/dt, the seed's throw with its observer drove
+    s through 0 at a contact's end, and radau5 stalled there).  ds_cap/dt holds the
+    exact penetration acceleration (compliant_sliding_force): with the contact's own
+    (-F_n/m* + g n_z), a massive observer made |s| drift off s_cap -- 3x above it, with
+    the dissipated work falling, for an observer as heavy as the ball (issue 20's
+    property test, found in stop 22).
     It is stiff as F_n -> 0 at the end (d ln(s_cap)/dt -> -inf): ``jacobian_form`` keeps
     that decay in d/ds and leaves out the growth while the cap rises (~ +1/t at a start:
     the dilution's trap, see JACOBIAN_FORMS).  Returns
@@ -438,7 +454,10 @@ def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
     before the kernel's code (``ContactLaw.frozen``), so the Jacobian leaves out
     de/ds ~ 1/|s|, singular at a contact that starts sliding (see JACOBIAN_FORMS)."""
     N = model.frame
-    c = compliant_contact(model, plane)
+    # the value's rates take the exact rho'' (affine in it: the C core adds its share,
+    # ACCELERATION_LAWS); the Jacobian form keeps the contact's own
+    c = compliant_contact(model, plane,
+                          None if jacobian_form else penetration_acceleration(plane))
     exact = sliding_direction(model, plane) + [turn_factor(model, plane)]
     frozen = None
     held = exact
@@ -464,8 +483,11 @@ def compliant_margins(model: Model, plane: str):
       faster the elastic law would stretch the spring than the cap grows; the sliding
       mode ends where it falls below 0;
     * s_cap = mu F_n / k_t (m) and k_t (N/m): what a mode change resets to.
+
+    The re-stick margin is affine in the exact penetration acceleration rho''
+    (penetration_acceleration(plane)), which the C core supplies.
     """
-    c = compliant_contact(model, plane)
+    c = compliant_contact(model, plane, penetration_acceleration(plane))
     f_n, rho, rhodot, slip = c.normal_force, c.rho, c.rhodot, c.slip
     sx, sy = deflection_symbols(model, plane)
     k_t = tangential_stiffness(model, c.stiffness)
@@ -628,6 +650,13 @@ COMPOSITIONS = {
     "digin": Composition(hertz_normal, hunt_crossley, dig_in, digin_share),
     "friction_normal": Composition(hertz_normal, hunt_crossley, no_friction, friction_share),
 }
+
+#: Laws whose auxiliary rates (dissipation, deflection) are affine in the exact
+#: penetration acceleration rho'' (penetration_acceleration): their value kernel is
+#: emitted at rho'' = 0 and a ``_acceleration`` kernel gives the rates' coefficients of
+#: rho'', which the C core multiplies with the solved rho'' (the forces do not depend on
+#: it, so it follows from the solve).
+ACCELERATION_LAWS = ("compliant_sliding",)
 
 TANGENTIAL_LAWS = {
     "friction": friction_model_force,

@@ -164,6 +164,13 @@ def build_kernels():
             outputs = pieces[f"{plane}_{law}"]
             doc = f"{plane} contact, {law} law (weighted):"
             extra_doc = "latched rhodot^-, d_x, d_y, d_z of this plane"
+            if law in contact.ACCELERATION_LAWS:
+                outputs, coefficients = split_acceleration(outputs, plane)
+                kernels.append(Kernel(
+                    f"{plane}_{law}_acceleration", f"{doc} the coefficients of the exact "
+                    "penetration acceleration rho'' in its dissipation rates (normal, "
+                    "tangential) and deflection rates (x, y) (4); the value kernel's are "
+                    "at rho'' = 0.", coefficients, list(latch), extra_doc))
             kernels.append(Kernel(f"{plane}_{law}", f"{doc} {describe_contact_law_layout()}.",
                                   list(outputs), list(latch), extra_doc))
             form = pieces.get(f"{plane}_{law}_jacobian_form", outputs)
@@ -188,15 +195,43 @@ def build_kernels():
     for plane in PLANES:
         kernels.append(slip_kernel(model, plane, pieces[f"{plane}_force_map"]))
     for plane in PLANES:
+        margins = contact.compliant_margins(model, plane)
+        accel = contact.penetration_acceleration(plane)
+        restick = _affine_coefficient(margins[1], accel, f"{plane} re-stick margin")
         kernels.append(Kernel(
             f"{plane}_compliant_margins",
             f"{plane} contact, the compliant law's mode guards (contact.compliant_margins): "
-            "yield margin 1 - k_t |s| / (mu F_n), re-stick margin (m/s), s_cap = mu F_n / k_t "
-            "(m), k_t (N/m).", contact.compliant_margins(model, plane),
+            "yield margin 1 - k_t |s| / (mu F_n), re-stick margin (m/s) at rho'' = 0, "
+            "s_cap = mu F_n / k_t (m), k_t (N/m), and the re-stick margin's coefficient of "
+            "the exact penetration acceleration rho'' (s).",
+            [margins[0], margins[1].xreplace({accel: 0}), margins[2], margins[3], restick],
             list(contact.latch_symbols(model, plane)),
             "latched rhodot^-, d_x, d_y, d_z of this plane"))
     kernels += output_kernels(model)
     return model, kernels
+
+
+def _affine_coefficient(expression, symbol, what):
+    """d(expression)/d(symbol), checked to be free of the symbol (affine)."""
+    coefficient = sm.sympify(expression).diff(symbol)
+    if coefficient.has(symbol):
+        raise ValueError(f"{what} is not affine in {symbol}")
+    return coefficient
+
+
+def split_acceleration(outputs, plane):
+    """A contact law's outputs at rho'' = 0, and the coefficients of rho'' in its
+    dissipation and deflection rates (4): the law's rates are affine in it, its forces
+    free of it (checked)."""
+    accel = contact.penetration_acceleration(plane)
+    offsets = dict(contact_law_offsets())
+    first = offsets["DISSIPATION"]
+    for i in range(first):
+        if sm.sympify(outputs[i]).has(accel):
+            raise ValueError(f"{plane}: a contact force depends on {accel}")
+    coefficients = [_affine_coefficient(outputs[i], accel, f"{plane} law output {i}")
+                    for i in range(first, first + 4)]
+    return sm.Matrix([sm.sympify(o).xreplace({accel: 0}) for o in outputs]), coefficients
 
 
 def observer_by_offset(model: Model):

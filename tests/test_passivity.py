@@ -124,3 +124,47 @@ def test_compliant_seed_throw_closes_its_energy_balance(method, rtol):
     assert len(result.contacts) == 9
     balance = result.energy["balance"]
     assert abs(balance[-1] - balance[0]) < 1e4 * rtol * balance[0], balance[-1] - balance[0]
+
+
+def _heavy_observer_scene(observer_mass):
+    """Hypothesis' find (tests/test_properties.py, stop 22): a soft compliant ball spun
+    about a horizontal axis, starting on the floor, with an observer as heavy as the
+    ball 0.34 r off its centre."""
+    return ballc.Scene(
+        mass=0.284541054278651, observer_mass=observer_mass, radius=0.2948514740577711,
+        ceiling_height=0.7371286851444279, inertia=(0.009894902842372311,) * 3,
+        observer_position=(0.0, 0.0, 0.3409639079563186), ball_youngs_modulus=1000.0,
+        c_tau=0.5, tangential_damping_ratio=0.13005521328387676,
+        friction_coefficient=0.11951764382391243, mixture=0.0, tangential_model="compliant",
+        tangential_stiffness_ratio=0.9672918915736324,
+        position=(0.0, 0.0, 0.2948514740577711), velocity=(0.0, 0.0, 0.0),
+        angles=(-1.5, 0.0, 0.0), angular_velocity=(7.198497510501522, 0.0, 0.0))
+
+
+@pytest.mark.parametrize("observer_mass", [0.1, 0.3])
+def test_a_heavy_observer_keeps_the_sliding_spring_at_the_cap(observer_mass):
+    """The sliding mode keeps |s| = s_cap through ds_cap/dt, which holds the penetration's
+    acceleration rho''.  Taken as the contact's own (-F_n/m* + g), a heavy observer's
+    share of rho'' was missing: |s| drifted to 3 s_cap, the dissipated work fell by 0.3 J
+    and the run stalled on 1e5 mode changes.  Oracles: the cap itself (|s| <= s_cap to
+    the tolerance at every sliding sample), the dissipation rate >= 0 at every sample,
+    and the energy balance."""
+    scene = _heavy_observer_scene(observer_mass)
+    result = ballc.simulate(scene, 0.3, rtol=1e-8, atol=1e-10, max_nfev=200_000)
+    assert result.status == 0, result.message
+    p = scene.parameter_vector()
+    rates = np.array([_core.rhs(np.ascontiguousarray(y), p, np.ascontiguousarray(latch),
+                                int(flags))[STATE["dissipated_tangential"]]
+                      for y, latch, flags in zip(result.y.T, result.latch.T, result.flags)])
+    assert np.all(rates >= -1e-9), rates.min()
+    assert np.all(np.diff(result.y[STATE["dissipated_tangential"]]) >= -1e-12)
+    sliding = (result.flags & _core.FLAGS["floor_compliant_sliding"]) != 0
+    assert sliding.sum() > 10   # the case slides
+    for k in np.flatnonzero(sliding):
+        y = np.ascontiguousarray(result.y[:, k])
+        s_cap = compliantmodes.margins(y, p, np.ascontiguousarray(result.latch[:, k]),
+                                       "floor")[2]
+        size = np.hypot(*y[[STATE["floor_deflection_x"], STATE["floor_deflection_y"]]])
+        assert size <= s_cap * (1 + 1e-5) + 1e-12, (result.t[k], size, s_cap)
+    balance = result.energy["balance"]
+    assert np.ptp(balance) < 1e-6 * (abs(balance[0]) + 1)

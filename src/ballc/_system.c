@@ -20,27 +20,33 @@ void ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
     ballc_parameter_constants(params, prepared->constants);
 }
 
-/* Contact laws: which flag switches them on, their kernels, their plane, and (friction
- * only) the kernels of the law's normal share (mu = 0), used under exact Coulomb friction. */
-static const struct { int flag; kernel_fn value, jac; int plane; kernel_fn normal, normal_jac; }
-CONTACT_LAWS[] = {
+/* Contact laws: which flag switches them on, their kernels, their plane, (friction
+ * only) the kernels of the law's normal share (mu = 0), used under exact Coulomb friction,
+ * and (the compliant sliding mode only) the kernel of its rates' coefficients of the exact
+ * penetration acceleration rho'' (codegen: contact.ACCELERATION_LAWS). */
+static const struct {
+    int flag; kernel_fn value, jac; int plane; kernel_fn normal, normal_jac, acceleration;
+} CONTACT_LAWS[] = {
     {BALLC_FLOOR_FRICTION, ballc_floor_friction, ballc_floor_friction_jac, 0,
-     ballc_floor_friction_normal, ballc_floor_friction_normal_jac},
-    {BALLC_FLOOR_DIGIN, ballc_floor_digin, ballc_floor_digin_jac, 0, NULL, NULL},
-    {BALLC_FLOOR_COMPLIANT, ballc_floor_compliant, ballc_floor_compliant_jac, 0, NULL, NULL},
+     ballc_floor_friction_normal, ballc_floor_friction_normal_jac, NULL},
+    {BALLC_FLOOR_DIGIN, ballc_floor_digin, ballc_floor_digin_jac, 0, NULL, NULL, NULL},
+    {BALLC_FLOOR_COMPLIANT, ballc_floor_compliant, ballc_floor_compliant_jac, 0, NULL, NULL,
+     NULL},
     {BALLC_FLOOR_COMPLIANT_SLIDING, ballc_floor_compliant_sliding,
-     ballc_floor_compliant_sliding_jac, 0, NULL, NULL},
+     ballc_floor_compliant_sliding_jac, 0, NULL, NULL,
+     ballc_floor_compliant_sliding_acceleration},
     {BALLC_FLOOR_COMPLIANT_ELASTIC, ballc_floor_compliant_elastic,
-     ballc_floor_compliant_elastic_jac, 0, NULL, NULL},
+     ballc_floor_compliant_elastic_jac, 0, NULL, NULL, NULL},
     {BALLC_CEILING_FRICTION, ballc_ceiling_friction, ballc_ceiling_friction_jac, 1,
-     ballc_ceiling_friction_normal, ballc_ceiling_friction_normal_jac},
-    {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac, 1, NULL, NULL},
+     ballc_ceiling_friction_normal, ballc_ceiling_friction_normal_jac, NULL},
+    {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac, 1, NULL, NULL, NULL},
     {BALLC_CEILING_COMPLIANT, ballc_ceiling_compliant, ballc_ceiling_compliant_jac, 1,
-     NULL, NULL},
+     NULL, NULL, NULL},
     {BALLC_CEILING_COMPLIANT_SLIDING, ballc_ceiling_compliant_sliding,
-     ballc_ceiling_compliant_sliding_jac, 1, NULL, NULL},
+     ballc_ceiling_compliant_sliding_jac, 1, NULL, NULL,
+     ballc_ceiling_compliant_sliding_acceleration},
     {BALLC_CEILING_COMPLIANT_ELASTIC, ballc_ceiling_compliant_elastic,
-     ballc_ceiling_compliant_elastic_jac, 1, NULL, NULL},
+     ballc_ceiling_compliant_elastic_jac, 1, NULL, NULL, NULL},
 };
 #define N_CONTACT_LAWS (sizeof CONTACT_LAWS / sizeof CONTACT_LAWS[0])
 #define LAW_NOUT BALLC_CONTACT_LAW_NOUT
@@ -118,7 +124,17 @@ typedef struct {
     double slip[BALLC_N_PLANES][BALLC_FLOOR_SLIP_NOUT];
     double e[BALLC_N_PLANES][2];                /* sliding: the force direction is -e */
     double lambda[BALLC_N_PLANES][2];           /* sticking: the constraint force */
+    /* the coefficients of rho'' in the auxiliary rates, per plane (0 without) */
+    double acceleration[BALLC_N_PLANES][4];
 } evaluation_t;
+
+/* The exact penetration acceleration rho'' of ``plane`` from the solved udot: rho = r - z
+ * on the floor, z - (H - r) on the ceiling. */
+static double penetration_acceleration(int plane, const double *udot)
+{
+    const double a_z = udot[BALLC_STATE_VZ - NQ];
+    return plane == 0 ? -a_z : a_z;
+}
 
 /* Mass blocks and forcing of everything that acts under ``flags``; the rates of the
  * auxiliary states go to ``xdot`` (indexed by state, may be NULL).  A plane in exact
@@ -144,6 +160,7 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
     for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
         ev->mode[plane] = exact_mode(flags, plane);
         ev->load[plane] = 0.0;
+        for (int i = 0; i < 4; i++) ev->acceleration[plane][i] = 0.0;
     }
     for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
         if (!(flags & CONTACT_LAWS[k].flag)) continue;
@@ -157,6 +174,12 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
         if (!xdot) continue;
         auxiliary_targets(plane, target);
         for (int i = 0; i < 4; i++) xdot[target[i]] += out[BALLC_LAW_DISSIPATION + i];
+        if (CONTACT_LAWS[k].acceleration) {   /* its rho'' share is added after the solve */
+            double coefficients[4];
+            CONTACT_LAWS[k].acceleration(state, PARAMS(params), law_latch(latch, plane),
+                                         coefficients);
+            for (int i = 0; i < 4; i++) ev->acceleration[plane][i] += coefficients[i];
+        }
     }
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
     for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
@@ -293,6 +316,16 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
             xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -=
                 lambda[0] * slip[SLIP_U] + lambda[1] * slip[SLIP_U + 1];
     }
+    if (xdot)
+        for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+            const double *coefficients = ev->acceleration[plane];
+            if (!coefficients[0] && !coefficients[1] && !coefficients[2] && !coefficients[3])
+                continue;
+            int target[4];
+            auxiliary_targets(plane, target);
+            double rho_dd = penetration_acceleration(plane, udot);
+            for (int i = 0; i < 4; i++) xdot[target[i]] += coefficients[i] * rho_dd;
+        }
     return all_finite(udot, NU) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
@@ -387,17 +420,35 @@ int ballc_stick_state(const double *state, const double *params, const double *l
 static const kernel_fn MARGIN_KERNELS[BALLC_N_PLANES] = {
     ballc_floor_compliant_margins, ballc_ceiling_compliant_margins};
 
+/* The margins kernel's outputs: the four margins (the re-stick margin at rho'' = 0),
+ * then the re-stick margin's coefficient of rho''. */
+#define MARGINS_RESTICK_ACCELERATION BALLC_COMPLIANT_MARGINS
+
 int ballc_compliant_margins_prepared(const double *state, const ballc_parameters_t *params,
                                      const double *latch, int plane, double *out)
 {
-    MARGIN_KERNELS[plane](state, PARAMS(params), law_latch(latch, plane), out);
-    return all_finite(out, BALLC_FLOOR_COMPLIANT_MARGINS_NOUT) ? BALLC_OK : BALLC_NOT_FINITE;
+    double m[BALLC_FLOOR_COMPLIANT_MARGINS_NOUT];
+    MARGIN_KERNELS[plane](state, PARAMS(params), law_latch(latch, plane), m);
+    for (int i = 0; i < BALLC_COMPLIANT_MARGINS; i++) out[i] = m[i];
+    if (m[MARGINS_RESTICK_ACCELERATION] != 0) {
+        /* the exact rho'' of the contact sliding at the cap (the elastic law at the cap
+         * applies the same force, so it is the rho'' of either mode there) */
+        int flags = plane == 0 ? BALLC_FLOOR_COMPLIANT_SLIDING : BALLC_CEILING_COMPLIANT_SLIDING;
+        if (params->values[BALLC_PARAMETER_OBSERVER_MASS] != 0) flags |= BALLC_WITH_OBSERVER;
+        schur_t factor;
+        evaluation_t ev;
+        double udot[NU];
+        int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+        if (status != BALLC_OK) return status;
+        out[1] += m[MARGINS_RESTICK_ACCELERATION] * penetration_acceleration(plane, udot);
+    }
+    return all_finite(out, BALLC_COMPLIANT_MARGINS) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 int ballc_compliant_margins(const double *state, const double *params, const double *latch,
                             int plane, double *out)
 {
-    for (int i = 0; i < BALLC_FLOOR_COMPLIANT_MARGINS_NOUT; i++) out[i] = NAN;
+    for (int i = 0; i < BALLC_COMPLIANT_MARGINS; i++) out[i] = NAN;
     if (plane < 0 || plane >= BALLC_N_PLANES) return BALLC_SINGULAR;
     if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
     ballc_parameters_t prepared;

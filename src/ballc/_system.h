@@ -75,9 +75,12 @@ typedef struct {
 
 void ballc_parameters_init(ballc_parameters_t *prepared, const double *params);
 
-/* The compliant law's mode guards on ``plane`` (0 floor, 1 ceiling): out[0] the yield
- * margin 1 - k_t |s| / (mu F_n) (1), out[1] the re-stick margin (m/s), out[2] s_cap =
+/* The compliant law's mode guards on ``plane`` (0 floor, 1 ceiling), BALLC_COMPLIANT_MARGINS
+ * numbers: out[0] the yield margin 1 - k_t |s| / (mu F_n) (1), out[1] the re-stick margin
+ * (m/s, with the exact penetration acceleration of the contact sliding at the cap: one
+ * solve of the dynamics, the observer's share included when it has mass), out[2] s_cap =
  * mu F_n / k_t (m), out[3] k_t (N/m); see contact.compliant_margins. */
+#define BALLC_COMPLIANT_MARGINS 4
 int ballc_compliant_margins(const double *state, const double *params, const double *latch,
                             int plane, double *out);
 /* The same with the parameters prepared (the integrator's adapter: inputs checked). */

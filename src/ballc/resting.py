@@ -38,10 +38,11 @@ friction: the spin never decays, and its energy is counted in criterion 3), a ba
 rolling on the plane (no rolling resistance: it rolls for ever -- the seed scene
 does, at ~0.8 m/s, from t = 30.94 s), a ball rocked by an eccentric observer.
 
-**Uniform rolling** (:func:`rolls`): when the scene's free rotation is exact (massless
-observer, isotropic inertia), a rolling contact that has settled at the equilibrium
-is continued in closed form (see :func:`rolls` for the criterion).  With the seed's
-observer the rolling is not uniform, and is left to the integrator.
+**Uniform rolling or sliding** (:func:`rolls`): when the scene's free rotation is exact
+(massless observer, isotropic inertia), a contact that has settled at the equilibrium
+and rolls, or slides with no force opposing its slip (mu = 0), is continued in closed
+form (see :func:`rolls` for the criterion).  With the seed's observer the rolling is
+not uniform: ballc.orbit continues it as a relative periodic orbit.
 """
 from __future__ import annotations
 

@@ -592,10 +592,13 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         the static Hertz equilibrium below that of an oscillation of 10 tolerances)
         is put in the rest state and the run finishes analytically: ``message`` says
         when, and so does the contact's ``t_rest``; likewise a ball rolling uniformly
-        without slip at the equilibrium, when its rotation is exact (massless observer,
-        isotropic inertia), goes on in closed form (``t_rolling``).  Checked only
-        without ``t_eval`` and user ``events``.  False: integrate to t_end whatever
-        happens.
+        without slip at the equilibrium, or sliding with no force opposing its slip,
+        when its rotation is exact (massless observer, isotropic inertia), goes on in
+        closed form (``t_rolling``, ``t_sliding``), and a ball with an eccentric
+        observer (isotropic inertia) that rolls on with its wobble goes on as a
+        relative periodic orbit, measured over a trial of 3.5 periods (ballc.orbit;
+        ``t_rolling``; the message says what it neglects).  Checked only without
+        ``t_eval`` and user ``events``.  False: integrate to t_end whatever happens.
 
     Returns
     -------
