@@ -482,7 +482,9 @@ def compliant_margins(model: Model, plane: str):
     * re-stick margin (m/s): (e . v_t - max(rhodot, 0)/(2 rho) |s|) - ds_cap/dt, how much
       faster the elastic law would stretch the spring than the cap grows; the sliding
       mode ends where it falls below 0;
-    * s_cap = mu F_n / k_t (m) and k_t (N/m): what a mode change resets to.
+    * s_cap = mu F_n / k_t (m) and k_t (N/m): what a mode change resets to;
+    * capacity margin (N): (mu F_n - |F_el|) - |V| of the elastic mode's viscous
+      damping (capacity_margin), whose zero is a kink the exact modes end a segment at.
 
     The re-stick margin is affine in the exact penetration acceleration rho''
     (penetration_acceleration(plane)), which the C core supplies.
@@ -506,20 +508,37 @@ def compliant_margins(model: Model, plane: str):
     # reads +1 (a sliding contact never re-sticks by losing its load).
     in_contact = sm.Heaviside(f_n, 0)
     idle = 1 - in_contact
+    # the elastic mode's force is F_el = -k_t s (no smooth yield: compliant_elastic_force)
+    capacity = capacity_margin(model, k_t, c.cap, [-k_t * sx, -k_t * sy], slip)
     return [in_contact * yield_margin - idle, in_contact * (stretch - s_cap_rate) + idle,
-            s_cap, k_t]
+            s_cap, k_t, capacity]
+
+
+def _capacity(model: Model, k_t, cap, capped, slip):
+    """(V, the capacity cap - |F_e| left (>= 0), |V|) of capacity_damping (N)."""
+    c_t = 2 * model.p["tangential_damping_ratio"] * _sqrt_positive(effective_mass(model) * k_t)
+    viscous = [-c_t * v for v in slip]
+    spare = _positive(cap - sm.sqrt(sm.Max(capped[0]**2 + capped[1]**2, _FORCE_FLOOR2)))
+    viscous_size = sm.sqrt(sm.Max(viscous[0]**2 + viscous[1]**2, _FORCE_FLOOR2))
+    return viscous, spare, viscous_size
 
 
 def capacity_damping(model: Model, k_t, cap, capped, slip):
     """The viscous tangential force (2) within the capacity the elastic force leaves:
     V = -c_t v_t, c_t = 2 gamma_t sqrt(m* k_t), scaled by
-    alpha = min(1, max(0, cap - |F_e|) / |V|)."""
-    c_t = 2 * model.p["tangential_damping_ratio"] * _sqrt_positive(effective_mass(model) * k_t)
-    viscous = [-c_t * v for v in slip]
-    spare = _positive(cap - sm.sqrt(sm.Max(capped[0]**2 + capped[1]**2, _FORCE_FLOOR2)))
-    viscous_size = sm.sqrt(sm.Max(viscous[0]**2 + viscous[1]**2, _FORCE_FLOOR2))
+    alpha = min(1, max(0, cap - |F_e|) / |V|).  alpha has a kink where the capacity
+    saturates, spare = |V| (capacity_margin): the exact modes end a segment there."""
+    viscous, spare, viscous_size = _capacity(model, k_t, cap, capped, slip)
     alpha = sm.Min(1, spare / viscous_size)
     return [alpha * f for f in viscous]
+
+
+def capacity_margin(model: Model, k_t, cap, capped, slip):
+    """(cap - |F_e|) - |V| (N): > 0 while the viscous force fits in the capacity the
+    elastic force leaves (alpha = 1), < 0 while it is cut to it (capacity_damping);
+    its zero is a kink of the tangential force and of the dissipation rate."""
+    _, spare, viscous_size = _capacity(model, k_t, cap, capped, slip)
+    return spare - viscous_size
 
 
 def compliant_elastic_force(model: Model, plane: str, jacobian_form=False):

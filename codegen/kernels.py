@@ -202,9 +202,11 @@ def build_kernels():
             f"{plane}_compliant_margins",
             f"{plane} contact, the compliant law's mode guards (contact.compliant_margins): "
             "yield margin 1 - k_t |s| / (mu F_n), re-stick margin (m/s) at rho'' = 0, "
-            "s_cap = mu F_n / k_t (m), k_t (N/m), and the re-stick margin's coefficient of "
-            "the exact penetration acceleration rho'' (s).",
-            [margins[0], margins[1].xreplace({accel: 0}), margins[2], margins[3], restick],
+            "s_cap = mu F_n / k_t (m), k_t (N/m), the elastic mode's capacity margin (N) "
+            "and its negative, and the re-stick margin's coefficient of the exact "
+            "penetration acceleration rho'' (s).",
+            [margins[0], margins[1].xreplace({accel: 0}), margins[2], margins[3], margins[4],
+             -margins[4], restick],
             list(contact.latch_symbols(model, plane)),
             "latched rhodot^-, d_x, d_y, d_z of this plane"))
     kernels += output_kernels(model)

@@ -61,11 +61,12 @@ cdef extern from "_system.h":
     int BALLC_FLOOR_SLIP, BALLC_CEILING_SLIP, BALLC_FLOOR_STICK, BALLC_CEILING_STICK
     int BALLC_FLOOR_SLIP_FIXED, BALLC_CEILING_SLIP_FIXED
     int BALLC_FLOOR_COMPLIANT_SLIDING, BALLC_CEILING_COMPLIANT_SLIDING
+    int BALLC_COMPLIANT_MARGINS
     int BALLC_FLOOR_COMPLIANT_ELASTIC, BALLC_CEILING_COMPLIANT_ELASTIC
     int ballc_compliant_margins(const double *, const double *, const double *, int,
                                 double *) nogil
     int ballc_compliant_margins_prepared(const double *, const ballc_parameters_t *,
-                                         const double *, int, double *) nogil
+                                         const double *, int, int, double *) nogil
 
 N_STATES = BALLC_N_STATES
 N_PARAMETERS = BALLC_N_PARAMETERS
@@ -339,10 +340,11 @@ def stick_state(const double[::1] y, const double[::1] params, const double[::1]
 def compliant_margins(const double[::1] y, const double[::1] params, const double[::1] latch,
                       int plane):
     """The compliant law's mode guards on ``plane`` at state y: (yield margin
-    1 - k_t |s| / (mu F_n) (1), re-stick margin (m/s), s_cap = mu F_n / k_t (m), k_t (N/m));
-    see codegen/contact.py, compliant_margins.  Raises if they are not finite."""
+    1 - k_t |s| / (mu F_n) (1), re-stick margin (m/s), s_cap = mu F_n / k_t (m), k_t (N/m),
+    the elastic mode's capacity margin (mu F_n - |F_el|) - |V| (N), its negative); see
+    codegen/contact.py, compliant_margins.  Raises if they are not finite."""
     _check_plane_call(y, params, latch, plane)
-    out = np.empty(4)
+    out = np.empty(BALLC_COMPLIANT_MARGINS)
     cdef double[::1] o = out
     cdef int status = ballc_compliant_margins(&y[0], &params[0], &latch[0], plane, &o[0])
     if status != BALLC_OK:

@@ -104,9 +104,11 @@ ctypedef struct ball_ctx:
     ballc_parameters_t prepared   # params and their constants, prepared once per segment
     double *latch            # writable: a re-armed event may change it
     int flags
-    const int *event_plane   # per event: 0/1 stick release of that plane, 2/3 the
-                             # compliant yield margin, 4/5 its re-stick margin, -1
-                             # linear, -2 - k the user's Python event k
+    int *event_plane         # per event: 0/1 stick release of that plane, 2 + 2 row +
+                             # plane row ``row`` of the compliant margins (0 yield,
+                             # 1 re-stick, 4/5 the capacity margin and its negative), -1
+                             # linear, -2 - k the user's Python event k (writable: a
+                             # capacity guard toggles between rows 4 and 5)
     void *user_events        # list of the user's event callables (borrowed)
     void *errors             # list collecting exceptions raised by them (borrowed)
     void *rearms             # per event: its ``rearm`` callable or None (borrowed)
@@ -125,15 +127,17 @@ cdef int _ball_event(void *ctx, int e, double t, const double *y, double *g) noe
     """The stick-to-slip margin mu N - |lambda| of the event's plane, a compliant mode
     guard (yield or re-stick margin), or a user event."""
     cdef ball_ctx *c = <ball_ctx *>ctx
-    cdef double out[4]
+    cdef double out[6]   # BALLC_COMPLIANT_MARGINS (stick_state's 4 fit)
     cdef int plane = c.event_plane[e]
+    cdef int row
     cdef int status
     if plane <= -2:
         with gil:
             return _user_event(c, -2 - plane, t, y, g)
     if plane >= 2:
-        status = ballc_compliant_margins_prepared(y, &c.prepared, c.latch, plane % 2, out)
-        g[0] = out[(plane - 2) // 2]
+        row = (plane - 2) // 2
+        status = ballc_compliant_margins_prepared(y, &c.prepared, c.latch, plane % 2, row, out)
+        g[0] = out[row]
         return status
     status = ballc_stick_state(y, c.params, c.latch, c.flags, plane, out)
     g[0] = out[3]
@@ -159,9 +163,23 @@ cdef int _user_event(ball_ctx *c, int k, double t, const double *y, double *g) n
         g[0] = NAN
         return -1
 
+#: The codes of the capacity guards (compliant margin rows 4 and 5, per plane): a capacity
+#: guard that fires is re-armed in C to watch the way back (row 4 <-> 5).
+cdef enum:
+    _CAPACITY_FIRST = 2 + 2 * 4
+    _CAPACITY_SECOND = 2 + 2 * 5
+
 cdef int _ball_rearm(void *ctx, int e, double t, const double *y) noexcept nogil:
+    """Re-arm event e at its hit: a capacity guard toggles its row (no Python, no change
+    of the equations: the segment goes on past the kink it ended a step at); any other
+    calls its ``rearm``."""
+    cdef ball_ctx *c = <ball_ctx *>ctx
+    cdef int code = c.event_plane[e]
+    if code >= _CAPACITY_FIRST:
+        c.event_plane[e] = code + 2 if code < _CAPACITY_SECOND else code - 2
+        return 1
     with gil:
-        return _rearm_event(<ball_ctx *>ctx, e, t, y)
+        return _rearm_event(c, e, t, y)
 
 
 cdef int _rearm_event(ball_ctx *c, int e, double t, const double *y) noexcept:
@@ -327,8 +345,8 @@ def _event_arrays(events, int n):
     Returns (m, coef, offset, ints, user callables, rearms); ``ints`` (5 rows):
     terminal, direction, plane (-1 linear, 0..5 a system event, -2 - k the user's event
     k), nonlinear (not evaluated from ``coef``) and re-armable (a terminal linear event
-    with a ``rearm`` callable, see solve_system); ``rearms``: per event, that callable
-    or None."""
+    with a ``rearm`` callable, see solve_system, or a system event that ``toggles``: a
+    compliant capacity guard); ``rearms``: per event, that callable or None."""
     cdef Py_ssize_t m = len(events), k, size = max(len(events), 1)
     coef = np.zeros((size, n))
     reals = np.zeros(size)
@@ -351,6 +369,8 @@ def _event_arrays(events, int n):
             iv[2, k] = int(e.system_event)
             iv[3, k] = 1
             offset[k] = float(getattr(e, "offset", 0.0))
+            if getattr(e, "toggles", False) and terminal_count(getattr(e, "terminal", False)):
+                iv[4, k] = 1   # a capacity guard: re-armed in C (_ball_rearm)
         elif callable(e):
             iv[2, k] = -2 - len(users)
             iv[3, k] = 1

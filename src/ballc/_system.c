@@ -420,17 +420,17 @@ int ballc_stick_state(const double *state, const double *params, const double *l
 static const kernel_fn MARGIN_KERNELS[BALLC_N_PLANES] = {
     ballc_floor_compliant_margins, ballc_ceiling_compliant_margins};
 
-/* The margins kernel's outputs: the four margins (the re-stick margin at rho'' = 0),
- * then the re-stick margin's coefficient of rho''. */
+/* The margins kernel's outputs: the BALLC_COMPLIANT_MARGINS margins (the re-stick margin
+ * at rho'' = 0), then the re-stick margin's coefficient of rho''. */
 #define MARGINS_RESTICK_ACCELERATION BALLC_COMPLIANT_MARGINS
 
 int ballc_compliant_margins_prepared(const double *state, const ballc_parameters_t *params,
-                                     const double *latch, int plane, double *out)
+                                     const double *latch, int plane, int row, double *out)
 {
     double m[BALLC_FLOOR_COMPLIANT_MARGINS_NOUT];
     MARGIN_KERNELS[plane](state, PARAMS(params), law_latch(latch, plane), m);
     for (int i = 0; i < BALLC_COMPLIANT_MARGINS; i++) out[i] = m[i];
-    if (m[MARGINS_RESTICK_ACCELERATION] != 0) {
+    if ((row < 0 || row == 1) && m[MARGINS_RESTICK_ACCELERATION] != 0) {
         /* the exact rho'' of the contact sliding at the cap (the elastic law at the cap
          * applies the same force, so it is the rho'' of either mode there) */
         int flags = plane == 0 ? BALLC_FLOOR_COMPLIANT_SLIDING : BALLC_CEILING_COMPLIANT_SLIDING;
@@ -442,7 +442,8 @@ int ballc_compliant_margins_prepared(const double *state, const ballc_parameters
         if (status != BALLC_OK) return status;
         out[1] += m[MARGINS_RESTICK_ACCELERATION] * penetration_acceleration(plane, udot);
     }
-    return all_finite(out, BALLC_COMPLIANT_MARGINS) ? BALLC_OK : BALLC_NOT_FINITE;
+    return (row < 0 ? all_finite(out, BALLC_COMPLIANT_MARGINS) : isfinite(out[row]))
+           ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 int ballc_compliant_margins(const double *state, const double *params, const double *latch,
@@ -453,7 +454,7 @@ int ballc_compliant_margins(const double *state, const double *params, const dou
     if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
     ballc_parameters_t prepared;
     ballc_parameters_init(&prepared, params);
-    return ballc_compliant_margins_prepared(state, &prepared, latch, plane, out);
+    return ballc_compliant_margins_prepared(state, &prepared, latch, plane, -1, out);
 }
 
 int ballc_remove_slip(const double *state, const double *params, int flags, int plane,

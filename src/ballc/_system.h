@@ -79,13 +79,16 @@ void ballc_parameters_init(ballc_parameters_t *prepared, const double *params);
  * numbers: out[0] the yield margin 1 - k_t |s| / (mu F_n) (1), out[1] the re-stick margin
  * (m/s, with the exact penetration acceleration of the contact sliding at the cap: one
  * solve of the dynamics, the observer's share included when it has mass), out[2] s_cap =
- * mu F_n / k_t (m), out[3] k_t (N/m); see contact.compliant_margins. */
-#define BALLC_COMPLIANT_MARGINS 4
+ * mu F_n / k_t (m), out[3] k_t (N/m), out[4] the elastic mode's capacity margin
+ * (mu F_n - |F_el|) - |V| (N) and out[5] its negative; see contact.compliant_margins. */
+#define BALLC_COMPLIANT_MARGINS 6
 int ballc_compliant_margins(const double *state, const double *params, const double *latch,
                             int plane, double *out);
-/* The same with the parameters prepared (the integrator's adapter: inputs checked). */
+/* The same with the parameters prepared (the integrator's adapter: inputs checked); with
+ * ``row`` >= 0 only out[row] is needed (the re-stick margin's solve is made for row 1
+ * only; the others are then the kernel's values), with -1 all of them. */
 int ballc_compliant_margins_prepared(const double *state, const ballc_parameters_t *params,
-                                     const double *latch, int plane, double *out);
+                                     const double *latch, int plane, int row, double *out);
 
 /* ballc_rhs and ballc_jacobian for callers that have checked once that params and latch
  * are finite and prepared the parameters (the integrator's adapters, per segment): only

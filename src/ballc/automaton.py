@@ -88,6 +88,12 @@ TRANSITIONS = (
                "else elastic with the spring brought back to the cap; where the load "
                "vanished with the spring far below the cap, elastic and disarmed (the "
                "contact's last instants)", "compliant_event"),
+    Transition("capacity", ("elastic",), ("elastic",),
+               "(mu F_n - |F_el|) - |V|, or its negative (its sign at the segment's start), "
+               "+ offset falls through 0: the viscous damping saturates the capacity the "
+               "elastic force leaves, or stops saturating it",
+               "none: the segment ends at that kink of the force and of the dissipation "
+               "rate, so that no step straddles it", "compliant_event"),
     Transition("restick", ("sliding",), ("elastic",),
                "(e . v_t - max(rhodot, 0)/(2 rho) |s|) - ds_cap/dt + offset falls "
                "through 0", "a spring beyond the cap is brought back to it",
@@ -117,7 +123,7 @@ TRANSITIONS = (
 #: compliant guard; the user's events come after the driver's.  A mode change at the
 #: time of the last one counts as stalled, and 100 in a row stop the run (status -1).
 SIMULTANEOUS = ("leave", "enter", "through", "deepest", "approach", "stop", "clear",
-                "release", "arm", "yield", "restick", "user")
+                "release", "arm", "yield", "capacity", "restick", "user")
 
 _HANDLERS = {transition.event: transition.handler for transition in TRANSITIONS}
 

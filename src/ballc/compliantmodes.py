@@ -12,9 +12,15 @@ with two modes per contact (docs/contact_laws.md, "Exact elastic and sliding mod
 * **sliding** (at the cap; the ``<plane>_compliant_sliding`` kernels): F = -mu F_n e,
   e = s/|s|, with |s| = s_cap = mu F_n / k_t and e turning with the slip velocity:
   s' = (v_t - (e . v_t) e) f + s d ln(s_cap)/dt (f = 1 above |s| = 1e-12 m, see
-  contact.TURN_FLOOR).  Guard **restick**: the elastic law would
+  contact.TURN_FLOOR), ds_cap/dt with the exact penetration acceleration (the C core
+  adds its share after solving the dynamics).  Guard **restick**: the elastic law would
   stretch the spring slower than the cap grows, (e . v_t - max(rhodot, 0)/(2 rho) |s|)
   - ds_cap/dt falls below 0.
+
+In the elastic mode a third guard, **capacity** (:func:`capacity_guard`), ends a
+segment without a mode change where the viscous damping saturates the capacity the
+elastic force leaves (or stops saturating it): a kink of the force that an integrator's
+error estimate can step over.
 
 A compliant contact begins where the penetration reaches the arming depth (ARM_ULPS
 ulp of the plane's position, and Hertz's force ARM_FORCE; the impulse before it, below
@@ -49,10 +55,11 @@ from . import _core, layout, stickslip
 PLANES = ("floor", "ceiling")
 MODES = ("elastic", "sliding")
 #: The guards' event kinds: the arming's (a contact starting shallower than the arming
-#: depth), the elastic mode's, the sliding mode's.
-GUARDS = ("arm", "yield", "restick")
+#: depth), the elastic mode's (and its capacity kink's), the sliding mode's.
+GUARDS = ("arm", "yield", "capacity", "restick")
 _DEFLECTION = layout.DEFLECTION
 _DISSIPATED_TANGENTIAL = layout.INDEX["dissipated_tangential"]
+_TANGENTIAL_DAMPING = _core.PARAMETER_NAMES.index("tangential_damping_ratio")
 
 #: The guards are armed once the penetration reaches ARM_ULPS units in the last place of
 #: the plane's position (rho = r - z is resolved to one of them): before, rho's rounding
@@ -92,7 +99,8 @@ def mode_flags(plane: str, mode: str | None, armed: bool = True) -> int:
 
 
 def margins(y, params, latch, plane: str) -> np.ndarray:
-    """(yield margin (1), re-stick margin (m/s), s_cap (m), k_t (N/m)) at state y."""
+    """(yield margin (1), re-stick margin (m/s), s_cap (m), k_t (N/m), capacity margin
+    (N), its negative) at state y (_core.compliant_margins)."""
     return _core.compliant_margins(np.ascontiguousarray(y, dtype=float), params, latch,
                                    PLANES.index(plane))
 
@@ -162,6 +170,31 @@ def guard(scene, mode: str, armed: bool, y0, params, latch, plane: str, rho0: fl
     return "restick", rounding * stickslip.speed_scale(scene, y0) * max(1.0, ratio)
 
 
+#: The capacity guard's rows of :func:`margins`: the capacity margin, and its negative.
+CAPACITY_ROWS = (4, 5)
+
+
+def capacity_guard(scene, y0, params, latch, plane: str, rho0: float, row=None):
+    """(row of :func:`margins`, offset) of the elastic mode's capacity guard on ``plane``
+    for a segment starting at y0, or None without viscous damping: the capacity margin
+    (mu F_n - |F_el|) - |V| crosses 0 where the viscous force saturates the capacity the
+    elastic force leaves, or stops saturating it -- a kink of the tangential force and of
+    the dissipation rate that an integrator's error estimate can step over (radau5 did,
+    at rtol 1e-9: 1.5e-6 J of tangential work, 1e-6 m/s off by t = 5 s).  The segment
+    ends there, in the same mode.  The row (the margin or its negative, falling through
+    0): ``row`` after a capacity event (the other one than the event's: the state there,
+    a step's end point, can sit on the near side of the kink its dense output located,
+    and the margin's sign would fire the same crossing again), else the margin's sign
+    at y0; the offset is its rounding times mu F_n."""
+    if not params[_TANGENTIAL_DAMPING] > 0:
+        return None
+    values = margins(y0, params, latch, plane)
+    if row is None:
+        row = CAPACITY_ROWS[0] if values[CAPACITY_ROWS[0]] >= 0 else CAPACITY_ROWS[1]
+    cap = float(values[2] * values[3])
+    return row, _rounding(scene, plane, rho0) * max(cap, 1e-12)
+
+
 def start(y, params, latch, plane: str):
     """(mode, state) at a contact start (s = 0): the self-similar start s = 2/3 v_t t
     (elastic; for Hunt-Crossley k_t |s| / (mu F_n) = kappa |v_t| / (mu (1 + chi)
@@ -191,7 +224,7 @@ def load_vanished(y, params, latch, plane: str) -> bool:
     so a contact whose spring is (nearly) relaxed "yields" at its last instant.  There
     the guards are disarmed (the smooth-yield kernels take the contact to its end, the
     load ~0), instead of sliding on a spring of rounding-level |s|."""
-    margin, _, s_cap, _ = margins(y, params, latch, plane).tolist()
+    margin, _, s_cap = margins(y, params, latch, plane).tolist()[:3]
     return not s_cap > 0 or margin > 0.5
 
 
@@ -231,7 +264,7 @@ def at_cap(y, params, latch, plane: str, only_down=True) -> np.ndarray:
     size = math.hypot(*s.tolist())
     if not size > 0:
         return y
-    _, _, s_cap, k_t = margins(y, params, latch, plane).tolist()
+    s_cap, k_t = margins(y, params, latch, plane).tolist()[2:4]
     if only_down and size <= s_cap:
         return y
     y[_DEFLECTION[plane]] = s * (s_cap / size)

@@ -144,7 +144,8 @@ def _past(base, far_side):
 
 
 def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
-                   clear=0.0, approach=None, rearm=None, compliant=None, armed=None):
+                   clear=0.0, approach=None, rearm=None, compliant=None, armed=None,
+                   capacity_row=None):
     """Events of one segment starting at state y0: [(kind, plane, event)].
 
     ``coulomb``: each plane's exact-Coulomb mode ("slip", "slip_fixed", "stick" or None;
@@ -158,10 +159,12 @@ def segment_events(scene, in_contact, y0, coulomb=None, params=None, latch=None,
     that plane's approach event (see :class:`LinearEvent`).  ``compliant`` (optional,
     per plane): the compliant law's mode ("elastic", "sliding" or None; see
     ballc.compliantmodes), whose guard ends the segment; ``armed`` (per plane): whether
-    that guard is armed (else the arming depth is the guard).
+    that guard is armed (else the arming depth is the guard); ``capacity_row`` (per
+    plane, optional): the row of the elastic mode's capacity guard after a capacity
+    event (compliantmodes.capacity_guard).
     """
     return SegmentEvents(scene)(in_contact, y0, coulomb, params, latch, flags, clear,
-                                approach, rearm, compliant, armed)
+                                approach, rearm, compliant, armed, capacity_row)
 
 
 class SegmentEvents:
@@ -188,7 +191,8 @@ class SegmentEvents:
                 _deepest_of(plane)))
 
     def __call__(self, in_contact, y0, coulomb=None, params=None, latch=None, flags=0,
-                 clear=0.0, approach=None, rearm=None, compliant=None, armed=None):
+                 clear=0.0, approach=None, rearm=None, compliant=None, armed=None,
+                 capacity_row=None):
         scene = self.scene
         events = []
         append = events.append
@@ -233,6 +237,14 @@ class SegmentEvents:
                     append((kind, plane, rho.shifted(offset, True, 1)))
                 else:
                     append((kind, plane, CompliantGuard(plane, kind, params, latch, offset)))
+                if kind == "yield":   # the elastic mode: its viscous capacity's kink too
+                    capacity = compliantmodes.capacity_guard(
+                        scene, y0, params, latch, plane, rho0,
+                        capacity_row.get(plane) if capacity_row else None)
+                    if capacity is not None:
+                        row, offset = capacity
+                        append(("capacity", plane, CompliantGuard(
+                            plane, "capacity", params, latch, offset, row)))
         return events
 
 
@@ -267,21 +279,26 @@ class StickRelease:
 
 class CompliantGuard:
     """A guard of the compliant law's modes on ``plane`` (see ballc.compliantmodes):
-    ``kind`` "yield" (the elastic mode's end: g = 1 - k_t |s| / (mu F_n) + offset) or
-    "restick" (the sliding mode's end: g = the re-stick margin + offset, m/s), falling
-    through 0.
+    ``kind`` "yield" (the elastic mode's end: g = 1 - k_t |s| / (mu F_n) + offset),
+    "restick" (the sliding mode's end: g = the re-stick margin + offset, m/s) or
+    "capacity" (the elastic mode's viscous capacity saturating or freeing: g = the
+    capacity margin, or its negative (``row``), + offset, N; ends the segment, no mode
+    change), falling through 0.
 
     Callable like a solve_ivp event (evaluated through ``_core``); radau5 reads
     ``system_event`` and ``offset`` and evaluates it in C.
     """
 
-    KINDS = ("yield", "restick")
+    ROWS = {"yield": 0, "restick": 1}   # their rows of compliantmodes.margins
     __slots__ = ("plane", "kind", "system_event", "offset", "terminal", "direction",
-                 "_params", "_latch", "_margin")
+                 "toggles", "_params", "_latch", "_margin")
 
-    def __init__(self, plane: str, kind: str, params, latch, offset: float):
+    def __init__(self, plane: str, kind: str, params, latch, offset: float, row=None):
         self.plane, self.kind = PLANES.index(plane), kind
-        self._margin = self.KINDS.index(kind)   # its row of compliantmodes.margins
+        self._margin = self.ROWS[kind] if row is None else int(row)
+        # a capacity guard that fires where radau5/dop853 stepped to it is re-armed in C
+        # (its other row: the way back) and the segment goes on; else it ends the segment
+        self.toggles = kind == "capacity"
         self.system_event = 2 + 2 * self._margin + self.plane
         self.offset = float(offset)
         self.terminal = True

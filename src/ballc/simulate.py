@@ -34,7 +34,7 @@ _QUATERNION, _DISSIPATED, _DEFLECTION = layout.QUATERNION, layout.DISSIPATED, la
 _CENTRE_XY = layout.rows("x", 2)
 SUCCESS = "The solver successfully reached the end of the integration interval."
 #: Events after which the next segment starts with the last segment's next step size.
-CARRY_STEP = ("approach", "stop", "clear", "release", "arm", "yield", "restick")
+CARRY_STEP = ("approach", "stop", "clear", "release", "arm", "yield", "restick", "capacity")
 
 
 def check_initial_state(scene, y0):
@@ -76,6 +76,9 @@ class _Run:
         self.exact = stickslip.uses_exact_coulomb(scene)
         self.compliant_modes = compliantmodes.uses_modes(scene)
         self.compliant: dict[str, str | None] = {plane: None for plane in PLANES}
+        # the elastic mode's capacity guard row after a capacity event (compliantmodes)
+        self.capacity_row: dict[str, int | None] = {plane: None for plane in PLANES}
+        self.fired = None   # the driver event being handled
         self.armed = {plane: False for plane in PLANES}   # the compliant guards
         self.in_contact = {plane: False for plane in PLANES}
         self.passed: set[str] = set()   # the planes the ball passed through
@@ -154,6 +157,7 @@ class _Run:
         self.contact_step.pop(plane, None)
         self.in_contact[plane] = False
         self.coulomb[plane] = self.approach[plane] = self.compliant[plane] = None
+        self.capacity_row[plane] = None
         contact = self.open.pop(plane)
         contact.t_end = self.t
         contact.velocity_after = y[layout.VELOCITY].copy()
@@ -186,6 +190,7 @@ class _Run:
         """Enter the compliant law's ``mode`` on ``plane`` now; the contact records its
         phases as Coulomb's: "slip" (sliding, at the cap) and "stick" (elastic)."""
         self.compliant[plane] = mode
+        self.capacity_row[plane] = None
         self.transitions[plane] += 1
         self.record_phase(plane, "slip" if mode == "sliding" else "stick")
 
@@ -212,6 +217,10 @@ class _Run:
     def compliant_event(self, kind, plane):
         """The compliant law's next mode after its guard ``kind`` fired on ``plane``."""
         if not self.settles(plane, "the compliant law's elastic/sliding"):
+            return
+        if kind == "capacity":   # a kink of the elastic mode: the segment ends, no change;
+            first, second = compliantmodes.CAPACITY_ROWS   # the next watches the way back
+            self.capacity_row[plane] = second if self.fired._margin == first else first
             return
         if kind == "arm":
             self.armed[plane] = True
@@ -642,7 +651,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         system = Segment(run.params, run.latch, flags)
         driver_events = run.segment_events(run.in_contact, run.y, run.coulomb, run.params,
                                            run.latch, flags, run.clear_speed, run.approach,
-                                           run.rearm_approach, run.compliant, run.armed)
+                                           run.rearm_approach, run.compliant, run.armed,
+                                           run.capacity_row)
         run.rearmed = []
         rest_plane, t_check = run.rest_candidate() if checks_rest else (None, math.inf)
         # a rest check, or the end of a compliant contact's step bound, ends the segment
@@ -764,7 +774,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         if fired >= n_driver:   # a terminal user event
             run.status, run.message = 1, "A termination event occurred."
             break
-        kind, plane, _ = driver_events[fired]
+        kind, plane, run.fired = driver_events[fired]
         run.handle(kind, plane)
         h_next = sol.get("h_next", 0)
         if kind in CARRY_STEP and h_next > 0:
