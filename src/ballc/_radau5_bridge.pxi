@@ -17,7 +17,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from libc.math cimport isfinite
-from libc.string cimport memcpy
+from libc.string cimport memcmp, memcpy
 from libc.math cimport NAN
 
 
@@ -114,6 +114,13 @@ ctypedef struct ball_ctx:
     void *rearms             # per event: its ``rearm`` callable or None (borrowed)
     double *ev_coef_w        # the event arrays radau5 reads (events x N_STATES, events)
     double *ev_offset_w
+    # the last compliant margins computed (a segment's yield and capacity guards read the
+    # same kernel at the same state): the state, the plane (-1: none), whether the
+    # re-stick margin's solve was made, the margins
+    double *margins_y        # N_STATES (a buffer solve_system holds)
+    int margins_plane
+    int margins_solved
+    double margins_out[6]
 
 cdef int _ball_fun(void *ctx, double t, const double *y, double *f) noexcept nogil:
     cdef ball_ctx *c = <ball_ctx *>ctx
@@ -136,8 +143,17 @@ cdef int _ball_event(void *ctx, int e, double t, const double *y, double *g) noe
             return _user_event(c, -2 - plane, t, y, g)
     if plane >= 2:
         row = (plane - 2) // 2
-        status = ballc_compliant_margins_prepared(y, &c.prepared, c.latch, plane % 2, row, out)
-        g[0] = out[row]
+        plane = plane % 2
+        if (c.margins_plane == plane and (row != 1 or c.margins_solved)
+                and memcmp(c.margins_y, y, BALLC_N_STATES * sizeof(double)) == 0):
+            g[0] = c.margins_out[row]   # the same kernel at the same state: its values
+            return BALLC_OK
+        status = ballc_compliant_margins_prepared(y, &c.prepared, c.latch, plane, row,
+                                                  c.margins_out)
+        c.margins_plane = plane if status == BALLC_OK else -1
+        c.margins_solved = row == 1
+        memcpy(c.margins_y, y, BALLC_N_STATES * sizeof(double))
+        g[0] = c.margins_out[row]
         return status
     status = ballc_stick_state(y, c.params, c.latch, c.flags, plane, out)
     g[0] = out[3]
@@ -210,6 +226,7 @@ cdef int _rearm_event(ball_ctx *c, int e, double t, const double *y) noexcept:
                BALLC_N_STATES * sizeof(double))
         c.ev_offset_w[e] = off
         memcpy(c.latch, &lv[0], BALLC_N_LATCH * sizeof(double))
+        c.margins_plane = -1   # the margins read the latch
         return 1
     except BaseException as error:
         errors.append(error)
@@ -694,6 +711,10 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ctx.latch = &lv[0]
     ctx.flags = flags
     ctx.event_plane = &planes[0]
+    margins_state = np.empty(BALLC_N_STATES)
+    cdef double[::1] margins_y = margins_state
+    ctx.margins_y = &margins_y[0]
+    ctx.margins_plane = -1
     users, errors = [], []
     ctx.user_events = <void *>users
     ctx.errors = <void *>errors
