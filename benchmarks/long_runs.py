@@ -1,4 +1,4 @@
-"""Long runs: what the seed scene costs for 10 .. 1e6 s of simulated time (issue 21, item 1).
+"""Long runs: what the seed scene costs for 10 .. 1e9 s of simulated time (issue 21, item 1).
 
     python -m benchmarks.long_runs [--t-ends 10 100 1000 1e6 1e9] [--method radau5]
                                    [--no-figures] [--scenes seed rolling drop] [--out FILE]
@@ -12,7 +12,8 @@ step after the last contact started.  For the largest run, the figures
 (``result.plot()``, ``plot_energy()``, ``plot_observer()``, ``plot_contacts()``, matplotlib
 Agg, not saved) and the animation (GIF) are timed too.  ``--scene drop``: a vertical
 drop without spin or observer (the seed's materials), a ball that truly comes to rest; ``rolling``: the
-seed's throw without its observer, which rolls uniformly (closed form in ballc.resting).  Each scene is run
+seed's throw without its observer, which rolls uniformly (closed form in ballc.resting); the seed scene
+itself ends rolling with its observer's wobble (the orbit of ballc.orbit).  Each scene is run
 with ``rest=True`` (the default: the resting end state of ballc.resting) and with
 ``rest=False`` (the integrator all the way, what the build before ballc.resting did;
 the first 5 s are bit-identical either way), in the same process.  Prints the tables
