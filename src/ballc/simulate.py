@@ -372,6 +372,20 @@ class _Run:
             return None, math.inf
         return plane, self.rest_check.get(plane, math.inf)
 
+    def end_state(self, plane, t_end):
+        """At a rest check: (sample times to t_end, the closed-form solution from now)
+        when the contact with ``plane`` has reached an end state -- rest, uniform
+        rolling or sliding, the orbit of a wobble whose trial ends now -- else None."""
+        if self.check_rest(plane):
+            return np.array([t_end]), resting.Constant(self.y)
+        if self.check_rolling(plane) is not None:
+            rolling = FreeFlight(self.t, self.y, 0.0, t_max=t_end)
+            return resting.rolling_samples(self.t, t_end, rolling.rate), rolling
+        periodic = self.check_orbit(plane, t_end)
+        if periodic is not None:
+            return orbit.sample_times(self.t, t_end, periodic.period), periodic
+        return None
+
     def check_rest(self, plane):
         """At a rest check: True (and the rest state entered) when the contact with
         ``plane`` is at rest (resting.at_rest), else schedule the next check."""
@@ -729,27 +743,12 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                 if t_stop != t_check:   # only a step bound ended: go on with a fresh step
                     first, implicit = None, sol.get("method_end") == "radau5"
                     continue
-                if run.check_rest(rest_plane):
-                    samples.add(np.array([t_end]), run.y[:, None], flags, run.latch)
+                ending = run.end_state(rest_plane, t_end)
+                if ending is not None:   # to t_end in closed form
+                    times, closed = ending
+                    samples.add(times, closed(times), flags, run.latch)
                     if options.dense_output:
-                        pieces.append((run.t, t_end, resting.Constant(run.y)))
-                    run.t = t_end
-                    break
-                if run.check_rolling(rest_plane) is not None:
-                    rolling = FreeFlight(run.t, run.y, 0.0, t_max=t_end)
-                    times = resting.rolling_samples(run.t, t_end, rolling.rate)
-                    samples.add(times, rolling(times), flags, run.latch)
-                    if options.dense_output:
-                        pieces.append((run.t, t_end, rolling))
-                    run.y = samples.last_state.copy()
-                    run.t = t_end
-                    break
-                periodic = run.check_orbit(rest_plane, t_end)
-                if periodic is not None:
-                    times = orbit.sample_times(run.t, t_end, periodic.period)
-                    samples.add(times, periodic(times), flags, run.latch)
-                    if options.dense_output:
-                        pieces.append((run.t, t_end, periodic))
+                        pieces.append((run.t, t_end, closed))
                     run.y = samples.last_state.copy()
                     run.t = t_end
                     break
