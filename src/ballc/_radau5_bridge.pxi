@@ -727,6 +727,8 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  bool(auto_implicit))
     if errors:
         raise errors[0]
+    # each system event's code at the end (a capacity guard re-armed in C has toggled)
+    sol.system_events = planes_array[:len(events or ())]
     return sol
 
 
