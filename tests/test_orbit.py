@@ -174,3 +174,21 @@ def test_the_sampled_orbit_is_its_dense_output():
     run = ballc.simulate(ballc.Scene(), 1e6, dense_output=True)
     late = run.t > run.contacts[-1].t_rolling
     np.testing.assert_allclose(run.sol(run.t[late]), run.y[:, late], rtol=0, atol=1e-12)
+
+
+def test_a_refused_trial_is_not_followed_by_another_at_once(monkeypatch):
+    """A fast-spinning wobbling ball whose wobble still changes refuses trial after trial:
+    the next starts only at the next scheduled rest check, not where the last ended (770
+    back-to-back trials made such a run 78 % slower)."""
+    trials = []
+    init = orbit.Trial.__init__
+
+    def recording(self, plane, t_from, t_to, guess):
+        init(self, plane, t_from, t_to, guess)
+        trials.append((t_from, t_to))
+
+    monkeypatch.setattr(orbit.Trial, "__init__", recording)
+    run = ballc.simulate(ballc.Scene(angular_velocity=(0, 0, 30)), 120.0)
+    assert run.status == 0 and len(trials) >= 2
+    for (_, end), (start, _) in zip(trials, trials[1:]):
+        assert start > end, trials
