@@ -77,6 +77,10 @@ cdef extern from "_driver.h":
     void ballc_drive_free(ballc_drive_output *) nogil
 
 
+DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH = (
+    BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH)
+
+
 def _py_hypot(values):
     """The C port of math.hypot (tests)."""
     cdef double v[8]
