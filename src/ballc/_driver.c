@@ -1,6 +1,10 @@
 /* See _driver.h.  Each step names the Python it reproduces (file:function); the
  * floating-point operations are those of the Python, in its order.  Compiled with the
  * rest of the extension: -std=c99, so no FP contraction (never -ffast-math). */
+#ifdef RADAU5_PROFILE
+#define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
+#include <time.h>
+#endif
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -668,11 +672,24 @@ static int add_later(run_t *r, const radau5_result *res, double after, int flags
 
 /* ---- the loop (simulate.simulate) ---- */
 
+#ifdef RADAU5_PROFILE
+static double thread_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e9 + ts.tv_nsec;
+}
+#endif
+
 int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_output *o)
 {
+    memset(o, 0, sizeof *o);
+#ifdef RADAU5_PROFILE
+    double started = thread_ns();
+    o->profiled = 1;
+#endif
     run_t *r = calloc(1, sizeof(run_t));
     if (!r) return BALLC_DRIVE_NO_MEMORY;
-    memset(o, 0, sizeof *o);
     o->open[0] = o->open[1] = -1;
     o->stiff_at = NAN;
     r->c = c;
@@ -750,6 +767,9 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         int solved = radau5_solve(&pr, &res);
         o->segments++;
         has_first = 0;
+#ifdef RADAU5_PROFILE
+        o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
+#endif
         if (solved != RADAU5_DONE) { radau5_free(&res); rc = -1; break; }
         nfev += res.nfev;
         njev += res.njev;
@@ -843,5 +863,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     free(r->rearmed_t);
     free(r->rearmed_latch);
     free(r);
+#ifdef RADAU5_PROFILE
+    o->drive_ns = thread_ns() - started;
+#endif
     return o->stop_code;
 }

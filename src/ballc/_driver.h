@@ -86,6 +86,10 @@ typedef struct {
     double stiff_at;                    /* NaN: none */
     char message[240];                  /* FAILED: the integrator's message */
     long segments;
+    /* a -DRADAU5_PROFILE build: thread CPU time (ns) inside radau5_solve, summed over
+     * the segments, and in the whole of ballc_drive; zeros otherwise */
+    int profiled;
+    double integrator_ns, drive_ns;
 } ballc_drive_output;
 
 int ballc_drive(const ballc_drive_config *config, const double *y0,

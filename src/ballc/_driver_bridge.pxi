@@ -73,6 +73,8 @@ cdef extern from "_driver.h":
         double stiff_at
         char message[240]
         long segments
+        int profiled
+        double integrator_ns, drive_ns
     int ballc_drive(const ballc_drive_config *, const double *, ballc_drive_output *) nogil
     void ballc_drive_free(ballc_drive_output *) nogil
 
@@ -217,6 +219,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                     in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),
                     transitions=(o.transitions[0], o.transitions[1]), stalled=o.stalled,
                     nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
-                    segments=o.segments)
+                    segments=o.segments, profiled=bool(o.profiled),
+                    integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
     finally:
         ballc_drive_free(&o)

@@ -957,6 +957,8 @@ def _simulate_c(scene, options, y, config):
                     flags=flags, latch=latch, t_events=[], y_events=[], sol=None,
                     method_switches=None)
     result._driver = "c"
+    result._driver_counts = {key: out[key] for key in (
+        "segments", "profiled", "integrator_ns", "drive_ns")}
     stiff_at = out["stiff_at"]
     return _finish(result, options, None if math.isnan(stiff_at) else stiff_at)
 
