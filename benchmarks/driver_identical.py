@@ -12,7 +12,9 @@ a fallback cannot pass vacuously.  Exit status 0 when all are identical, 1 other
 Cases: the comeback map's cells Scene(mixture=m, friction_coefficient=mu), 1.2 s at
 rtol = atol = 1e-3, m in {0, 0.3, 0.7, 1}, mu in {0, 0.2, 0.5, 1}, both methods; the
 seed scene Scene() for 5 s at the default tolerance and at 1e-6, both methods; and a few
-runs that must fall back (t_eval, dense output, compliant law, method "Radau").
+other paths of the C loop (a start in contact, regularised friction, max_step and
+first_step, y0, passing through, the ceiling, a call budget); and runs that must fall
+back (t_eval, dense output, compliant law, a rest check coming due, method "Radau").
 """
 from __future__ import annotations
 
@@ -42,6 +44,28 @@ def cases(quick=False):
         out.append((f"seed 5 s {method} default tol", {}, 5.0, dict(method=method), True))
         out.append((f"seed 5 s {method} 1e-6", {}, 5.0,
                     dict(method=method, rtol=1e-6, atol=1e-6), True))
+    # other paths of the C loop: a start in contact, regularised friction, max_step and
+    # first_step, a user y0, passing through (status 1), the ceiling, a call budget
+    # (status -1)
+    out += [
+        ("start in contact", dict(position=(0, 0, 0.9999), velocity=(0.3, 0, 0),
+                                  angular_velocity=(0, 0, 0), c_tau=0.2), 3.0,
+         dict(method="dop853", rtol=1e-4, atol=1e-4), True),
+        ("regularised friction", dict(friction_regularization="max"), 1.2,
+         dict(method="radau5", rtol=1e-4, atol=1e-4), True),
+        ("max_step, first_step", dict(mixture=0.3, friction_coefficient=0.5), 1.2,
+         dict(method="dop853", rtol=1e-5, atol=1e-5, max_step=0.01, first_step=1e-4), True),
+        ("y0", {}, 1.0, dict(method="radau5", rtol=1e-6, atol=1e-6,
+                            y0=[1, 0.1, 0, 0, 0, 0, 3, 5, 1, 0, 1, 0, -2, 0, 0, 0, 0, 0, 0]),
+         True),
+        ("passing through", dict(velocity=(0, 0, -2000.0), ball_youngs_modulus=1e4), 0.1,
+         dict(method="dop853", rtol=1e-3, atol=1e-3), True),
+        ("ceiling", dict(position=(0, 0, 2.0), velocity=(1.0, 0, 14.0), ceiling_height=5.0,
+                         friction_coefficient=0.6), 2.0,
+         dict(method="dop853", rtol=1e-6, atol=1e-6), True),
+        ("call budget", dict(mixture=0.3, friction_coefficient=0.2), 1.2,
+         dict(method="radau5", rtol=1e-3, atol=1e-3, max_nfev=300), True),
+    ]
     # must fall back
     out += [
         ("fallback: t_eval", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
@@ -50,6 +74,9 @@ def cases(quick=False):
                                                 dense_output=True), False),
         ("fallback: compliant", dict(tangential_model="compliant"), 1.2,
          dict(method="radau5", rtol=1e-3, atol=1e-3), False),
+        ("fallback: a rest check due", dict(position=(0, 0, 0.9999), velocity=(0, 0, 0),
+                                            angular_velocity=(0, 0, 0), c_tau=0.2), 6.0,
+         dict(method="radau5", rtol=1e-4, atol=1e-4), False),
         ("fallback: scipy Radau", {}, 0.3, dict(method="Radau", rtol=1e-3, atol=1e-3), False),
     ]
     return out

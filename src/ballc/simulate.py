@@ -17,8 +17,8 @@ import sys
 
 import numpy as np
 
-from . import (_core, automaton, compliantmodes, events as ev, layout, modes, orbit, outcome,
-               resting, stickslip)
+from . import (_core, _radau5, automaton, compliantmodes, events as ev, layout, modes,
+               orbit, outcome, resting, stickslip)
 from ._format import plain
 from .dense import PiecewiseSolution
 from .flight import FreeFlight, scene_allows as flight_scene_allows
@@ -647,7 +647,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     options = check_options(scene, t_end, method, rtol, atol, max_step, first_step, t_eval,
                             max_nfev, events, dense_output, exact_flight)
     y_start = check_initial_state(scene, y0)
-    if not os.environ.get("BALLC_PYTHON_DRIVER"):
+    if not os.environ.get("BALLC_PYTHON_DRIVER") and _seams_untouched():
         config = _c_config(scene, options, progress, rest)
         if config is not None:
             result = _simulate_c(scene, options, y_start, config)
@@ -840,14 +840,23 @@ def _finish(result, options, stiff_at):
 
 # ---- the segment loop in C (ballc._core.drive, _driver.c; docs/c_loop_plan.md) ----
 #
-# simulate() runs the loop in C when the run is in its subset (_c_config) and the
-# environment variable BALLC_PYTHON_DRIVER is not set (to anything non-empty); the
-# results are bit-identical to the Python loop above (benchmarks/driver_identical.py,
-# tests/test_c_driver.py).  Everything else, and a C run that meets what it does not
-# port (a rest check coming due, a kernel failure where Python raises), runs the Python
-# loop from the start.  ``result._driver`` says which ran ("c" or "python").
+# simulate() runs the loop in C when the run is in its subset (_c_config), the
+# environment variable BALLC_PYTHON_DRIVER is not set (to anything non-empty) and the
+# integrator seam is not wrapped (_seams_untouched).  The results are bit-identical to
+# the Python loop above (benchmarks/driver_identical.py, tests/test_c_driver.py).
+# Everything else, and a C run that meets what it does not port (a rest check coming
+# due, a kernel failure where Python raises), runs the Python loop from the start.  ``result._driver`` says which ran ("c" or "python").
 
 _C_METHODS = ("radau5", "dop853")
+_SEAMS = (integrate_segment, _radau5.solve_system)
+
+
+def _seams_untouched():
+    """Whether the Python driver's seam to the integrators (integrate_segment here,
+    ballc._radau5.solve_system) is the original: a caller that wraps it (a recording,
+    a profile, a test counting segments) instruments the Python driver, so gets it."""
+    return (globals()["integrate_segment"] is _SEAMS[0]
+            and _radau5.solve_system is _SEAMS[1])
 
 
 def _c_config(scene, options, progress, rest):
