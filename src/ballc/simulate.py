@@ -859,17 +859,41 @@ def _seams_untouched():
             and _radau5.solve_system is _SEAMS[1])
 
 
+_NUMERICS_AGREE: list = []   # once per process: [bool]
+
+
+def _c_numerics_agree():
+    """Whether this process's math.hypot and numpy dot are those the C loop reproduces
+    (CPython 3.11's vector_norm, a BLAS ddot of length 3 as an FMA chain): checked once
+    on a few thousand random vectors; if not, every run takes the Python driver."""
+    if not _NUMERICS_AGREE:
+        rng = np.random.default_rng(2022)
+        v = rng.standard_normal((4000, 4)) * np.exp(rng.uniform(-30, 30, (4000, 1)))
+        three = np.ascontiguousarray(v[:, :3])
+        agree = np.array_equal(_core._dot3_fma_many(three),
+                               np.array([row.dot(row) for row in three]))
+        for n in (2, 3, 4):
+            rows = np.ascontiguousarray(v[:, :n])
+            agree = agree and np.array_equal(
+                _core._hypot_many(rows), np.array([math.hypot(*r) for r in rows.tolist()]))
+        _NUMERICS_AGREE.append(bool(agree))
+    return _NUMERICS_AGREE[0]
+
+
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
     in the C loop's subset: method radau5 or dop853, one float atol, no t_eval, user
     events, dense output or progress bar, no compliant law, no exact flight, slip rows of
-    at most 2 terms (sum() of more would be compensated on Python >= 3.12)."""
+    at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
+    process's hypot and dot as the C loop reproduces them (_c_numerics_agree)."""
     if (options.method not in _C_METHODS or options.t_eval is not None or options.events
             or options.dense_output or type(options.atol) is not float):
         return None
     if progress or (progress is None and sys.stderr.isatty()):
         return None
     if scene.tangential_model == "compliant" or compliantmodes.uses_modes(scene):
+        return None
+    if not _c_numerics_agree():
         return None
     params = scene.parameter_vector()
     if options.exact_flight and flight_scene_allows(params):
