@@ -137,3 +137,24 @@ def test_the_fma_dot_is_numpys_dot():
     v = rng.standard_normal((200_000, 3)) * np.exp(rng.uniform(-20, 20, (200_000, 1)))
     theirs = np.array([row.dot(row) for row in v])
     assert np.array_equal(_core._dot3_fma_many(np.ascontiguousarray(v)), theirs)
+
+
+def test_this_process_takes_the_c_loop():
+    """simulate's once-per-process check of hypot and dot passes here (else every run
+    would quietly take the Python driver and the identity tests above would fail)."""
+    import sys
+    assert sys.modules["ballc.simulate"]._c_numerics_agree()
+
+
+def test_a_wrapped_integrator_seam_gets_the_python_driver(monkeypatch):
+    driver = __import__("sys").modules["ballc.simulate"]
+    calls = []
+    original = driver.integrate_segment
+
+    def counting(*args, **kwargs):
+        calls.append(1)
+        return original(*args, **kwargs)
+    monkeypatch.setattr(driver, "integrate_segment", counting)
+    result = _run(monkeypatch, False, ballc.Scene(), 0.5, method="dop853", rtol=1e-3,
+                  atol=1e-3)
+    assert result._driver == "python" and calls
