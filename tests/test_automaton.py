@@ -75,6 +75,9 @@ SCENES = {
 @pytest.fixture(scope="module")
 def transitions():
     with pytest.MonkeyPatch.context() as monkeypatch:
+        # the Python driver's handlers are what this records (the C loop is
+        # bit-identical to it: tests/test_c_driver.py)
+        monkeypatch.setenv("BALLC_PYTHON_DRIVER", "1")
         seen = _record(monkeypatch)
         for name, (make, t_end) in SCENES.items():
             scene, y0 = make()

@@ -409,6 +409,9 @@ def _segments_of(monkeypatch, *args, restart=False, **kwargs):
         calls.append(1)
         return original(*a, **k)
     with monkeypatch.context() as patch:
+        # the Python driver: its hooks are what this counts and patches (the C loop,
+        # bit-identical to it, is checked by tests/test_c_driver.py)
+        patch.setenv("BALLC_PYTHON_DRIVER", "1")
         patch.setattr(driver, "integrate_segment", counting)
         if restart:
             patch.setattr(driver._Run, "rearm_approach", lambda self, plane: None)
@@ -573,6 +576,7 @@ def test_a_slip_from_rest_leaves_along_minus_lambda_and_friction_dissipates(monk
                         float(y[layout.INDEX["vz"]])))
         return found
     monkeypatch.setattr(stickslip, "settle", recording)
+    monkeypatch.setenv("BALLC_PYTHON_DRIVER", "1")   # records the Python driver's settles
     scene = _mixture_throw(mu, m, 1.0, u0, w0)
     result = ballc.simulate(scene, 0.15, rtol=1e-10, atol=1e-10, max_nfev=100_000)
 

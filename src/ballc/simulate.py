@@ -12,14 +12,16 @@ behind ballc.integrate, and a finished run is post-processed by ballc.outcome.
 from __future__ import annotations
 
 import math
+import os
+import sys
 
 import numpy as np
 
-from . import (_core, automaton, compliantmodes, events as ev, layout, modes, orbit, outcome,
-               resting, stickslip)
+from . import (_core, _radau5, automaton, compliantmodes, events as ev, layout, modes,
+               orbit, outcome, resting, stickslip)
 from ._format import plain
 from .dense import PiecewiseSolution
-from .flight import FreeFlight
+from .flight import FreeFlight, scene_allows as flight_scene_allows
 from .integrate import Segment, failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
@@ -644,7 +646,15 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     """
     options = check_options(scene, t_end, method, rtol, atol, max_step, first_step, t_eval,
                             max_nfev, events, dense_output, exact_flight)
-    run = _Run(scene, options, check_initial_state(scene, y0))
+    y_start = check_initial_state(scene, y0)
+    if not os.environ.get("BALLC_PYTHON_DRIVER") and _seams_untouched():
+        config = _c_config(scene, options, progress, rest)
+        if config is not None:
+            result = _simulate_c(scene, options, y_start, config)
+            if result is not None:
+                return result
+    run = _Run(scene, options, y_start)
+    run.driver = "python"
     t_end, t_eval = options.t_end, options.t_eval
     for plane in PLANES:   # a scene may start in contact: latch as documented in modes
         if ev.penetration(plane, scene)(0.0, run.y) > 0:
@@ -814,12 +824,176 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                               for k in user_y],
                     sol=PiecewiseSolution(pieces) if options.dense_output else None,
                     method_switches=switches if options.method == "auto" else None)
+    result._driver = "python"
+    return _finish(result, options, stiff_at)
+
+
+def _finish(result, options, stiff_at):
+    """The post-processing of a finished run (either driver)."""
     outcome.summarize_contact_forces(result)
     result.message += outcome.tolerance_warning(options.rtol, options.atol)
     result.message += outcome.balance_warning(result, options.rtol)
     if options.method == "dop853":   # auto switched to radau5 where the test fired
         result.message += outcome.stiffness_note(stiff_at)
     return result
+
+
+# ---- the segment loop in C (ballc._core.drive, _driver.c; docs/c_loop_plan.md) ----
+#
+# simulate() runs the loop in C when the run is in its subset (_c_config), the
+# environment variable BALLC_PYTHON_DRIVER is not set (to anything non-empty) and the
+# integrator seam is not wrapped (_seams_untouched).  The results are bit-identical to
+# the Python loop above (benchmarks/driver_identical.py, tests/test_c_driver.py).
+# Everything else, and a C run that meets what it does not port (a rest check coming
+# due, a kernel failure where Python raises), runs the Python loop from the start.  ``result._driver`` says which ran ("c" or "python").
+
+_C_METHODS = ("radau5", "dop853")
+_SEAMS = (integrate_segment, _radau5.solve_system)
+
+
+def _seams_untouched():
+    """Whether the Python driver's seam to the integrators (integrate_segment here,
+    ballc._radau5.solve_system) is the original: a caller that wraps it (a recording,
+    a profile, a test counting segments) instruments the Python driver, so gets it."""
+    return (globals()["integrate_segment"] is _SEAMS[0]
+            and _radau5.solve_system is _SEAMS[1])
+
+
+_NUMERICS_AGREE: list = []   # once per process: [bool]
+
+
+def _c_numerics_agree():
+    """Whether this process's math.hypot and numpy dot are those the C loop reproduces
+    (CPython 3.11's vector_norm, a BLAS ddot of length 3 as an FMA chain): checked once
+    on a few thousand random vectors; if not, every run takes the Python driver."""
+    if not _NUMERICS_AGREE:
+        rng = np.random.default_rng(2022)
+        v = rng.standard_normal((4000, 4)) * np.exp(rng.uniform(-30, 30, (4000, 1)))
+        three = np.ascontiguousarray(v[:, :3])
+        agree = np.array_equal(_core._dot3_fma_many(three),
+                               np.array([row.dot(row) for row in three]))
+        for n in (2, 3, 4):
+            rows = np.ascontiguousarray(v[:, :n])
+            agree = agree and np.array_equal(
+                _core._hypot_many(rows), np.array([math.hypot(*r) for r in rows.tolist()]))
+        _NUMERICS_AGREE.append(bool(agree))
+    return _NUMERICS_AGREE[0]
+
+
+def _c_config(scene, options, progress, rest):
+    """The constants of a C run (a dict for _core.drive), or None when the run is not
+    in the C loop's subset: method radau5 or dop853, one float atol, no t_eval, user
+    events, dense output or progress bar, no compliant law, no exact flight, slip rows of
+    at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
+    process's hypot and dot as the C loop reproduces them (_c_numerics_agree)."""
+    if (options.method not in _C_METHODS or options.t_eval is not None or options.events
+            or options.dense_output or type(options.atol) is not float):
+        return None
+    if progress or (progress is None and sys.stderr.isatty()):
+        return None
+    if scene.tangential_model == "compliant" or compliantmodes.uses_modes(scene):
+        return None
+    if not _c_numerics_agree():
+        return None
+    params = scene.parameter_vector()
+    if options.exact_flight and flight_scene_allows(params):
+        return None
+    terms = [stickslip.slip_terms(params, plane) for plane in PLANES]
+    if any(len(row) > 2 for rows in terms for row in rows):
+        return None
+    observer = _core.FLAGS["observer"] if scene.observer_mass != 0 else 0
+    segment_events = ev.SegmentEvents(scene)
+    planes = segment_events.planes
+    resting_plane = resting.resting_plane(scene)
+    period = resting.REST_PERIODS * resting.oscillation_period(scene) \
+        if resting_plane is not None else math.inf
+    flags = _core.FLAGS
+    return dict(
+        params=params, rtol=options.rtol, atol=options.atol, t_end=options.t_end,
+        max_step=float(options.max_step), first_step=options.first_step,
+        max_nfev=options.max_nfev, method=options.method, observer_bits=observer,
+        contact_bits=[modes.flags(scene, {p: p == plane for p in PLANES}) ^ observer
+                      for plane in PLANES],
+        slip_bits=[flags[f"{plane}_slip"] for plane in PLANES],
+        slip_fixed_bits=[flags[f"{plane}_slip_fixed"] for plane in PLANES],
+        stick_bits=[flags[f"{plane}_stick"] for plane in PLANES],
+        exact=int(stickslip.uses_exact_coulomb(scene)), radius=float(scene.radius),
+        weight=(scene.mass + scene.observer_mass) * abs(scene.gravity),
+        hertz_k=scene.hertz_stiffness, total_mass=scene.mass + scene.observer_mass,
+        rest_period=period,
+        resting_plane=-1 if resting_plane is None else PLANES.index(resting_plane),
+        checks_rest=int(bool(rest)),
+        rho_scale=[entry[3] for entry in planes], rho_offset=[entry[4] for entry in planes],
+        through_offset=[entry[7].offset for entry in planes],
+        threshold_base=[entry[5] for entry in planes],
+        slip_terms=terms,
+        slip_map=np.ascontiguousarray([stickslip.slip_map(params, plane) for plane in PLANES]))
+
+
+def _simulate_c(scene, options, y, config):
+    """simulate() with the loop in C; None when it needs the Python loop."""
+    out = _core.drive(config["params"], y, config)
+    if out is None:
+        return None
+    counts = out["counts"]
+    t = out["t"]
+    states = out["rows"].T
+    flags = np.repeat(out["block_flags"], counts)
+    latch = np.repeat(out["latches"], counts, axis=0).T
+    contacts = []
+    for rec in out["contacts"]:
+        rate = np.float64(rec["rate"]) if rec["rate_is_kernel_value"] else rec["rate"]
+        contact = Contact(plane=PLANES[rec["plane"]], t_start=rec["t_start"],
+                          velocity_before=np.array(rec["v_before"]),
+                          angular_velocity_before=np.array(rec["w_before"]),
+                          penetration_rate_at_impact=rate,
+                          digin_direction=np.array(rec["digin"]))
+        contact.max_penetration = rec["max_penetration"]
+        if not math.isnan(rec["contact_point"][0]):
+            contact.contact_point = np.array(rec["contact_point"])
+        if rec["ended"]:
+            contact.t_end = rec["t_end"]
+            contact.velocity_after = np.array(rec["v_after"])
+            contact.angular_velocity_after = np.array(rec["w_after"])
+            contact.energy_lost_normal, contact.energy_lost_tangential = rec["lost"]
+        if rec["passed_through"]:
+            contact.max_penetration = scene.radius
+        contacts.append(contact)
+    for k, when, phase in out["phases"]:
+        contacts[k].transitions.append((when, "stick" if phase else "slip"))
+    if counts[-1]:   # still in contact at the end
+        last = states[:, -1]
+        for k in out["open"]:
+            if k >= 0:
+                plane = contacts[k].plane
+                record_depth(contacts[k], ev.penetration(plane, scene)(0, last), last)
+    code, status = out["stop_code"], out["status"]
+    message = SUCCESS
+    if code == _core.DRIVE_FAILED:
+        reason = out["message"]
+        if "max_nfev" in reason:
+            reason = (f"gave up after {out['nfev']} right-hand-side evaluations in all "
+                      f"(max_nfev = {options.max_nfev})")
+        in_contact = dict(zip(PLANES, out["in_contact"]))
+        message = (f"integrator failed at t = {out['fail_end']:.6g} s: {reason}"
+                   + failure_hint(scene, in_contact, options.atol))
+    elif code == _core.DRIVE_UNSETTLED:
+        plane = PLANES[out["stop_plane"]]
+        message = (f"stick-slip transitions on the {plane} did not settle: "
+                   f"{out['transitions'][out['stop_plane']]} mode changes in one contact, "
+                   f"{out['stalled']} of them at t = {out['t_run']:.17g} s")
+    elif code == _core.DRIVE_THROUGH:
+        message = (f"ball passed through the {PLANES[out['stop_plane']]} at t = "
+                   f"{out['t_run']:.6g} s (penetration reached the ball's radius)")
+    result = Result(t=t, y=states, scene=scene, status=status, message=message,
+                    nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], contacts=contacts,
+                    flags=flags, latch=latch, t_events=[], y_events=[], sol=None,
+                    method_switches=None)
+    result._driver = "c"
+    result._driver_counts = {key: out[key] for key in (
+        "segments", "profiled", "integrator_ns", "drive_ns")}
+    stiff_at = out["stiff_at"]
+    return _finish(result, options, None if math.isnan(stiff_at) else stiff_at)
 
 
 def record_depth(contact, depth, y):

@@ -1,0 +1,150 @@
+"""Do the C segment loop and the Python one give the same bits?  (docs/c_loop_plan.md)
+
+    python -m benchmarks.driver_identical [--quick]
+
+One process: each case runs with the Python driver (BALLC_PYTHON_DRIVER=1) and with the
+default (the C loop where the run is in its subset), and every output is compared:
+t, y, flags, latch (np.array_equal, NaN equal to NaN, and dtype and memory order),
+status, message, nfev/njev/nlu, t_events/y_events and every field of every contact
+(value and type).  A case marked C-eligible fails if it ran in Python (``_driver``), so
+a fallback cannot pass vacuously.  Exit status 0 when all are identical, 1 otherwise.
+
+Cases: the comeback map's cells Scene(mixture=m, friction_coefficient=mu), 1.2 s at
+rtol = atol = 1e-3, m in {0, 0.3, 0.7, 1}, mu in {0, 0.2, 0.5, 1}, both methods; the
+seed scene Scene() for 5 s at the default tolerance and at 1e-6, both methods; and a few
+other paths of the C loop (a start in contact, regularised friction, max_step and
+first_step, y0, passing through, the ceiling, a call budget); and runs that must fall
+back (t_eval, dense output, compliant law, a rest check coming due, method "Radau").
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+import numpy as np
+
+import ballc
+
+METHODS = ("dop853", "radau5")
+
+
+def cases(quick=False):
+    mixtures = (0.0, 0.3, 0.7, 1.0)
+    mus = (0.0, 0.2, 0.5, 1.0)
+    if quick:
+        mixtures, mus = (0.0, 0.3), (0.2, 1.0)
+    out = []
+    for m in mixtures:
+        for mu in mus:
+            for method in METHODS:
+                out.append((f"map m={m} mu={mu} {method}", dict(mixture=m, friction_coefficient=mu),
+                            1.2, dict(method=method, rtol=1e-3, atol=1e-3), True))
+    for method in METHODS:
+        out.append((f"seed 5 s {method} default tol", {}, 5.0, dict(method=method), True))
+        out.append((f"seed 5 s {method} 1e-6", {}, 5.0,
+                    dict(method=method, rtol=1e-6, atol=1e-6), True))
+    # other paths of the C loop: a start in contact, regularised friction, max_step and
+    # first_step, a user y0, passing through (status 1), the ceiling, a call budget
+    # (status -1)
+    out += [
+        ("start in contact", dict(position=(0, 0, 0.9999), velocity=(0.3, 0, 0),
+                                  angular_velocity=(0, 0, 0), c_tau=0.2), 3.0,
+         dict(method="dop853", rtol=1e-4, atol=1e-4), True),
+        ("regularised friction", dict(friction_regularization="max"), 1.2,
+         dict(method="radau5", rtol=1e-4, atol=1e-4), True),
+        ("max_step, first_step", dict(mixture=0.3, friction_coefficient=0.5), 1.2,
+         dict(method="dop853", rtol=1e-5, atol=1e-5, max_step=0.01, first_step=1e-4), True),
+        ("y0", {}, 1.0, dict(method="radau5", rtol=1e-6, atol=1e-6,
+                            y0=[1, 0.1, 0, 0, 0, 0, 3, 5, 1, 0, 1, 0, -2, 0, 0, 0, 0, 0, 0]),
+         True),
+        ("passing through", dict(velocity=(0, 0, -2000.0), ball_youngs_modulus=1e4), 0.1,
+         dict(method="dop853", rtol=1e-3, atol=1e-3), True),
+        ("ceiling", dict(position=(0, 0, 2.0), velocity=(1.0, 0, 14.0), ceiling_height=5.0,
+                         friction_coefficient=0.6), 2.0,
+         dict(method="dop853", rtol=1e-6, atol=1e-6), True),
+        ("call budget", dict(mixture=0.3, friction_coefficient=0.2), 1.2,
+         dict(method="radau5", rtol=1e-3, atol=1e-3, max_nfev=300), True),
+    ]
+    # must fall back
+    out += [
+        ("fallback: t_eval", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
+                                          t_eval=np.linspace(0, 1.2, 7)), False),
+        ("fallback: dense output", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
+                                                dense_output=True), False),
+        ("fallback: compliant", dict(tangential_model="compliant"), 1.2,
+         dict(method="radau5", rtol=1e-3, atol=1e-3), False),
+        ("fallback: a rest check due", dict(position=(0, 0, 0.9999), velocity=(0, 0, 0),
+                                            angular_velocity=(0, 0, 0), c_tau=0.2), 6.0,
+         dict(method="radau5", rtol=1e-4, atol=1e-4), False),
+        ("fallback: scipy Radau", {}, 0.3, dict(method="Radau", rtol=1e-3, atol=1e-3), False),
+    ]
+    return out
+
+
+def run(scene_kw, t_end, kw, python):
+    if python:
+        os.environ["BALLC_PYTHON_DRIVER"] = "1"
+    else:
+        os.environ.pop("BALLC_PYTHON_DRIVER", None)
+    try:
+        return ballc.simulate(ballc.Scene(**scene_kw), t_end, progress=False, **kw)
+    finally:
+        os.environ.pop("BALLC_PYTHON_DRIVER", None)
+
+
+def same(a, b):
+    """Equal bits and the same type (arrays: dtype, shape, order too)."""
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, np.ndarray):
+        return (a.dtype == b.dtype and a.shape == b.shape
+                and a.flags.f_contiguous == b.flags.f_contiguous
+                and a.flags.c_contiguous == b.flags.c_contiguous
+                and np.array_equal(a, b, equal_nan=a.dtype.kind == "f"))
+    if isinstance(a, (list, tuple)):
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b))
+    if isinstance(a, (float, np.floating)):
+        return (a == b and np.signbit(a) == np.signbit(b)) or (a != a and b != b)
+    if hasattr(a, "__dataclass_fields__"):
+        return all(same(getattr(a, k), getattr(b, k)) for k in a.__dataclass_fields__)
+    return a == b
+
+
+def differences(p, c):
+    found = []
+    for name in ("t", "y", "flags", "latch", "status", "message", "nfev", "njev", "nlu",
+                 "t_events", "y_events", "contacts"):
+        if not same(getattr(p, name), getattr(c, name)):
+            found.append(name)
+    return found
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="a few map cells only")
+    args = parser.parse_args(argv)
+    bad = 0
+    for name, scene_kw, t_end, kw, eligible in cases(args.quick):
+        p = run(scene_kw, t_end, kw, True)
+        c = run(scene_kw, t_end, kw, False)
+        driver = getattr(c, "_driver", "?")
+        if getattr(p, "_driver", "?") != "python":
+            print(f"{name}: BALLC_PYTHON_DRIVER did not select the Python driver")
+            bad += 1
+        diff = differences(p, c)
+        verdict = "identical" if not diff else "DIFFERENT: " + ", ".join(diff)
+        if eligible and driver != "c":
+            verdict += " (FELL BACK to Python)"
+            bad += 1
+        elif not eligible and driver != "python":
+            verdict += " (ran in C but should fall back)"
+            bad += 1
+        bad += bool(diff)
+        print(f"{name:40s} driver={driver:7s} {verdict}", flush=True)
+    print("all identical" if not bad else f"{bad} problem(s)")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,870 @@
+/* See _driver.h.  Each step names the Python it reproduces (file:function); the
+ * floating-point operations are those of the Python, in its order.  Compiled with the
+ * rest of the extension: -std=c99, so no FP contraction (never -ffast-math). */
+#ifdef RADAU5_PROFILE
+#define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
+#include <time.h>
+#endif
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "_driver.h"
+#include "_integrator.h"
+#include "_system.h"
+
+#define N BALLC_N_STATES
+#define NL BALLC_N_LATCH
+#define NLP BALLC_N_LATCH_PER_PLANE
+#define MAX_EVENTS 12
+#define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
+#define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
+
+/* stickslip.py constants */
+#define CLEAR_FACTOR 100.0
+#define PASS_FACTOR 3.0
+#define STOP_FACTOR 10.0
+#define APPROACH_FRACTION 0.5
+#define MAX_RELATCH 1000
+#define MAX_TRANSITIONS 100000
+#define MAX_STALLED 100
+#define MIN_IMPACT_RATE 1e-9
+
+/* ---- numerics that must match CPython and numpy ---- */
+
+/* CPython 3.11 Modules/mathmodule.c: vector_norm, verbatim (asserts dropped). */
+static double vector_norm(long n, double *vec, double max, int found_nan)
+{
+    const double T27 = 134217729.0;     /* ldexp(1.0, 27) + 1.0) */
+    double x, scale, oldcsum, csum = 1.0, frac1 = 0.0, frac2 = 0.0, frac3 = 0.0;
+    double t, hi, lo, h;
+    int max_e;
+    long i;
+
+    if (isinf(max)) {
+        return max;
+    }
+    if (found_nan) {
+        return NAN;
+    }
+    if (max == 0.0 || n <= 1) {
+        return max;
+    }
+    frexp(max, &max_e);
+    if (max_e < -1023) {
+        /* When max_e < -1023, ldexp(1.0, -max_e) would overflow. */
+        for (i = 0; i < n; i++) {
+            vec[i] /= DBL_MIN;          /* convert subnormals to normals */
+        }
+        return DBL_MIN * vector_norm(n, vec, max / DBL_MIN, found_nan);
+    }
+    scale = ldexp(1.0, -max_e);
+    for (i = 0; i < n; i++) {
+        x = vec[i];
+        x *= scale;
+        t = x * T27;
+        hi = t - (t - x);
+        lo = x - hi;
+        x = hi * hi;
+        oldcsum = csum;
+        csum += x;
+        frac1 += (oldcsum - csum) + x;
+        x = 2.0 * hi * lo;
+        oldcsum = csum;
+        csum += x;
+        frac2 += (oldcsum - csum) + x;
+        frac3 += lo * lo;
+    }
+    h = sqrt(csum - 1.0 + (frac1 + frac2 + frac3));
+    x = h;
+    t = x * T27;
+    hi = t - (t - x);
+    lo = x - hi;
+    x = -hi * hi;
+    oldcsum = csum;
+    csum += x;
+    frac1 += (oldcsum - csum) + x;
+    x = -2.0 * hi * lo;
+    oldcsum = csum;
+    csum += x;
+    frac2 += (oldcsum - csum) + x;
+    x = -lo * lo;
+    oldcsum = csum;
+    csum += x;
+    frac3 += (oldcsum - csum) + x;
+    x = csum - 1.0 + (frac1 + frac2 + frac3);
+    return (h + x / (2.0 * h)) / scale;
+}
+
+/* CPython math_hypot (n <= 8 here). */
+double ballc_py_hypot(int n, const double *values)
+{
+    double coordinates[8], max = 0.0;
+    int found_nan = 0;
+    for (int i = 0; i < n; i++) {
+        double x = fabs(values[i]);
+        coordinates[i] = x;
+        found_nan |= isnan(x);
+        if (x > max) max = x;
+    }
+    return vector_norm(n, coordinates, max, found_nan);
+}
+
+/* CPython math_ulp_impl. */
+double ballc_py_ulp(double x)
+{
+    if (isnan(x)) return x;
+    x = fabs(x);
+    if (isinf(x)) return x;
+    double x2 = nextafter(x, INFINITY);
+    if (isinf(x2)) {
+        x2 = nextafter(x, -INFINITY);
+        return x - x2;
+    }
+    return x2 - x;
+}
+
+/* numpy float64 v.dot(v), length 3 (OpenBLAS ddot with FMA on this machine). */
+double ballc_dot3_fma(const double *v)
+{
+    return fma(v[2], v[2], fma(v[1], v[1], v[0] * v[0]));
+}
+
+/* Python max(a, b) / min(a, b) on floats: the first unless the second is larger/smaller. */
+static double py_max(double a, double b) { return b > a ? b : a; }
+static double py_min(double a, double b) { return b < a ? b : a; }
+
+/* ---- growable output ---- */
+
+static int grow(void **p, long *cap, long need, size_t size)
+{
+    if (need <= *cap) return 0;
+    long c = *cap ? *cap : 16;
+    while (c < need) c *= 2;
+    void *q = realloc(*p, (size_t)c * size);
+    if (!q) return -1;
+    *p = q;
+    *cap = c;
+    return 0;
+}
+
+void ballc_drive_free(ballc_drive_output *o)
+{
+    free(o->t); free(o->y); free(o->block_count); free(o->block_flags);
+    free(o->block_latch); free(o->contacts); free(o->phases);
+    o->t = o->y = o->block_latch = NULL;
+    o->block_count = NULL; o->block_flags = NULL; o->contacts = NULL; o->phases = NULL;
+}
+
+/* ---- the run (simulate.py: _Run) ---- */
+
+typedef struct {
+    const ballc_drive_config *c;
+    ballc_drive_output *o;
+    ballc_parameters_t prepared;
+    double t, y[N], latch[NL];
+    int in_contact[2], coulomb[2];
+    double approach[2];
+    int has_approach[2];
+    long relatches[2], transitions[2], stalled;
+    double last_transition;
+    int has_last_transition;
+    double dissipated_at_start[2][2];
+    double rest_check[2];
+    int status, stop_code, stop_plane;
+    int failed_kernel;          /* a C kernel failed where Python raises: fall back */
+    /* this segment's re-arms: (t, latch before) */
+    long n_rearmed, cap_rearmed;
+    double *rearmed_t, *rearmed_latch;
+    /* the segment's events */
+    int n_ev;
+    double ev_coef[MAX_EVENTS * N], ev_offset[MAX_EVENTS];
+    int ev_terminal[MAX_EVENTS], ev_direction[MAX_EVENTS], ev_nonlinear[MAX_EVENTS];
+    int ev_plane_code[MAX_EVENTS], ev_rearm[MAX_EVENTS];
+    int ev_kind[MAX_EVENTS], ev_plane[MAX_EVENTS];
+    int seg_flags;
+} run_t;
+
+enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE };
+
+/* _Run.flags */
+static int run_flags(const run_t *r, int with_coulomb)
+{
+    const ballc_drive_config *c = r->c;
+    int flags = c->observer_bits;
+    for (int p = 0; p < 2; p++) {
+        if (!r->in_contact[p]) continue;
+        flags |= c->contact_bits[p];
+        if (with_coulomb) {
+            if (r->coulomb[p] == BALLC_MODE_SLIP) flags |= c->slip_bits[p];
+            else if (r->coulomb[p] == BALLC_MODE_SLIP_FIXED) flags |= c->slip_fixed_bits[p];
+            else if (r->coulomb[p] == BALLC_MODE_STICK) flags |= c->stick_bits[p];
+        }
+    }
+    return flags;
+}
+
+/* events.LinearEvent.__call__ of the plane's penetration: scale * y[z] + offset */
+static double rho_of(const run_t *r, int p, const double *y)
+{
+    return r->c->rho_scale[p] * y[BALLC_STATE_Z] + r->c->rho_offset[p];
+}
+
+/* simulate.record_depth */
+static void record_depth(ballc_contact_rec *k, double depth, const double *y)
+{
+    if (depth >= k->max_penetration) {
+        k->max_penetration = depth;
+        k->contact_point[0] = y[BALLC_STATE_X];
+        k->contact_point[1] = y[BALLC_STATE_Y];
+    }
+}
+
+/* stickslip.speed_scale */
+static double speed_scale(const run_t *r, const double *y)
+{
+    double s = ballc_py_hypot(3, y + BALLC_STATE_VX)
+               + r->c->radius * ballc_py_hypot(3, y + BALLC_STATE_OMEGA_X);
+    return s + 1e-300;
+}
+
+/* stickslip.error_speed */
+static double error_speed(const run_t *r, const double *y)
+{
+    return r->c->rtol * speed_scale(r, y) + r->c->atol;
+}
+
+/* _Run.slip: u, |u|, error, clear */
+static void slip(const run_t *r, int p, const double *y, double u[2], double *speed,
+                 double *error, double *clear)
+{
+    for (int row = 0; row < 2; row++) {
+        double s = 0.0;   /* sum(): int 0 + the first float, then float adds */
+        for (int k = 0; k < r->c->n_terms[p][row]; k++)
+            s += r->c->term_coef[p][row][k] * y[r->c->term_index[p][row][k]];
+        u[row] = s;
+    }
+    *speed = ballc_py_hypot(2, u);
+    *error = error_speed(r, y);
+    *clear = CLEAR_FACTOR * *error;
+}
+
+/* stickslip.passes_by_zero, with the latched direction */
+static int slips_on_freely(const run_t *r, int p, const double u[2], double speed,
+                           double error, double clear)
+{
+    if (speed > 2 * clear) return 1;
+    const double *d = r->latch + p * NLP + SLIP_D;
+    double along = u[0] * d[0] + u[1] * d[1];
+    double across = sqrt(py_max(u[0] * u[0] + u[1] * u[1] - along * along, 0.0));
+    return across > PASS_FACTOR * error;
+}
+
+static int record_phase(run_t *r, int p, int phase)
+{
+    ballc_drive_output *o = r->o;
+    long k = o->open[p];
+    long last = -1;
+    for (long i = o->n_phases - 1; i >= 0; i--)
+        if (o->phases[i].contact == k) { last = i; break; }
+    if (last >= 0 && o->phases[last].phase == phase) return 0;
+    if (grow((void **)&o->phases, &o->cap_phases, o->n_phases + 1, sizeof(ballc_phase_rec)))
+        return -1;
+    o->phases[o->n_phases].contact = k;
+    o->phases[o->n_phases].t = r->t;
+    o->phases[o->n_phases].phase = phase;
+    o->n_phases++;
+    return 0;
+}
+
+/* _Run.set_mode; direction may be NULL */
+static int set_mode(run_t *r, int p, int mode, const double *direction,
+                    int has_approach, double approach)
+{
+    r->coulomb[p] = mode;
+    r->has_approach[p] = has_approach;
+    r->approach[p] = approach;
+    r->transitions[p] += 1;
+    if (direction) {
+        r->latch[p * NLP + SLIP_D] = direction[0];
+        r->latch[p * NLP + SLIP_D + 1] = direction[1];
+    }
+    return record_phase(r, p, mode == BALLC_MODE_STICK ? 1 : 0);
+}
+
+/* stickslip.force_scale */
+static double force_scale(const run_t *r, double load)
+{
+    return (64 * DBL_EPSILON) * (r->c->weight + fabs(load));
+}
+
+/* _Run.settle -> stickslip.settle */
+static int settle(run_t *r, int p)
+{
+    int base = run_flags(r, 0);
+    double y0[N], out[4];
+    if (ballc_remove_slip(r->y, r->c->params, base, p, y0) != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    int stick_flags = base | r->c->stick_bits[p];
+    if (ballc_stick_state(y0, r->c->params, r->latch, stick_flags, p, out) != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    double size = hypot(out[0], out[1]);   /* np.hypot: libm */
+    memcpy(r->y, y0, sizeof y0);
+    if (out[3] >= -force_scale(r, out[2]) || size == 0)
+        return set_mode(r, p, BALLC_MODE_STICK, NULL, 0, 0.0);
+    double d[2] = {-out[0] / size, -out[1] / size};
+    return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
+}
+
+/* _Run.start_coulomb */
+static int start_coulomb(run_t *r, int p)
+{
+    double u[2], speed, error, clear;
+    slip(r, p, r->y, u, &speed, &error, &clear);
+    if (speed > 2 * clear || speed > 0) {
+        double d[2] = {u[0] / speed, u[1] / speed};
+        return set_mode(r, p, speed > 2 * clear ? BALLC_MODE_SLIP : BALLC_MODE_SLIP_FIXED,
+                        d, 0, 0.0);
+    }
+    return settle(r, p);
+}
+
+/* _Run.begin_contact (with modes.latch_values) */
+static int begin_contact(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    ballc_drive_output *o = r->o;
+    double *y = r->y;
+    double kin[BALLC_CONTACT_KINEMATICS_NOUT];
+    ballc_contact_kinematics(y, c->params, r->prepared.constants, NULL, kin);
+    int k = p * KIN_PER_PLANE;
+    double rho = kin[k], rate = kin[k + 1];
+    const double *v = kin + k + 2;
+    int kernel_rate = 1;
+    if (rho > 0) {
+        double stored = 0.8 * c->hertz_k * pow(rho, 2.5) / c->total_mass;
+        rate = sqrt(rate * rate + stored);
+        kernel_rate = 0;
+    }
+    double speed = sqrt(ballc_dot3_fma(v)), direction[3];
+    if (speed > 0) {
+        for (int i = 0; i < 3; i++) direction[i] = v[i] / speed;
+    } else {
+        direction[0] = direction[1] = 0.0;
+        direction[2] = p == 0 ? -1.0 : 1.0;
+    }
+    if (MIN_IMPACT_RATE > rate) { rate = MIN_IMPACT_RATE; kernel_rate = 0; }
+    int l = p * NLP;
+    r->latch[l] = rate;
+    for (int i = 0; i < 3; i++) r->latch[l + 1 + i] = direction[i];
+    y[p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X] = 0.0;
+    y[p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_Y : BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+    r->in_contact[p] = 1;
+    if (grow((void **)&o->contacts, &o->cap_contacts, o->n_contacts + 1,
+             sizeof(ballc_contact_rec)))
+        return -1;
+    ballc_contact_rec *rec = &o->contacts[o->n_contacts];
+    memset(rec, 0, sizeof *rec);
+    rec->plane = p;
+    rec->t_start = r->t;
+    memcpy(rec->v_before, y + BALLC_STATE_VX, 3 * sizeof(double));
+    memcpy(rec->w_before, y + BALLC_STATE_OMEGA_X, 3 * sizeof(double));
+    rec->rate = rate;
+    rec->rate_is_kernel_value = kernel_rate;
+    memcpy(rec->digin, direction, sizeof direction);
+    rec->max_penetration = 0.0;
+    rec->contact_point[0] = rec->contact_point[1] = NAN;
+    rec->t_end = NAN;
+    record_depth(rec, rho_of(r, p, y), y);
+    o->open[p] = (int)o->n_contacts;
+    o->n_contacts++;
+    r->dissipated_at_start[p][0] = y[BALLC_STATE_DISSIPATED_NORMAL];
+    r->dissipated_at_start[p][1] = y[BALLC_STATE_DISSIPATED_TANGENTIAL];
+    r->relatches[p] = r->transitions[p] = 0;
+    r->rest_check[p] = p == c->resting_plane ? r->t + c->rest_period : INFINITY;
+    if (c->exact) return start_coulomb(r, p);
+    return 0;
+}
+
+/* _Run.end_contact */
+static void end_contact(run_t *r, int p)
+{
+    ballc_drive_output *o = r->o;
+    r->rest_check[p] = INFINITY;
+    r->in_contact[p] = 0;
+    r->coulomb[p] = BALLC_MODE_NONE;
+    r->has_approach[p] = 0;
+    ballc_contact_rec *rec = &o->contacts[o->open[p]];
+    o->open[p] = -1;
+    rec->ended = 1;
+    rec->t_end = r->t;
+    memcpy(rec->v_after, r->y + BALLC_STATE_VX, 3 * sizeof(double));
+    memcpy(rec->w_after, r->y + BALLC_STATE_OMEGA_X, 3 * sizeof(double));
+    rec->lost[0] = r->y[BALLC_STATE_DISSIPATED_NORMAL] - r->dissipated_at_start[p][0];
+    rec->lost[1] = r->y[BALLC_STATE_DISSIPATED_TANGENTIAL] - r->dissipated_at_start[p][1];
+}
+
+/* _Run.stalled_at / unsettled / settles */
+static long stalled_at(const run_t *r, double t)
+{
+    return (r->has_last_transition && t == r->last_transition) ? r->stalled + 1 : 0;
+}
+
+static int unsettled(const run_t *r, int p, long stalled)
+{
+    return r->transitions[p] >= MAX_TRANSITIONS || stalled >= MAX_STALLED;
+}
+
+/* _Run.coulomb_event */
+static int coulomb_event(run_t *r, int kind, int p)
+{
+    r->stalled = stalled_at(r, r->t);
+    r->last_transition = r->t;
+    r->has_last_transition = 1;
+    if (unsettled(r, p, r->stalled)) {
+        r->status = -1;
+        r->stop_code = BALLC_DRIVE_UNSETTLED;
+        r->stop_plane = p;
+        return 0;
+    }
+    double u[2], speed, error, clear, dir[2];
+    slip(r, p, r->y, u, &speed, &error, &clear);
+    const double *direction = NULL;
+    if (speed > 0) {
+        dir[0] = u[0] / speed;
+        dir[1] = u[1] / speed;
+        direction = dir;
+    }
+    switch (kind) {
+    case K_APPROACH:
+        r->relatches[p] += 1;
+        if (r->relatches[p] <= MAX_RELATCH && slips_on_freely(r, p, u, speed, error, clear))
+            return set_mode(r, p, BALLC_MODE_SLIP, direction, 1,
+                            py_min(clear, APPROACH_FRACTION * speed));
+        return set_mode(r, p, BALLC_MODE_SLIP_FIXED, direction, 0, 0.0);
+    case K_STOP:
+        if (speed <= STOP_FACTOR * error) return settle(r, p);
+        return set_mode(r, p, BALLC_MODE_SLIP, direction, 1,
+                        py_min(clear, APPROACH_FRACTION * speed));
+    case K_CLEAR:
+        return set_mode(r, p, BALLC_MODE_SLIP, direction, 0, 0.0);
+    default: {   /* release */
+        double out[4], y1[N];
+        if (ballc_stick_state(r->y, r->c->params, r->latch, run_flags(r, 1), p, out)
+                != BALLC_OK) {
+            r->failed_kernel = 1;
+            return -1;
+        }
+        double size = hypot(out[0], out[1]);
+        const double *d = NULL;
+        if (size > 0) {
+            dir[0] = -out[0] / size;
+            dir[1] = -out[1] / size;
+            d = dir;
+        }
+        if (ballc_remove_slip(r->y, r->c->params, run_flags(r, 0), p, y1) != BALLC_OK) {
+            r->failed_kernel = 1;
+            return -1;
+        }
+        memcpy(r->y, y1, sizeof y1);
+        return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
+    }
+    }
+}
+
+/* stickslip.slip_stop_coefficients */
+static void stop_coefficients(const run_t *r, int p, const double *d, double *row)
+{
+    const double *a = r->c->slip_map[p][0], *b = r->c->slip_map[p][1];
+    for (int j = 0; j < N; j++) row[j] = d[0] * a[j] + d[1] * b[j];
+}
+
+/* ---- the integrator's callbacks ---- */
+
+static int drv_fun(void *ctx, double t, const double *y, double *f)
+{
+    run_t *r = (run_t *)ctx;
+    (void)t;
+    return ballc_rhs_checked_inputs(y, &r->prepared, r->latch, r->seg_flags, f);
+}
+
+static int drv_jac(void *ctx, double t, const double *y, double *jac)
+{
+    run_t *r = (run_t *)ctx;
+    (void)t;
+    return ballc_jacobian_checked_inputs(y, &r->prepared, r->latch, r->seg_flags, jac);
+}
+
+static int drv_event(void *ctx, int e, double t, const double *y, double *g)
+{
+    run_t *r = (run_t *)ctx;
+    double out[6];
+    (void)t;
+    int status = ballc_stick_state(y, r->c->params, r->latch, r->seg_flags,
+                                   r->ev_plane_code[e], out);
+    g[0] = out[3];
+    return status;
+}
+
+/* _Run.rearm_approach's closure */
+static int drv_rearm(void *ctx, int e, double t, const double *y)
+{
+    run_t *r = (run_t *)ctx;
+    int p = r->ev_plane[e];
+    long stalled = stalled_at(r, t);
+    if (unsettled(r, p, stalled) || r->relatches[p] + 1 > MAX_RELATCH) return 0;
+    double u[2], speed, error, clear;
+    slip(r, p, y, u, &speed, &error, &clear);
+    if (!slips_on_freely(r, p, u, speed, error, clear)) return 0;
+    if (grow((void **)&r->rearmed_t, &r->cap_rearmed, r->n_rearmed + 1, sizeof(double)))
+        return 0;
+    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * NL * sizeof(double));
+    if (!lat) return 0;
+    r->rearmed_latch = lat;
+    r->stalled = stalled;
+    r->last_transition = t;
+    r->has_last_transition = 1;
+    r->relatches[p] += 1;
+    r->rearmed_t[r->n_rearmed] = t;
+    memcpy(r->rearmed_latch + r->n_rearmed * NL, r->latch, NL * sizeof(double));
+    r->n_rearmed++;
+    double d[2] = {u[0] / speed, u[1] / speed};
+    double approach = py_min(clear, APPROACH_FRACTION * speed);
+    if (set_mode(r, p, BALLC_MODE_SLIP, d, 1, approach)) return 0;
+    stop_coefficients(r, p, d, r->ev_coef + (size_t)e * N);
+    r->ev_offset[e] = -approach;
+    return 1;
+}
+
+/* ---- one segment's events (events.SegmentEvents.__call__) ---- */
+
+static int add_event(run_t *r, int kind, int p, const double *coef, int state, double scale,
+                     double offset, int terminal, int direction)
+{
+    int k = r->n_ev++;
+    double *row = r->ev_coef + (size_t)k * N;
+    if (coef) memcpy(row, coef, N * sizeof(double));
+    else {
+        memset(row, 0, N * sizeof(double));
+        if (state >= 0) row[state] = scale;
+    }
+    r->ev_offset[k] = offset;
+    r->ev_terminal[k] = terminal;
+    r->ev_direction[k] = direction;
+    r->ev_nonlinear[k] = 0;
+    r->ev_plane_code[k] = -1;
+    r->ev_rearm[k] = 0;
+    r->ev_kind[k] = kind;
+    r->ev_plane[k] = p;
+    return k;
+}
+
+static int segment_events(run_t *r, int flags)
+{
+    const ballc_drive_config *c = r->c;
+    const double *y0 = r->y;
+    int have_clear = 0;
+    double clear = 0.0;
+    r->n_ev = 0;
+    for (int p = 0; p < 2; p++) {
+        double rho0 = c->rho_scale[p] * y0[BALLC_STATE_Z] + c->rho_offset[p];
+        double base = c->threshold_base[p];
+        if (r->in_contact[p]) {
+            double threshold = py_max(base, -rho0 + base);
+            add_event(r, K_LEAVE, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
+                      c->rho_offset[p] + threshold, 1, -1);
+            add_event(r, K_THROUGH, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
+                      c->through_offset[p], 1, 1);
+            add_event(r, K_DEEPEST, p, NULL, BALLC_STATE_VZ, p == 0 ? -1.0 : 1.0, 0.0, 0, -1);
+        } else {
+            double threshold = py_max(base, rho0 + base);
+            add_event(r, K_ENTER, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
+                      c->rho_offset[p] + (-threshold), 1, 1);
+        }
+        int mode = r->coulomb[p];
+        if (mode == BALLC_MODE_SLIP || mode == BALLC_MODE_SLIP_FIXED) {
+            if (!have_clear) {
+                clear = CLEAR_FACTOR * error_speed(r, y0);
+                have_clear = 1;
+            }
+            double along[N];
+            stop_coefficients(r, p, r->latch + p * NLP + SLIP_D, along);
+            if (mode == BALLC_MODE_SLIP) {
+                double speed = r->has_approach[p] ? r->approach[p] : clear;
+                int k = add_event(r, K_APPROACH, p, along, -1, 0, -speed, 1, -1);
+                r->ev_rearm[k] = 1;
+            } else {
+                double margin = 4 * ballc_py_ulp(speed_scale(r, y0));
+                add_event(r, K_STOP, p, along, -1, 0, margin, 1, -1);
+                add_event(r, K_CLEAR, p, along, -1, 0, -2 * clear, 1, 1);
+            }
+        } else if (mode == BALLC_MODE_STICK) {
+            double out[4];
+            if (ballc_stick_state(y0, c->params, r->latch, flags, p, out) != BALLC_OK) {
+                r->failed_kernel = 1;
+                return -1;
+            }
+            int k = add_event(r, K_RELEASE, p, NULL, -1, 0, force_scale(r, out[2]), 1, -1);
+            r->ev_nonlinear[k] = 1;
+            r->ev_plane_code[k] = p;
+        }
+    }
+    return 0;
+}
+
+/* ---- samples (samples.Samples) ---- */
+
+static int add_block(run_t *r, const double *t, const double *y, long count, int flags,
+                     const double *latch)
+{
+    ballc_drive_output *o = r->o;
+    if (grow((void **)&o->t, &o->cap, o->n + count, sizeof(double))) return -1;
+    double *yy = realloc(o->y, (size_t)(o->cap ? o->cap : 1) * N * sizeof(double));
+    if (!yy) return -1;
+    o->y = yy;
+    long cb = o->cap_blocks;
+    if (grow((void **)&o->block_count, &cb, o->n_blocks + 1, sizeof(long))) return -1;
+    if (cb != o->cap_blocks) {
+        int *f = realloc(o->block_flags, (size_t)cb * sizeof(int));
+        if (!f) return -1;
+        o->block_flags = f;
+        double *l = realloc(o->block_latch, (size_t)cb * NL * sizeof(double));
+        if (!l) return -1;
+        o->block_latch = l;
+        o->cap_blocks = cb;
+    }
+    if (count) {
+        memcpy(o->t + o->n, t, (size_t)count * sizeof(double));
+        memcpy(o->y + (size_t)o->n * N, y, (size_t)count * N * sizeof(double));
+    }
+    o->n += count;
+    o->block_count[o->n_blocks] = count;
+    o->block_flags[o->n_blocks] = flags;
+    memcpy(o->block_latch + (size_t)o->n_blocks * NL, latch, NL * sizeof(double));
+    o->n_blocks++;
+    return 0;
+}
+
+/* Samples.add_later (first = 1: a segment's first sample is its start) */
+static int add_later(run_t *r, const radau5_result *res, double after, int flags)
+{
+    long n = res->n_out, first = 1;
+    const double *t = res->t_out;
+    while (first < n && t[first] <= after) first++;
+    for (long k = 0; k < r->n_rearmed; k++) {
+        double when = r->rearmed_t[k];
+        long cut = 0;   /* searchsorted(t, when, 'right') */
+        while (cut < n && t[cut] <= when) cut++;
+        if (cut < first) cut = first;
+        if (add_block(r, t + first, res->y_out + (size_t)first * N, cut - first, flags,
+                      r->rearmed_latch + (size_t)k * NL))
+            return -1;
+        first = cut;
+    }
+    return add_block(r, t + first, res->y_out + (size_t)first * N, n - first, flags,
+                     r->latch);
+}
+
+/* ---- the loop (simulate.simulate) ---- */
+
+#ifdef RADAU5_PROFILE
+static double thread_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e9 + ts.tv_nsec;
+}
+#endif
+
+int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_output *o)
+{
+    memset(o, 0, sizeof *o);
+#ifdef RADAU5_PROFILE
+    double started = thread_ns();
+    o->profiled = 1;
+#endif
+    run_t *r = calloc(1, sizeof(run_t));
+    if (!r) return BALLC_DRIVE_NO_MEMORY;
+    o->open[0] = o->open[1] = -1;
+    o->stiff_at = NAN;
+    r->c = c;
+    r->o = o;
+    ballc_parameters_init(&r->prepared, c->params);
+    memcpy(r->y, y0, sizeof r->y);
+    r->rest_check[0] = r->rest_check[1] = INFINITY;
+    int rc = 0;
+    for (int i = 0; i < BALLC_N_PARAMETERS; i++)
+        if (!isfinite(c->params[i])) rc = -1;   /* solve_system would raise */
+    for (int p = 0; p < 2 && !rc; p++)
+        if (rho_of(r, p, r->y) > 0) rc = begin_contact(r, p);
+    double t0 = 0.0;
+    if (!rc) rc = add_block(r, &t0, r->y, 1, run_flags(r, 1), r->latch);
+    double atol[N];
+    for (int i = 0; i < N; i++) atol[i] = c->atol;
+    double first = c->first_step;
+    int has_first = c->has_first_step;
+    long nfev = 0, njev = 0, nlu = 0;
+    int stiff_found = 0;
+
+    while (!rc && r->t < c->t_end && r->status == 0) {
+        int flags = run_flags(r, 1);
+        r->seg_flags = flags;
+        if (segment_events(r, flags)) { rc = -1; break; }
+        r->n_rearmed = 0;
+        double t_check = INFINITY;
+        if (c->checks_rest && c->resting_plane >= 0 && r->in_contact[c->resting_plane]
+                && !r->in_contact[1 - c->resting_plane])
+            t_check = r->rest_check[c->resting_plane];
+        double t_stop = c->t_end < t_check ? c->t_end : t_check;
+        for (int i = 0; i < N; i++)
+            if (!isfinite(r->y[i])) rc = -1;
+        for (int i = 0; i < NL; i++)
+            if (!isfinite(r->latch[i])) rc = -1;
+        if (rc) break;
+        radau5_problem pr;
+        memset(&pr, 0, sizeof pr);
+        pr.n = N;
+        pr.fun = drv_fun;
+        pr.jac = drv_jac;
+        pr.ctx = r;
+        pr.t0 = r->t;
+        pr.t_bound = t_stop;
+        pr.y0 = r->y;
+        pr.rtol = c->rtol;
+        pr.atol = atol;
+        pr.max_step = c->max_step;
+        pr.first_step = 0.0;
+        if (has_first) {   /* integrate.integrate_segment, then the bridge's check */
+            double f = py_min(first, t_stop - r->t);
+            if (!(isfinite(f) && 0 < f && f <= fabs(t_stop - r->t))) { rc = -1; break; }
+            pr.first_step = f;
+        }
+        pr.max_nfev = c->max_nfev ? (c->max_nfev - nfev > 1 ? c->max_nfev - nfev : 1) : 0;
+        pr.t_eval = NULL;
+        pr.n_eval = 0;
+        pr.n_events = r->n_ev;
+        pr.ev_coef = r->ev_coef;
+        pr.ev_offset = r->ev_offset;
+        pr.ev_nonlinear = r->ev_nonlinear;
+        pr.ev_fun = drv_event;
+        pr.ev_terminal = r->ev_terminal;
+        pr.ev_direction = r->ev_direction;
+        pr.dense_output = 0;
+        pr.controller = c->controller;
+        pr.outputs_checked = 1;
+        pr.refine_events = 1;
+        pr.ev_rearm = r->ev_rearm;
+        pr.rearm = drv_rearm;
+        pr.method = c->method;
+        pr.jacobian_ahead = 0;
+        pr.auto_implicit = 0;
+        radau5_result res;
+        int solved = radau5_solve(&pr, &res);
+        o->segments++;
+        has_first = 0;
+#ifdef RADAU5_PROFILE
+        o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
+#endif
+        if (solved != RADAU5_DONE) { radau5_free(&res); rc = -1; break; }
+        nfev += res.nfev;
+        njev += res.njev;
+        nlu += res.nlu;
+        if (!stiff_found && isfinite(res.stiff_at)) {
+            o->stiff_at = res.stiff_at;
+            stiff_found = 1;
+        }
+        if (add_later(r, &res, r->t, flags)) { radau5_free(&res); rc = -2; break; }
+        int fired = -1;
+        double t_fired = INFINITY;
+        long fired_hit = -1;
+        for (int e = 0; e < r->n_ev; e++) {
+            long count = 0, last = -1;
+            for (long h = 0; h < res.n_hits; h++)
+                if (res.hit_event[h] == e) { count++; last = h; }
+            if (!count) continue;
+            if (r->ev_kind[e] == K_DEEPEST) {
+                int p = r->ev_plane[e];
+                for (long h = 0; h < res.n_hits; h++)
+                    if (res.hit_event[h] == e) {
+                        const double *yy = res.hit_y + (size_t)h * N;
+                        record_depth(&o->contacts[o->open[p]], rho_of(r, p, yy), yy);
+                    }
+            } else if (r->ev_terminal[e] > 0 && r->ev_terminal[e] <= count
+                       && res.hit_t[last] < t_fired) {
+                fired = e;
+                t_fired = res.hit_t[last];
+                fired_hit = last;
+            }
+        }
+        if (res.status == RADAU5_FAILED) {
+            r->status = -1;
+            r->stop_code = BALLC_DRIVE_FAILED;
+            memcpy(o->message, res.message, sizeof o->message);
+            o->message[sizeof o->message - 1] = 0;
+            o->fail_end = res.n_out ? res.t_out[res.n_out - 1] : r->t;
+            radau5_free(&res);
+            break;
+        }
+        if (res.status == RADAU5_REACHED) {
+            radau5_free(&res);
+            r->t = t_stop;
+            if (t_stop < c->t_end) { rc = -1; break; }   /* a rest check: not ported */
+            break;
+        }
+        if (fired < 0) { radau5_free(&res); rc = -1; break; }
+        double h_next = res.h_next;
+        r->t = t_fired;
+        memcpy(r->y, res.hit_y + (size_t)fired_hit * N, sizeof r->y);
+        radau5_free(&res);
+        double h = ballc_py_hypot(4, r->y + BALLC_STATE_QW);
+        for (int i = 0; i < 4; i++) r->y[BALLC_STATE_QW + i] /= h;
+        int kind = r->ev_kind[fired], p = r->ev_plane[fired];
+        int handled = 0;
+        switch (kind) {
+        case K_ENTER: handled = begin_contact(r, p); break;
+        case K_LEAVE: end_contact(r, p); break;
+        case K_THROUGH: {
+            ballc_contact_rec *rec = &o->contacts[o->open[p]];
+            o->open[p] = -1;
+            rec->passed_through = 1;
+            rec->max_penetration = c->radius;
+            r->in_contact[p] = 0;
+            r->status = 1;
+            r->stop_code = BALLC_DRIVE_THROUGH;
+            r->stop_plane = p;
+            break;
+        }
+        default: handled = coulomb_event(r, kind, p); break;
+        }
+        if (handled) { rc = -1; break; }
+        if (kind >= K_APPROACH && h_next > 0) {   /* CARRY_STEP */
+            first = py_min(h_next, c->max_step);
+            has_first = 1;
+        }
+    }
+    if (rc) r->stop_code = rc == -2 ? BALLC_DRIVE_NO_MEMORY : BALLC_DRIVE_FALLBACK;
+    o->stop_code = r->stop_code;
+    o->status = r->status;
+    o->stop_plane = r->stop_plane;
+    o->t_run = r->t;
+    o->in_contact[0] = r->in_contact[0];
+    o->in_contact[1] = r->in_contact[1];
+    o->transitions[0] = r->transitions[0];
+    o->transitions[1] = r->transitions[1];
+    o->stalled = r->stalled;
+    o->nfev = nfev;
+    o->njev = njev;
+    o->nlu = nlu;
+    free(r->rearmed_t);
+    free(r->rearmed_latch);
+    free(r);
+#ifdef RADAU5_PROFILE
+    o->drive_ns = thread_ns() - started;
+#endif
+    return o->stop_code;
+}

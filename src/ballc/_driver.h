@@ -1,0 +1,99 @@
+/* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0 and 1).
+ *
+ * ballc_drive runs a whole simulation of the "map subset" -- exact Coulomb friction
+ * (or none), no compliant law, no t_eval, no user events, no dense output, no progress
+ * bar, method radau5 or dop853 -- and reproduces the Python driver (simulate.py with
+ * events.py, stickslip.py, modes.py, samples.py) bit for bit: the same floating-point
+ * operations in the same order.  What it does not port ends the run with
+ * BALLC_DRIVE_FALLBACK, and simulate() then runs the Python driver from the start.
+ *
+ * Numerics that must match CPython / numpy exactly (see docs/c_loop_plan.md, 1.5):
+ *   ballc_py_hypot: CPython 3.11's math.hypot (vector_norm), verbatim;
+ *   ballc_py_ulp:   CPython's math.ulp;
+ *   ballc_dot3_fma: numpy's float64 dot of length 3 (OpenBLAS ddot on this machine:
+ *                   fma(c, c, fma(b, b, a * a)), checked by tests/test_c_driver.py).
+ * This file must be compiled as the rest of the extension: -std=c99 (no FP contraction),
+ * never -ffast-math or -march=native.
+ */
+#ifndef BALLC_DRIVER_H
+#define BALLC_DRIVER_H
+
+#include "ballc_kernels.h"
+
+double ballc_py_hypot(int n, const double *values);
+double ballc_py_ulp(double x);
+double ballc_dot3_fma(const double *v);
+
+/* stop codes */
+enum {
+    BALLC_DRIVE_OK = 0,          /* reached t_end (status 0) */
+    BALLC_DRIVE_FAILED = 1,      /* integrator failure (status -1); message, fail_end */
+    BALLC_DRIVE_UNSETTLED = 2,   /* stick-slip did not settle (status -1); stop_plane */
+    BALLC_DRIVE_THROUGH = 3,     /* passed through stop_plane (status 1) */
+    BALLC_DRIVE_FALLBACK = 4,    /* not ported here: run the Python driver */
+    BALLC_DRIVE_NO_MEMORY = 5
+};
+
+enum { BALLC_MODE_NONE = 0, BALLC_MODE_SLIP, BALLC_MODE_SLIP_FIXED, BALLC_MODE_STICK };
+
+typedef struct {                       /* constants of one run, filled by the bridge */
+    const double *params;              /* BALLC_N_PARAMETERS */
+    double rtol, atol;                 /* one atol for all states */
+    double t_end, max_step, first_step;
+    int has_first_step;
+    long max_nfev;                     /* 0: none */
+    int method, controller;
+    int observer_bits;                 /* the observer's flag when it has mass */
+    int contact_bits[2];               /* friction | digin of a plane in contact */
+    int slip_bits[2], slip_fixed_bits[2], stick_bits[2];
+    int exact;                         /* stickslip.uses_exact_coulomb */
+    double radius, weight, hertz_k, total_mass, rest_period;   /* rest: 20 T0 */
+    int resting_plane, checks_rest;    /* -1: none */
+    double rho_scale[2], rho_offset[2], through_offset[2], threshold_base[2];
+    int n_terms[2][2];                 /* slip_terms: plane, row -> at most 2 terms */
+    int term_index[2][2][2];
+    double term_coef[2][2][2];
+    double slip_map[2][2][BALLC_N_STATES];
+} ballc_drive_config;
+
+typedef struct {
+    int plane, ended, passed_through, rate_is_kernel_value;
+    double t_start, t_end, v_before[3], w_before[3], v_after[3], w_after[3];
+    double rate, digin[3], max_penetration, contact_point[2], lost[2];
+} ballc_contact_rec;
+
+typedef struct { long contact; double t; int phase; } ballc_phase_rec;  /* 0 slip, 1 stick */
+
+typedef struct {
+    long n, cap;                        /* samples: t (n), y (n x N_STATES) */
+    double *t, *y;
+    long n_blocks, cap_blocks;          /* blocks: count, flags, latch (N_LATCH) */
+    long *block_count;
+    int *block_flags;
+    double *block_latch;
+    long n_contacts, cap_contacts;
+    ballc_contact_rec *contacts;
+    long n_phases, cap_phases;
+    ballc_phase_rec *phases;
+    int open[2];                        /* open contact per plane, -1 none */
+    /* the end */
+    int stop_code, status, stop_plane;
+    double t_run;                       /* run.t at the end */
+    double fail_end;                    /* FAILED: t[-1] of the segment, or run.t */
+    int in_contact[2];
+    long transitions[2], stalled;
+    long nfev, njev, nlu;
+    double stiff_at;                    /* NaN: none */
+    char message[240];                  /* FAILED: the integrator's message */
+    long segments;
+    /* a -DRADAU5_PROFILE build: thread CPU time (ns) inside radau5_solve, summed over
+     * the segments, and in the whole of ballc_drive; zeros otherwise */
+    int profiled;
+    double integrator_ns, drive_ns;
+} ballc_drive_output;
+
+int ballc_drive(const ballc_drive_config *config, const double *y0,
+                ballc_drive_output *out);
+void ballc_drive_free(ballc_drive_output *out);
+
+#endif

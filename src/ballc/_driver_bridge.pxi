@@ -1,0 +1,225 @@
+# Included by _core.pyx after _radau5_bridge.pxi.  Bridge to the segment loop in C
+# (``_driver.c``, ballc_drive): the constants of one run in, the run's buffers out as
+# arrays.  Only converts: simulate.py decides what runs here (simulate._c_config) and
+# builds the Result; _driver.c computes.
+
+from libc.stdlib cimport free
+
+cdef extern from "_driver.h":
+    double ballc_py_hypot(int n, const double *values) nogil
+    double ballc_py_ulp(double x) nogil
+    double ballc_dot3_fma(const double *v) nogil
+    enum:
+        BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
+        BALLC_DRIVE_FALLBACK, BALLC_DRIVE_NO_MEMORY
+    ctypedef struct ballc_drive_config:
+        const double *params
+        double rtol, atol
+        double t_end, max_step, first_step
+        int has_first_step
+        long max_nfev
+        int method, controller
+        int observer_bits
+        int contact_bits[2]
+        int slip_bits[2]
+        int slip_fixed_bits[2]
+        int stick_bits[2]
+        int exact
+        double radius, weight, hertz_k, total_mass, rest_period
+        int resting_plane, checks_rest
+        double rho_scale[2]
+        double rho_offset[2]
+        double through_offset[2]
+        double threshold_base[2]
+        int n_terms[2][2]
+        int term_index[2][2][2]
+        double term_coef[2][2][2]
+        double slip_map[2][2][19]
+    ctypedef struct ballc_contact_rec:
+        int plane, ended, passed_through, rate_is_kernel_value
+        double t_start, t_end
+        double v_before[3]
+        double w_before[3]
+        double v_after[3]
+        double w_after[3]
+        double rate
+        double digin[3]
+        double max_penetration
+        double contact_point[2]
+        double lost[2]
+    ctypedef struct ballc_phase_rec:
+        long contact
+        double t
+        int phase
+    ctypedef struct ballc_drive_output:
+        long n
+        double *t
+        double *y
+        long n_blocks
+        long *block_count
+        int *block_flags
+        double *block_latch
+        long n_contacts
+        ballc_contact_rec *contacts
+        long n_phases
+        ballc_phase_rec *phases
+        int open[2]
+        int stop_code, status, stop_plane
+        double t_run, fail_end
+        int in_contact[2]
+        long transitions[2]
+        long stalled
+        long nfev, njev, nlu
+        double stiff_at
+        char message[240]
+        long segments
+        int profiled
+        double integrator_ns, drive_ns
+    int ballc_drive(const ballc_drive_config *, const double *, ballc_drive_output *) nogil
+    void ballc_drive_free(ballc_drive_output *) nogil
+
+
+DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH = (
+    BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH)
+
+
+def _py_hypot(values):
+    """The C port of math.hypot (tests)."""
+    cdef double v[8]
+    cdef int i, n = len(values)
+    if n > 8:
+        raise ValueError("at most 8 values")
+    for i in range(n):
+        v[i] = values[i]
+    return ballc_py_hypot(n, v)
+
+
+def _py_ulp(double x):
+    """The C port of math.ulp (tests)."""
+    return ballc_py_ulp(x)
+
+
+def _dot3_fma(const double[::1] v):
+    """The C helper that reproduces numpy's float64 v.dot(v) of length 3 (tests)."""
+    return ballc_dot3_fma(&v[0])
+
+
+def _dot3_fma_many(const double[:, ::1] v):
+    """_dot3_fma per row (tests)."""
+    out = np.empty(v.shape[0])
+    cdef double[::1] o = out
+    cdef Py_ssize_t i
+    for i in range(v.shape[0]):
+        o[i] = ballc_dot3_fma(&v[i, 0])
+    return out
+
+
+def _hypot_many(const double[:, ::1] v):
+    """_py_hypot per row (tests)."""
+    out = np.empty(v.shape[0])
+    cdef double[::1] o = out
+    cdef Py_ssize_t i
+    for i in range(v.shape[0]):
+        o[i] = ballc_py_hypot(<int>v.shape[1], &v[i, 0])
+    return out
+
+
+def drive(const double[::1] params, const double[::1] y0, dict k):
+    """Run the segment loop in C with the constants ``k`` (simulate._c_config).
+    Returns None when the run needs the Python driver (nothing of it is kept), else a
+    dict of the run's samples, contacts, phases and end."""
+    cdef ballc_drive_config c
+    cdef ballc_drive_output o
+    cdef int p, row, j, rc
+    cdef double[::1] tv
+    cdef double[:, ::1] rv, lv
+    cdef ballc_contact_rec rec
+    cdef Py_ssize_t i
+    cdef const double[:, :, ::1] smap = k["slip_map"]
+    if params.shape[0] != BALLC_N_PARAMETERS or y0.shape[0] != BALLC_N_STATES:
+        raise ValueError("params or y0 of the wrong length")
+    c.params = &params[0]
+    c.rtol = k["rtol"]
+    c.atol = k["atol"]
+    c.t_end = k["t_end"]
+    c.max_step = k["max_step"]
+    c.has_first_step = k["first_step"] is not None
+    c.first_step = k["first_step"] if c.has_first_step else 0.0
+    c.max_nfev = 0 if k["max_nfev"] is None else k["max_nfev"]
+    c.method = _method_code(k["method"])
+    c.controller = _controller[0]
+    c.observer_bits = k["observer_bits"]
+    c.exact = k["exact"]
+    c.radius = k["radius"]
+    c.weight = k["weight"]
+    c.hertz_k = k["hertz_k"]
+    c.total_mass = k["total_mass"]
+    c.rest_period = k["rest_period"]
+    c.resting_plane = k["resting_plane"]
+    c.checks_rest = k["checks_rest"]
+    for p in range(2):
+        c.contact_bits[p] = k["contact_bits"][p]
+        c.slip_bits[p] = k["slip_bits"][p]
+        c.slip_fixed_bits[p] = k["slip_fixed_bits"][p]
+        c.stick_bits[p] = k["stick_bits"][p]
+        c.rho_scale[p] = k["rho_scale"][p]
+        c.rho_offset[p] = k["rho_offset"][p]
+        c.through_offset[p] = k["through_offset"][p]
+        c.threshold_base[p] = k["threshold_base"][p]
+        terms = k["slip_terms"][p]
+        for row in range(2):
+            c.n_terms[p][row] = len(terms[row])
+            for j in range(len(terms[row])):
+                c.term_index[p][row][j] = terms[row][j][0]
+                c.term_coef[p][row][j] = terms[row][j][1]
+            for j in range(BALLC_N_STATES):
+                c.slip_map[p][row][j] = smap[p, row, j]
+    with nogil:
+        rc = ballc_drive(&c, &y0[0], &o)
+    try:
+        if rc == BALLC_DRIVE_NO_MEMORY:
+            raise MemoryError("ballc_drive: out of memory")
+        if rc == BALLC_DRIVE_FALLBACK:
+            return None
+        n = o.n
+        t = np.empty(n)
+        rows = np.empty((n, BALLC_N_STATES))
+        if n:
+            tv = t
+            rv = rows
+            memcpy(&tv[0], o.t, n * sizeof(double))
+            memcpy(&rv[0, 0], o.y, n * BALLC_N_STATES * sizeof(double))
+        counts = np.array([o.block_count[i] for i in range(o.n_blocks)], dtype=np.intp)
+        block_flags = np.array([o.block_flags[i] for i in range(o.n_blocks)], dtype=np.int32)
+        latches = np.empty((o.n_blocks, BALLC_N_LATCH))
+        if o.n_blocks:
+            lv = latches
+            memcpy(&lv[0, 0], o.block_latch, o.n_blocks * BALLC_N_LATCH * sizeof(double))
+        contacts = []
+        for i in range(o.n_contacts):
+            rec = o.contacts[i]
+            contacts.append(dict(
+                plane=rec.plane, ended=rec.ended, passed_through=rec.passed_through,
+                rate_is_kernel_value=rec.rate_is_kernel_value,
+                t_start=rec.t_start, t_end=rec.t_end,
+                v_before=[rec.v_before[j] for j in range(3)],
+                w_before=[rec.w_before[j] for j in range(3)],
+                v_after=[rec.v_after[j] for j in range(3)],
+                w_after=[rec.w_after[j] for j in range(3)],
+                rate=rec.rate, digin=[rec.digin[j] for j in range(3)],
+                max_penetration=rec.max_penetration,
+                contact_point=[rec.contact_point[0], rec.contact_point[1]],
+                lost=(rec.lost[0], rec.lost[1])))
+        phases = [(o.phases[i].contact, o.phases[i].t, o.phases[i].phase)
+                  for i in range(o.n_phases)]
+        return dict(t=t, rows=rows, counts=counts, block_flags=block_flags, latches=latches,
+                    contacts=contacts, phases=phases, open=(o.open[0], o.open[1]),
+                    stop_code=o.stop_code, status=o.status, stop_plane=o.stop_plane,
+                    t_run=o.t_run, fail_end=o.fail_end, message=o.message.decode(),
+                    in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),
+                    transitions=(o.transitions[0], o.transitions[1]), stalled=o.stalled,
+                    nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
+                    segments=o.segments, profiled=bool(o.profiled),
+                    integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
+    finally:
+        ballc_drive_free(&o)

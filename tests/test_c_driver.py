@@ -1,0 +1,160 @@
+"""The segment loop in C (_driver.c, ballc._core.drive) against the Python driver: the
+same bits for the runs in its subset, the Python driver for the others
+(docs/c_loop_plan.md; benchmarks/driver_identical.py runs the whole list)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import ballc
+from ballc import _core
+
+FIELDS = ("t", "y", "flags", "latch")
+
+
+def _run(monkeypatch, python, scene, t_end, **kwargs):
+    with monkeypatch.context() as patch:
+        if python:
+            patch.setenv("BALLC_PYTHON_DRIVER", "1")
+        else:
+            patch.delenv("BALLC_PYTHON_DRIVER", raising=False)
+        return ballc.simulate(scene, t_end, progress=False, **kwargs)
+
+
+def _assert_identical(p, c):
+    assert p._driver == "python" and c._driver == "c"
+    for name in FIELDS:
+        a, b = getattr(p, name), getattr(c, name)
+        assert a.dtype == b.dtype and a.flags.f_contiguous == b.flags.f_contiguous, name
+        assert np.array_equal(a, b), name
+    assert (p.status, p.message, p.nfev, p.njev, p.nlu) == (c.status, c.message, c.nfev,
+                                                            c.njev, c.nlu)
+    assert len(p.contacts) == len(c.contacts)
+    for a, b in zip(p.contacts, c.contacts):
+        for field in a.__dataclass_fields__:
+            x, y = getattr(a, field), getattr(b, field)
+            assert type(x) is type(y), field
+            if isinstance(x, np.ndarray):
+                assert np.array_equal(x, y, equal_nan=True), field
+            elif isinstance(x, float):
+                assert x == y or (math.isnan(x) and math.isnan(y)), field
+            else:
+                assert x == y, field
+
+
+@pytest.mark.parametrize("method", ["dop853", "radau5"])
+@pytest.mark.parametrize("mixture, mu", [(0.0, 0.5), (0.3, 0.2), (0.7, 1.0), (1.0, 0.2)])
+def test_map_cells_are_bit_identical(monkeypatch, method, mixture, mu):
+    scene = ballc.Scene(mixture=mixture, friction_coefficient=mu)
+    kw = dict(method=method, rtol=1e-3, atol=1e-3)
+    _assert_identical(_run(monkeypatch, True, scene, 1.2, **kw),
+                      _run(monkeypatch, False, scene, 1.2, **kw))
+
+
+@pytest.mark.parametrize("method", ["dop853", "radau5"])
+def test_the_seed_is_bit_identical(monkeypatch, method):
+    """5 s at the default tolerance: re-latches accepted inside the integrator (the
+    samples split at each), clear events, stops and settles."""
+    scene = ballc.Scene()
+    _assert_identical(_run(monkeypatch, True, scene, 5.0, method=method),
+                      _run(monkeypatch, False, scene, 5.0, method=method))
+
+
+def test_a_failure_and_the_call_budget_are_bit_identical(monkeypatch):
+    scene = ballc.Scene(mixture=0.3, friction_coefficient=0.2)
+    kw = dict(method="dop853", rtol=1e-3, atol=1e-3, max_nfev=300)
+    p = _run(monkeypatch, True, scene, 1.2, **kw)
+    assert p.status == -1
+    _assert_identical(p, _run(monkeypatch, False, scene, 1.2, **kw))
+
+
+@pytest.mark.parametrize("kwargs", [
+    dict(t_eval=np.linspace(0.0, 0.5, 6)), dict(dense_output=True), dict(method="Radau"),
+    dict(method="auto"), dict(events=lambda t, y: y[6] - 0.5),
+    dict(atol=np.full(_core.N_STATES, 1e-3)),
+], ids=["t_eval", "dense_output", "scipy", "auto", "user event", "atol per state"])
+def test_runs_outside_the_subset_fall_back(monkeypatch, kwargs):
+    kwargs = dict(dict(method="dop853", rtol=1e-3, atol=1e-3), **kwargs)
+    result = _run(monkeypatch, False, ballc.Scene(), 0.5, **kwargs)
+    assert result._driver == "python"
+
+
+def test_compliant_scene_and_a_due_rest_check_fall_back(monkeypatch):
+    compliant = _run(monkeypatch, False, ballc.Scene(tangential_model="compliant"), 0.5,
+                     method="radau5", rtol=1e-3, atol=1e-3)
+    assert compliant._driver == "python"
+    # a ball placed on the floor: its rest check falls due at 20 T0 = 4.3 s, which the
+    # C loop does not port -- it falls back and the result is the Python driver's
+    scene = ballc.Scene(position=(0.0, 0.0, 0.9999), velocity=(0.0, 0.0, 0.0),
+                        angular_velocity=(0.0, 0.0, 0.0), c_tau=0.2)
+    c = _run(monkeypatch, False, scene, 6.0, method="radau5", rtol=1e-4, atol=1e-4)
+    p = _run(monkeypatch, True, scene, 6.0, method="radau5", rtol=1e-4, atol=1e-4)
+    assert c._driver == "python"
+    assert np.array_equal(c.t, p.t) and np.array_equal(c.y, p.y)
+
+
+def test_the_python_driver_switch():
+    """BALLC_PYTHON_DRIVER is read per call."""
+    import os
+    scene = ballc.Scene(mixture=0.3, friction_coefficient=0.2)
+    os.environ["BALLC_PYTHON_DRIVER"] = "1"
+    try:
+        assert ballc.simulate(scene, 0.3, method="dop853", rtol=1e-3, atol=1e-3,
+                              progress=False)._driver == "python"
+    finally:
+        del os.environ["BALLC_PYTHON_DRIVER"]
+    assert ballc.simulate(scene, 0.3, method="dop853", rtol=1e-3, atol=1e-3,
+                          progress=False)._driver == "c"
+
+
+# ---- the numerics the C loop must share with CPython and numpy (docs/c_loop_plan.md 1.5)
+
+def test_the_hypot_port_is_math_hypot():
+    rng = np.random.default_rng(22)
+    for n in (2, 3, 4):
+        v = rng.standard_normal((100_000, n)) * np.exp(rng.uniform(-700, 700, (100_000, 1)))
+        v[:100] = rng.standard_normal((100, n)) * 5e-324 * 1e3   # subnormals
+        v[100:110] = 0.0
+        ours = _core._hypot_many(np.ascontiguousarray(v))
+        theirs = np.array([math.hypot(*row) for row in v.tolist()])
+        assert np.array_equal(ours, theirs), n
+
+
+def test_the_ulp_port_is_math_ulp():
+    rng = np.random.default_rng(23)
+    x = rng.standard_normal(50_000) * np.exp(rng.uniform(-700, 700, 50_000))
+    values = x.tolist() + [0.0, 5e-324, 1.7976931348623157e308, -1.0, math.inf]
+    assert all(_core._py_ulp(a) == math.ulp(a) for a in values)
+
+
+def test_the_fma_dot_is_numpys_dot():
+    """modes.latch_values takes |v| as sqrt(v.dot(v)): numpy's (BLAS) dot, which the C
+    loop reproduces as fma(c, c, fma(b, b, a a)).  A BLAS or CPU that sums otherwise
+    fails here (then the C loop is not bit-identical on contact starts)."""
+    rng = np.random.default_rng(24)
+    v = rng.standard_normal((200_000, 3)) * np.exp(rng.uniform(-20, 20, (200_000, 1)))
+    theirs = np.array([row.dot(row) for row in v])
+    assert np.array_equal(_core._dot3_fma_many(np.ascontiguousarray(v)), theirs)
+
+
+def test_this_process_takes_the_c_loop():
+    """simulate's once-per-process check of hypot and dot passes here (else every run
+    would quietly take the Python driver and the identity tests above would fail)."""
+    import sys
+    assert sys.modules["ballc.simulate"]._c_numerics_agree()
+
+
+def test_a_wrapped_integrator_seam_gets_the_python_driver(monkeypatch):
+    driver = __import__("sys").modules["ballc.simulate"]
+    calls = []
+    original = driver.integrate_segment
+
+    def counting(*args, **kwargs):
+        calls.append(1)
+        return original(*args, **kwargs)
+    monkeypatch.setattr(driver, "integrate_segment", counting)
+    result = _run(monkeypatch, False, ballc.Scene(), 0.5, method="dop853", rtol=1e-3,
+                  atol=1e-3)
+    assert result._driver == "python" and calls
