@@ -13,8 +13,9 @@ Cases: the comeback map's cells Scene(mixture=m, friction_coefficient=mu), 1.2 s
 rtol = atol = 1e-3, m in {0, 0.3, 0.7, 1}, mu in {0, 0.2, 0.5, 1}, both methods; the
 seed scene Scene() for 5 s at the default tolerance and at 1e-6, both methods; and a few
 other paths of the C loop (a start in contact, regularised friction, max_step and
-first_step, y0, passing through, the ceiling, a call budget); and runs that must fall
-back (t_eval, dense output, compliant law, a rest check coming due, method "Radau").
+first_step, y0, passing through, the ceiling, a call budget); the rest checks (rest, uniform
+rolling and sliding, checks that find neither); and runs that must fall back (t_eval,
+dense output, compliant law, an orbit's trial, method "Radau").
 """
 from __future__ import annotations
 
@@ -66,6 +67,32 @@ def cases(quick=False):
         ("call budget", dict(mixture=0.3, friction_coefficient=0.2), 1.2,
          dict(method="radau5", rtol=1e-3, atol=1e-3, max_nfev=300), True),
     ]
+    # stage 2a: the rest checks (ballc.resting): rest, uniform rolling and sliding, and
+    # checks that find neither (the next one scheduled)
+    for method in METHODS:
+        out += [
+            (f"drop, rests 1e6 s {method} 1e-6", dict(velocity=(0, 0, 0), observer_mass=0),
+             1e6, dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
+            (f"drop, rests 100 s {method} 1e-4", dict(velocity=(0, 0, 0), observer_mass=0),
+             100.0, dict(method=method, rtol=1e-4, atol=1e-4, exact_flight=False), True),
+            (f"seed 30 s {method} 1e-6 (checks)", {}, 30.0,
+             dict(method=method, rtol=1e-6, atol=1e-6), True),
+            (f"massless observer 100 s {method} 1e-6 (rolls)", dict(observer_mass=0), 100.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
+            (f"massless observer 1e6 s {method} 1e-6 (rolls)", dict(observer_mass=0), 1e6,
+             dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
+            (f"rest {method}", dict(position=(0, 0, 0.9999), velocity=(0, 0, 0),
+                                    angular_velocity=(0, 0, 0), c_tau=0.2, observer_mass=0),
+             6.0, dict(method=method, rtol=1e-4, atol=1e-4, exact_flight=False), True),
+            (f"rest, observer below {method}", dict(position=(0, 0, 0.9999),
+                                                   velocity=(0, 0, 0),
+                                                   angular_velocity=(0, 0, 0), c_tau=0.2,
+                                                   observer_position=(0, 0, -0.5)), 6.0,
+             dict(method=method, rtol=1e-4, atol=1e-4), True),
+            (f"mu=0, no end state {method}", dict(observer_mass=0, friction_coefficient=0.0,
+                                            velocity=(1.0, 0, 0)), 60.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
+        ]
     # must fall back
     out += [
         ("fallback: t_eval", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
@@ -74,9 +101,10 @@ def cases(quick=False):
                                                 dense_output=True), False),
         ("fallback: compliant", dict(tangential_model="compliant"), 1.2,
          dict(method="radau5", rtol=1e-3, atol=1e-3), False),
-        ("fallback: a rest check due", dict(position=(0, 0, 0.9999), velocity=(0, 0, 0),
-                                            angular_velocity=(0, 0, 0), c_tau=0.2), 6.0,
-         dict(method="radau5", rtol=1e-4, atol=1e-4), False),
+        ("fallback: an orbit's trial (seed 100 s)", {}, 100.0,
+         dict(method="dop853", rtol=1e-6, atol=1e-6), False),
+        ("fallback: exact flight (Scene(observer_mass=0))", dict(observer_mass=0), 100.0,
+         dict(method="radau5", rtol=1e-6, atol=1e-6), False),
         ("fallback: scipy Radau", {}, 0.3, dict(method="Radau", rtol=1e-3, atol=1e-3), False),
     ]
     return out

@@ -96,18 +96,37 @@ def test_runs_outside_the_subset_fall_back(monkeypatch, kwargs):
     assert result._driver == "python"
 
 
-def test_compliant_scene_and_a_due_rest_check_fall_back(monkeypatch):
+def test_compliant_scene_and_an_orbit_trial_fall_back(monkeypatch):
     compliant = _run(monkeypatch, False, ballc.Scene(tangential_model="compliant"), 0.5,
                      method="radau5", rtol=1e-3, atol=1e-3)
     assert compliant._driver == "python"
-    # a ball placed on the floor: its rest check falls due at 20 T0 = 4.3 s, which the
-    # C loop does not port -- it falls back and the result is the Python driver's
-    scene = ballc.Scene(position=(0.0, 0.0, 0.9999), velocity=(0.0, 0.0, 0.0),
-                        angular_velocity=(0.0, 0.0, 0.0), c_tau=0.2)
-    c = _run(monkeypatch, False, scene, 6.0, method="radau5", rtol=1e-4, atol=1e-4)
-    p = _run(monkeypatch, True, scene, 6.0, method="radau5", rtol=1e-4, atol=1e-4)
+    # the seed rolls on from 30.9 s: its rest checks find neither rest nor uniform motion
+    # (it is Routh's sphere), and one where an orbit's trial may start falls back
+    kw = dict(method="dop853", rtol=1e-6, atol=1e-6)
+    c = _run(monkeypatch, False, ballc.Scene(), 100.0, **kw)
+    p = _run(monkeypatch, True, ballc.Scene(), 100.0, **kw)
     assert c._driver == "python"
-    assert np.array_equal(c.t, p.t) and np.array_equal(c.y, p.y)
+    assert np.array_equal(c.t, p.t) and np.array_equal(c.y, p.y) and c.message == p.message
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5"])
+@pytest.mark.parametrize("case", ["rest", "rolling", "checks"])
+def test_the_rest_checks_are_bit_identical(monkeypatch, method, case):
+    """Stage 2a: a rest check that finds rest, uniform rolling (then the closed-form
+    end), or nothing (the seed before an orbit's trial could fit)."""
+    scene, t_end, kw = {
+        "rest": (ballc.Scene(velocity=(0, 0, 0), observer_mass=0), 1e6,
+                 dict(exact_flight=False)),
+        "rolling": (ballc.Scene(observer_mass=0), 1e6, dict(exact_flight=False)),
+        "checks": (ballc.Scene(), 30.0, {}),
+    }[case]
+    kw = dict(kw, method=method, rtol=1e-6, atol=1e-6)
+    p = _run(monkeypatch, True, scene, t_end, **kw)
+    expected = {"rest": "came to rest", "rolling": "rolls uniformly",
+                "checks": ""}[case]
+    assert expected in p.message
+    _assert_identical(p, _run(monkeypatch, False, scene, t_end, **kw))
 
 
 @needs_c_numerics

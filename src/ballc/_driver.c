@@ -30,6 +30,10 @@
 #define MAX_TRANSITIONS 100000
 #define MAX_STALLED 100
 #define MIN_IMPACT_RATE 1e-9
+#define ORBIT_TRIAL_PERIODS 3.5   /* orbit.TRIAL_PERIODS */
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 /* ---- numerics that must match CPython and numpy ---- */
 
@@ -670,6 +674,149 @@ static int add_later(run_t *r, const radau5_result *res, double after, int flags
                      r->latch);
 }
 
+/* ---- the rest checks (ballc.resting; stage 2a) ---- */
+
+/* _core.energies of one state row */
+static void energy_of(const run_t *r, const double *y, double *e)
+{
+    ballc_energy(y, r->c->params, r->prepared.constants, NULL, e);
+}
+
+/* resting._booked: the energy y has above ``new`` added to dissipated_normal */
+static void booked(const run_t *r, const double *y, double *new_y)
+{
+    double a[BALLC_ENERGY_NOUT], b[BALLC_ENERGY_NOUT];
+    energy_of(r, y, a);
+    energy_of(r, new_y, b);
+    double before = a[0] + a[1] + a[2] + a[3] + a[4] + a[5];
+    double after = b[0] + b[1] + b[2] + b[3] + b[4] + b[5];
+    new_y[BALLC_STATE_DISSIPATED_NORMAL] += before - after;
+}
+
+/* the Hertz spring plus gravity above rho_eq (resting.energy_above_rest, rolls); x > -1 */
+static double normal_above(const ballc_drive_config *c, double x)
+{
+    return c->rest_weight * c->rho_eq * (0.4 * expm1(2.5 * (x == 0.0 ? x : log1p(x))) - x);
+}
+
+/* resting.at_rest (criteria 2-4); -1 where Python would raise */
+static int at_rest(const run_t *r, const double *y, double t_start, double t)
+{
+    const ballc_drive_config *c = r->c;
+    if (t - t_start < c->rest_period) return 0;
+    double across = 0.0, up = 0.0;
+    if (c->observer_massive) {   /* resting._observer_offset */
+        double where[BALLC_OBSERVER_POSITION_NOUT], d[3];
+        ballc_observer_position(y, c->params, r->prepared.constants, NULL, where);
+        for (int i = 0; i < 3; i++) d[i] = where[i] - y[BALLC_STATE_X + i];
+        across = ballc_py_hypot(2, d);
+        up = d[2];
+        if (up >= 0) return 0;
+    }
+    double e[BALLC_ENERGY_NOUT];
+    energy_of(r, y, e);
+    double kinetic = e[0], spring = e[4] + e[5];
+    double rho = c->radius - y[BALLC_STATE_Z];
+    double x = (rho - c->rho_eq) / c->rho_eq;
+    double normal = INFINITY;
+    if (x > -1) {
+        normal = normal_above(c, x);
+        if (!isfinite(normal) && isfinite(x)) return -1;   /* math.expm1 overflow */
+    }
+    double observer = 0.0;
+    if (c->observer_massive) {
+        double pair[2] = {across, up};
+        double reach = ballc_py_hypot(2, pair);
+        observer = reach > 0 ? c->observer_weight * across * across / (reach + fabs(up)) : 0.0;
+    }
+    double above = kinetic + py_max(normal, 0.0) + spring + observer;
+    return above <= c->rest_threshold;
+}
+
+/* np.max(np.abs(v)) of n values: NaN when one is NaN */
+static double max_abs(const double *v, int n)
+{
+    double m = fabs(v[0]);
+    for (int i = 0; i < n; i++) {
+        if (isnan(v[i])) return NAN;
+        if (fabs(v[i]) > m) m = fabs(v[i]);
+    }
+    return m;
+}
+
+/* resting.rolls: BALLC_END_ROLLING / SLIDING with ``roll`` the uniform state, 0 none,
+ * -1 where Python would raise */
+static int rolls(const run_t *r, const double *y, double t_start, double t,
+                 double slip_speed, double *roll)
+{
+    const ballc_drive_config *c = r->c;
+    if (t - t_start < c->rest_period || !c->rolls_allowed) return 0;
+    double e[BALLC_ENERGY_NOUT];
+    energy_of(r, y, e);
+    double x = (c->radius - y[BALLC_STATE_Z] - c->rho_eq) / c->rho_eq;
+    if (!(x > -1)) return 0;
+    double normal = normal_above(c, x);
+    if (!isfinite(normal) && isfinite(x)) return -1;
+    double above = c->half_mass * pow(y[BALLC_STATE_VZ], 2.0) + (e[4] + e[5])
+                   + py_max(normal, 0.0);
+    if (!(above <= c->rest_threshold)) return 0;
+    memcpy(roll, y, N * sizeof(double));   /* resting.rolling_state */
+    roll[BALLC_STATE_Z] = c->z_eq;
+    roll[BALLC_STATE_VZ] = 0.0;
+    roll[BALLC_STATE_FLOOR_DEFLECTION_X] = roll[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
+    roll[BALLC_STATE_CEILING_DEFLECTION_X] = roll[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+    booked(r, y, roll);
+    double rate[N];
+    if (ballc_rhs(roll, c->params, r->latch, run_flags(r, 1), rate) != BALLC_OK) return -1;
+    double level = c->rolls_level;
+    if (max_abs(rate + BALLC_STATE_VX, 3) > level
+            || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level
+            || max_abs(rate + BALLC_STATE_FLOOR_DEFLECTION_X, 2) > level
+            || max_abs(rate + BALLC_STATE_CEILING_DEFLECTION_X, 2) > level)
+        return 0;
+    return slip_speed <= c->rolls_dv ? BALLC_END_ROLLING : BALLC_END_SLIDING;
+}
+
+/* _Run.end_state at a rest check on plane p at (r->t, r->y): BALLC_END_* when the run
+ * finishes in closed form from here (r->y the new state), 0 to go on (the next check
+ * scheduled), -1 to fall back (an orbit's trial would start, or Python would raise) */
+static int end_state(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    const ballc_contact_rec *k = &r->o->contacts[r->o->open[p]];
+    int rest = at_rest(r, r->y, k->t_start, r->t);
+    if (rest < 0) return -1;
+    if (rest) {   /* resting.rest_state */
+        double new_y[N];
+        memcpy(new_y, r->y, sizeof new_y);
+        for (int i = 0; i < 3; i++) new_y[BALLC_STATE_VX + i] = new_y[BALLC_STATE_OMEGA_X + i] = 0.0;
+        new_y[BALLC_STATE_Z] = c->z_eq;
+        new_y[BALLC_STATE_FLOOR_DEFLECTION_X] = new_y[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
+        new_y[BALLC_STATE_CEILING_DEFLECTION_X] = new_y[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+        booked(r, r->y, new_y);
+        memcpy(r->y, new_y, sizeof new_y);
+        return BALLC_END_REST;
+    }
+    /* resting.next_check */
+    r->rest_check[p] = r->t + py_max(c->rest_period, 0.25 * (r->t - k->t_start));
+    double u[2], speed, error, clear, roll[N];
+    slip(r, p, r->y, u, &speed, &error, &clear);
+    int kind = rolls(r, r->y, k->t_start, r->t, speed, roll);
+    if (kind < 0) return -1;
+    if (kind) {
+        memcpy(r->y, roll, sizeof roll);
+        return kind;
+    }
+    if (!c->orbit_applies) return 0;
+    /* _Run.plan_orbit_trial: a trial may start (then orbit.equivariant, not ported,
+     * decides): fall back; with no spin, or a trial that would end after t_end, none */
+    double rate = sqrt(ballc_dot3_fma(r->y + BALLC_STATE_OMEGA_X));
+    if (!(rate > 0)) return 0;
+    double guess = 2 * M_PI / rate;
+    double t_to = r->t + ORBIT_TRIAL_PERIODS * guess;
+    return t_to < c->t_end ? -1 : 0;
+}
+
 /* ---- the loop (simulate.simulate) ---- */
 
 #ifdef RADAU5_PROFILE
@@ -811,9 +958,24 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         if (res.status == RADAU5_REACHED) {
-            radau5_free(&res);
             r->t = t_stop;
-            if (t_stop < c->t_end) { rc = -1; break; }   /* a rest check: not ported */
+            if (t_stop < c->t_end) {   /* a rest check (ballc.resting) */
+                if (!res.n_out) { radau5_free(&res); rc = -1; break; }
+                memcpy(r->y, res.y_out + (size_t)(res.n_out - 1) * N, sizeof r->y);
+                radau5_free(&res);
+                int p = c->resting_plane;
+                int kind = end_state(r, p);
+                if (kind < 0) { rc = -1; break; }
+                if (kind) {   /* to t_end in closed form: the samples are Python's */
+                    o->end_kind = kind;
+                    o->end_plane = p;
+                    o->end_t = r->t;
+                    memcpy(o->end_y, r->y, sizeof r->y);
+                    break;
+                }
+                continue;   /* the next segment starts with its own first step */
+            }
+            radau5_free(&res);
             break;
         }
         if (fired < 0) { radau5_free(&res); rc = -1; break; }

@@ -1,4 +1,5 @@
-/* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0 and 1).
+/* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1 and 2a:
+ * the rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back).
  *
  * ballc_drive runs a whole simulation of the "map subset" -- exact Coulomb friction
  * (or none), no compliant law, no t_eval, no user events, no dense output, no progress
@@ -54,7 +55,19 @@ typedef struct {                       /* constants of one run, filled by the br
     int term_index[2][2][2];
     double term_coef[2][2][2];
     double slip_map[2][2][BALLC_N_STATES];
+    /* the rest checks (ballc.resting; stage 2a), constants computed by Python */
+    int observer_massive;              /* observer_mass > 0 */
+    int rolls_allowed;                 /* flight.scene_allows: uniform motion possible */
+    int orbit_applies;                 /* orbit.applies: a check finding nothing falls back */
+    double rest_threshold;             /* resting.energy_threshold */
+    double rho_eq, z_eq;               /* equilibrium_penetration, radius - rho_eq */
+    double rest_weight;                /* total_mass * gravity */
+    double observer_weight;            /* observer_mass * gravity */
+    double rolls_dv, rolls_level, half_mass;   /* resting.rolls: dv, 1e3 eps g, 0.5 M */
 } ballc_drive_config;
+
+/* how a run ended at a rest check (ballc.resting): the state from end_t on is end_y */
+enum { BALLC_END_NONE = 0, BALLC_END_REST, BALLC_END_ROLLING, BALLC_END_SLIDING };
 
 typedef struct {
     int plane, ended, passed_through, rate_is_kernel_value;
@@ -86,6 +99,8 @@ typedef struct {
     double stiff_at;                    /* NaN: none */
     char message[240];                  /* FAILED: the integrator's message */
     long segments;
+    int end_kind, end_plane;            /* BALLC_END_*: rest / uniform motion found */
+    double end_t, end_y[BALLC_N_STATES];
     /* a -DRADAU5_PROFILE build: thread CPU time (ns) inside radau5_solve, summed over
      * the segments, and in the whole of ballc_drive; zeros otherwise */
     int profiled;

@@ -35,6 +35,9 @@ cdef extern from "_driver.h":
         int term_index[2][2][2]
         double term_coef[2][2][2]
         double slip_map[2][2][19]
+        int observer_massive, rolls_allowed, orbit_applies
+        double rest_threshold, rho_eq, z_eq, rest_weight, observer_weight
+        double rolls_dv, rolls_level, half_mass
     ctypedef struct ballc_contact_rec:
         int plane, ended, passed_through, rate_is_kernel_value
         double t_start, t_end
@@ -73,6 +76,9 @@ cdef extern from "_driver.h":
         double stiff_at
         char message[240]
         long segments
+        int end_kind, end_plane
+        double end_t
+        double end_y[19]
         int profiled
         double integrator_ns, drive_ns
     int ballc_drive(const ballc_drive_config *, const double *, ballc_drive_output *) nogil
@@ -157,6 +163,17 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.rest_period = k["rest_period"]
     c.resting_plane = k["resting_plane"]
     c.checks_rest = k["checks_rest"]
+    c.observer_massive = k["observer_massive"]
+    c.rolls_allowed = k["rolls_allowed"]
+    c.orbit_applies = k["orbit_applies"]
+    c.rest_threshold = k["rest_threshold"]
+    c.rho_eq = k["rho_eq"]
+    c.z_eq = k["z_eq"]
+    c.rest_weight = k["rest_weight"]
+    c.observer_weight = k["observer_weight"]
+    c.rolls_dv = k["rolls_dv"]
+    c.rolls_level = k["rolls_level"]
+    c.half_mass = k["half_mass"]
     for p in range(2):
         c.contact_bits[p] = k["contact_bits"][p]
         c.slip_bits[p] = k["slip_bits"][p]
@@ -219,7 +236,9 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                     in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),
                     transitions=(o.transitions[0], o.transitions[1]), stalled=o.stalled,
                     nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
-                    segments=o.segments, profiled=bool(o.profiled),
+                    segments=o.segments, end_kind=o.end_kind, end_plane=o.end_plane,
+                    end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(BALLC_N_STATES)]),
+                    profiled=bool(o.profiled),
                     integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
     finally:
         ballc_drive_free(&o)

@@ -412,15 +412,7 @@ class _Run:
             return None
         self.y, kind = found
         self.enter_motion(plane, kind)
-        v = float(np.hypot(*self.y[layout.VELOCITY][:2]))
-        what = "rolls uniformly" if kind == "rolling" else (
-            "slides uniformly (no force opposes its slip)")
-        self.message = (f"{SUCCESS} The ball {what} on the {plane} from t = "
-                        f"{self.t:.9g} s at {v:.6g} m/s (ballc.resting: static Hertz "
-                        f"equilibrium, penetration "
-                        f"{resting.equilibrium_penetration(self.scene):.6g} m); from there "
-                        f"to t_end the state is that {kind.replace('free_', '')}, in "
-                        "closed form.")
+        self.message = _motion_message(self.scene, plane, self.t, self.y, kind)
         return self.y
 
     def enter_motion(self, plane, kind):
@@ -508,10 +500,7 @@ class _Run:
         self.y = resting.rest_state(self.scene, self.y, plane)
         self.t_rest = contact.t_rest = self.t
         contact.transitions.append((self.t, "rest"))
-        self.message = (f"{SUCCESS} The ball came to rest on the {plane} at t = {self.t:.9g} s "
-                        f"(ballc.resting: static Hertz equilibrium, penetration "
-                        f"{resting.equilibrium_penetration(self.scene):.6g} m); from there "
-                        "to t_end the state is that rest state.")
+        self.message = _rest_message(self.scene, plane, self.t)
         return True
 
     # ---- one event ----
@@ -543,6 +532,28 @@ class _Run:
         self.status = 1
         self.message = (f"ball passed through the {plane} at t = {self.t:.6g} s "
                         "(penetration reached the ball's radius)")
+
+
+def _rest_message(scene, plane, t):
+    """The message of a run that came to rest on ``plane`` at ``t`` (either driver)."""
+    return (f"{SUCCESS} The ball came to rest on the {plane} at t = {t:.9g} s "
+            f"(ballc.resting: static Hertz equilibrium, penetration "
+            f"{resting.equilibrium_penetration(scene):.6g} m); from there "
+            "to t_end the state is that rest state.")
+
+
+def _motion_message(scene, plane, t, y, kind):
+    """The message of a run that goes on uniformly (``kind`` "rolling" or
+    "free_sliding") on ``plane`` from ``t`` in state ``y`` (either driver)."""
+    v = float(np.hypot(*y[layout.VELOCITY][:2]))
+    what = "rolls uniformly" if kind == "rolling" else (
+        "slides uniformly (no force opposes its slip)")
+    return (f"{SUCCESS} The ball {what} on the {plane} from t = "
+            f"{t:.9g} s at {v:.6g} m/s (ballc.resting: static Hertz "
+            f"equilibrium, penetration "
+            f"{resting.equilibrium_penetration(scene):.6g} m); from there "
+            f"to t_end the state is that {kind.replace('free_', '')}, in "
+            "closed form.")
 
 
 def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float = 1e-10,
@@ -844,10 +855,13 @@ def _finish(result, options, stiff_at):
 # environment variable BALLC_PYTHON_DRIVER is not set (to anything non-empty) and the
 # integrator seam is not wrapped (_seams_untouched).  The results are bit-identical to
 # the Python loop above (benchmarks/driver_identical.py, tests/test_c_driver.py).
-# Everything else, and a C run that meets what it does not port (a rest check coming
-# due, a kernel failure where Python raises), runs the Python loop from the start.  ``result._driver`` says which ran ("c" or "python").
+# Everything else, and a C run that meets what it does not port (a rest check on a
+# Routh sphere where an orbit's trial may start, a kernel failure where Python raises),
+# runs the Python loop from the start.  A rest check that finds rest or uniform motion
+# ends the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
 
 _C_METHODS = ("radau5", "dop853")
+_END_REST, _END_ROLLING, _END_SLIDING = 1, 2, 3   # _driver.h: BALLC_END_*
 _SEAMS = (integrate_segment, _radau5.solve_system)
 
 
@@ -908,7 +922,23 @@ def _c_config(scene, options, progress, rest):
     period = resting.REST_PERIODS * resting.oscillation_period(scene) \
         if resting_plane is not None else math.inf
     flags = _core.FLAGS
+    rest_consts = dict(rest_threshold=math.inf, rho_eq=1.0, z_eq=0.0, rest_weight=0.0,
+                       observer_weight=0.0, rolls_dv=0.0, rolls_level=0.0, half_mass=0.0)
+    if resting_plane is not None:   # the rest checks' constants (resting.at_rest, rolls)
+        rho_eq = resting.equilibrium_penetration(scene)
+        rest_consts = dict(
+            rest_threshold=resting.energy_threshold(scene, options.rtol, options.atol),
+            rho_eq=rho_eq, z_eq=scene.radius - rho_eq,
+            rest_weight=resting.total_mass(scene) * scene.gravity,
+            observer_weight=scene.observer_mass * scene.gravity,
+            rolls_dv=resting.REST_FACTOR * (float(np.max(options.atol)) + options.rtol
+                                            * math.sqrt(scene.gravity * scene.radius)),
+            rolls_level=float(1e3 * np.finfo(float).eps * scene.gravity),
+            half_mass=0.5 * resting.total_mass(scene))
     return dict(
+        observer_massive=int(scene.observer_mass > 0),
+        rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbit.applies(scene)),
+        **rest_consts,
         params=params, rtol=options.rtol, atol=options.atol, t_end=options.t_end,
         max_step=float(options.max_step), first_step=options.first_step,
         max_nfev=options.max_nfev, method=options.method, observer_bits=observer,
@@ -937,9 +967,25 @@ def _simulate_c(scene, options, y, config):
         return None
     counts = out["counts"]
     t = out["t"]
-    states = out["rows"].T
-    flags = np.repeat(out["block_flags"], counts)
-    latch = np.repeat(out["latches"], counts, axis=0).T
+    rows = out["rows"]
+    block_flags, latches = out["block_flags"], out["latches"]
+    end_kind = out["end_kind"]
+    if end_kind:   # a rest check found an end state: to t_end in closed form
+        when, y_end = out["end_t"], out["end_y"]
+        if end_kind == _END_REST:
+            times = np.array([options.t_end])
+            closed = resting.Constant(y_end)
+        else:
+            closed = FreeFlight(when, y_end, 0.0, t_max=options.t_end)
+            times = resting.rolling_samples(when, options.t_end, closed.rate)
+        t = np.concatenate([t, times])
+        rows = np.concatenate([rows, closed(times).T])
+        counts = np.append(counts, times.size)
+        block_flags = np.append(block_flags, block_flags[-1])
+        latches = np.concatenate([latches, latches[-1:]])
+    states = rows.T
+    flags = np.repeat(block_flags, counts)
+    latch = np.repeat(latches, counts, axis=0).T
     contacts = []
     for rec in out["contacts"]:
         rate = np.float64(rec["rate"]) if rec["rate_is_kernel_value"] else rec["rate"]
@@ -961,6 +1007,23 @@ def _simulate_c(scene, options, y, config):
         contacts.append(contact)
     for k, when, phase in out["phases"]:
         contacts[k].transitions.append((when, "stick" if phase else "slip"))
+    message = SUCCESS
+    if end_kind:   # as _Run.enter_rest / enter_motion
+        plane = PLANES[out["end_plane"]]
+        contact = contacts[out["open"][out["end_plane"]]]
+        when = out["end_t"]
+        if end_kind == _END_REST:
+            contact.t_rest = when
+            contact.transitions.append((when, "rest"))
+            message = _rest_message(scene, plane, when)
+        else:
+            kind = "rolling" if end_kind == _END_ROLLING else "free_sliding"
+            if kind == "rolling":
+                contact.t_rolling = when
+            else:
+                contact.t_sliding = when
+            contact.transitions.append((when, kind))
+            message = _motion_message(scene, plane, when, out["end_y"], kind)
     if counts[-1]:   # still in contact at the end
         last = states[:, -1]
         for k in out["open"]:
@@ -968,7 +1031,6 @@ def _simulate_c(scene, options, y, config):
                 plane = contacts[k].plane
                 record_depth(contacts[k], ev.penetration(plane, scene)(0, last), last)
     code, status = out["stop_code"], out["status"]
-    message = SUCCESS
     if code == _core.DRIVE_FAILED:
         reason = out["message"]
         if "max_nfev" in reason:
