@@ -5,8 +5,8 @@
 One process: each case runs with the Python driver (BALLC_PYTHON_DRIVER=1) and with the
 default (the C loop where the run is in its subset), and every output is compared:
 t, y, flags, latch (np.array_equal, NaN equal to NaN, and dtype and memory order),
-status, message, nfev/njev/nlu, t_events/y_events and every field of every contact
-(value and type).  A case marked C-eligible fails if it ran in Python (``_driver``), so
+status, message, nfev/njev/nlu, t_events/y_events, every field of every contact
+(value and type), and Result.sol's pieces and values.  A case marked C-eligible fails if it ran in Python (``_driver``), so
 a fallback cannot pass vacuously.  Exit status 0 when all are identical, 1 otherwise.
 
 Cases: the comeback map's cells Scene(mixture=m, friction_coefficient=mu), 1.2 s at
@@ -93,12 +93,35 @@ def cases(quick=False):
                                             velocity=(1.0, 0, 0)), 60.0,
              dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
         ]
+    # stage 2b: t_eval and dense output (Result.sol compared at its pieces' ends and
+    # on a grid)
+    for method in METHODS:
+        out += [
+            (f"seed 5 s t_eval {method}", {}, 5.0,
+             dict(method=method, t_eval=np.linspace(0, 5.0, 101)), True),
+            (f"seed 5 s t_eval, no 0 {method} 1e-6", {}, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, t_eval=np.linspace(0.01, 4.0, 37)),
+             True),
+            (f"seed 5 s dense output {method}", {}, 5.0,
+             dict(method=method, dense_output=True), True),
+            (f"map cell dense + t_eval {method}", dict(mixture=0.3, friction_coefficient=0.2),
+             1.2, dict(method=method, rtol=1e-3, atol=1e-3, dense_output=True,
+                       t_eval=[0.0, 0.3, 0.6, 1.2]), True),
+            (f"drop, rests, dense output {method}", dict(velocity=(0, 0, 0), observer_mass=0),
+             1e6, dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False,
+                       dense_output=True), True),
+            (f"rolls, dense output {method}", dict(observer_mass=0), 100.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False,
+                  dense_output=True), True),
+            (f"call budget, dense output {method}", dict(mixture=0.3, friction_coefficient=0.2),
+             1.2, dict(method=method, rtol=1e-3, atol=1e-3, max_nfev=300, dense_output=True),
+             True),
+        ]
     # must fall back
     out += [
-        ("fallback: t_eval", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
-                                          t_eval=np.linspace(0, 1.2, 7)), False),
-        ("fallback: dense output", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
-                                                dense_output=True), False),
+        ("fallback: a user event", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
+                                                events=lambda t, y: y[6] - 0.5), False),
+        ("fallback: method auto", {}, 1.2, dict(method="auto", rtol=1e-3, atol=1e-3), False),
         ("fallback: compliant", dict(tangential_model="compliant"), 1.2,
          dict(method="radau5", rtol=1e-3, atol=1e-3), False),
         ("fallback: an orbit's trial (seed 100 s)", {}, 100.0,
@@ -139,8 +162,24 @@ def same(a, b):
     return a == b
 
 
+def sol_values(result):
+    """Result.sol at its pieces' ends and on a grid of 1001 times (None without)."""
+    sol = result.sol
+    if sol is None:
+        return None
+    times = np.concatenate([[a for a, _, _ in sol.pieces], [b for _, b, _ in sol.pieces],
+                            np.linspace(sol.t_min, sol.t_max, 1001)])
+    out = [np.array([(a, b) for a, b, _ in sol.pieces])]
+    for where in [times] + [np.linspace(a, b, 11) for a, b, _ in sol.pieces]:
+        try:
+            out.append(sol(where))
+        except (ValueError, IndexError) as error:   # a piece without steps: as Python's
+            out.append(type(error).__name__)
+    return out
+
+
 def differences(p, c):
-    found = []
+    found = [] if same(sol_values(p), sol_values(c)) else ["sol"]
     for name in ("t", "y", "flags", "latch", "status", "message", "nfev", "njev", "nlu",
                  "t_events", "y_events", "contacts"):
         if not same(getattr(p, name), getattr(c, name)):

@@ -86,10 +86,9 @@ def test_a_failure_and_the_call_budget_are_bit_identical(monkeypatch):
 
 
 @pytest.mark.parametrize("kwargs", [
-    dict(t_eval=np.linspace(0.0, 0.5, 6)), dict(dense_output=True), dict(method="Radau"),
-    dict(method="auto"), dict(events=lambda t, y: y[6] - 0.5),
+    dict(method="Radau"), dict(method="auto"), dict(events=lambda t, y: y[6] - 0.5),
     dict(atol=np.full(_core.N_STATES, 1e-3)),
-], ids=["t_eval", "dense_output", "scipy", "auto", "user event", "atol per state"])
+], ids=["scipy", "auto", "user event", "atol per state"])
 def test_runs_outside_the_subset_fall_back(monkeypatch, kwargs):
     kwargs = dict(dict(method="dop853", rtol=1e-3, atol=1e-3), **kwargs)
     result = _run(monkeypatch, False, ballc.Scene(), 0.5, **kwargs)
@@ -127,6 +126,31 @@ def test_the_rest_checks_are_bit_identical(monkeypatch, method, case):
                 "checks": ""}[case]
     assert expected in p.message
     _assert_identical(p, _run(monkeypatch, False, scene, t_end, **kw))
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5"])
+def test_t_eval_and_dense_output_are_bit_identical(monkeypatch, method):
+    """Stage 2b: t_eval (with and without 0) and Result.sol, here with a rest end's
+    closed-form piece too, and on a failed run."""
+    seed = ballc.Scene()
+    drop = ballc.Scene(velocity=(0, 0, 0), observer_mass=0)
+    cell = ballc.Scene(mixture=0.3, friction_coefficient=0.2)
+    for scene, t_end, kw in [
+            (seed, 5.0, dict(t_eval=np.linspace(0.0, 5.0, 51))),
+            (seed, 5.0, dict(t_eval=[0.5, 1.5, 2.5], dense_output=True)),
+            (drop, 1e6, dict(rtol=1e-6, atol=1e-6, exact_flight=False, dense_output=True)),
+            (cell, 1.2, dict(rtol=1e-3, atol=1e-3, max_nfev=300, dense_output=True))]:
+        kw = dict(kw, method=method)
+        p = _run(monkeypatch, True, scene, t_end, **kw)
+        c = _run(monkeypatch, False, scene, t_end, **kw)
+        _assert_identical(p, c)
+        if kw.get("dense_output"):
+            assert [(a, b) for a, b, _ in p.sol.pieces] == [(a, b) for a, b, _ in c.sol.pieces]
+            for (a, b, f), (_, _, g) in zip(p.sol.pieces, c.sol.pieces):
+                if b > a and getattr(f, "steps", np.ones(1)).size:
+                    times = np.linspace(a, b, 7)
+                    assert np.array_equal(f(times), g(times))
 
 
 @needs_c_numerics

@@ -157,6 +157,8 @@ void ballc_drive_free(ballc_drive_output *o)
 {
     free(o->t); free(o->y); free(o->block_count); free(o->block_flags);
     free(o->block_latch); free(o->contacts); free(o->phases);
+    free(o->pieces); free(o->dense_t); free(o->dense_c); free(o->dense_kind);
+    o->pieces = NULL; o->dense_t = o->dense_c = NULL; o->dense_kind = NULL;
     o->t = o->y = o->block_latch = NULL;
     o->block_count = NULL; o->block_flags = NULL; o->contacts = NULL; o->phases = NULL;
 }
@@ -657,7 +659,7 @@ static int add_block(run_t *r, const double *t, const double *y, long count, int
 /* Samples.add_later (first = 1: a segment's first sample is its start) */
 static int add_later(run_t *r, const radau5_result *res, double after, int flags)
 {
-    long n = res->n_out, first = 1;
+    long n = res->n_out, first = r->c->t_eval ? 0 : 1;   /* simulate: skip */
     const double *t = res->t_out;
     while (first < n && t[first] <= after) first++;
     for (long k = 0; k < r->n_rearmed; k++) {
@@ -817,6 +819,40 @@ static int end_state(run_t *r, int p)
     return t_to < c->t_end ? -1 : 0;
 }
 
+/* pieces.append((t0, t1, sol.interpolant)): the segment's steps kept (stage 2b) */
+static int add_piece(run_t *r, const radau5_result *res, double t0, double t1)
+{
+    ballc_drive_output *o = r->o;
+    long m = res->n_dense, width = (long)(1 + res->dense_terms) * N;
+    if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1, sizeof(ballc_piece_rec)))
+        return -1;
+    long cs = o->cap_steps;
+    if (grow((void **)&o->dense_kind, &cs, o->n_steps + m, sizeof(int))) return -1;
+    if (cs != o->cap_steps) {
+        double *dt = realloc(o->dense_t, (size_t)cs * 2 * sizeof(double));
+        if (!dt) return -1;
+        o->dense_t = dt;
+        o->cap_steps = cs;
+    }
+    if (grow((void **)&o->dense_c, &o->cap_coef, o->n_coef + m * width, sizeof(double)))
+        return -1;
+    ballc_piece_rec *k = &o->pieces[o->n_pieces++];
+    k->t0 = t0;
+    k->t1 = t1;
+    k->step0 = o->n_steps;
+    k->n_steps = m;
+    k->coef0 = o->n_coef;
+    k->terms = res->dense_terms;
+    if (m) {
+        memcpy(o->dense_t + 2 * o->n_steps, res->dense_t, (size_t)m * 2 * sizeof(double));
+        memcpy(o->dense_kind + o->n_steps, res->dense_kind, (size_t)m * sizeof(int));
+        memcpy(o->dense_c + o->n_coef, res->dense_c, (size_t)(m * width) * sizeof(double));
+    }
+    o->n_steps += m;
+    o->n_coef += m * width;
+    return 0;
+}
+
 /* ---- the loop (simulate.simulate) ---- */
 
 #ifdef RADAU5_PROFILE
@@ -850,7 +886,27 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     for (int p = 0; p < 2 && !rc; p++)
         if (rho_of(r, p, r->y) > 0) rc = begin_contact(r, p);
     double t0 = 0.0;
-    if (!rc) rc = add_block(r, &t0, r->y, 1, run_flags(r, 1), r->latch);
+    if (!rc && !c->t_eval) rc = add_block(r, &t0, r->y, 1, run_flags(r, 1), r->latch);
+    long eval_at = 0;   /* t_eval: the first point after run.t */
+    if (!rc && c->t_eval) {   /* the points at 0 (t_eval == 0.0), each the initial state */
+        long keep = 0;
+        for (long i = 0; i < c->n_eval; i++) keep += c->t_eval[i] == 0.0;
+        double *rows = malloc((size_t)(keep ? keep : 1) * N * sizeof(double));
+        double *times = malloc((size_t)(keep ? keep : 1) * sizeof(double));
+        if (!rows || !times) rc = -2;
+        else {
+            long j = 0;
+            for (long i = 0; i < c->n_eval; i++)
+                if (c->t_eval[i] == 0.0) {
+                    times[j] = c->t_eval[i];
+                    memcpy(rows + j * N, r->y, N * sizeof(double));
+                    j++;
+                }
+            rc = add_block(r, times, rows, keep, run_flags(r, 1), r->latch) ? -2 : 0;
+        }
+        free(rows);
+        free(times);
+    }
     double atol[N];
     for (int i = 0; i < N; i++) atol[i] = c->atol;
     double first = c->first_step;
@@ -894,6 +950,13 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.max_nfev = c->max_nfev ? (c->max_nfev - nfev > 1 ? c->max_nfev - nfev : 1) : 0;
         pr.t_eval = NULL;
         pr.n_eval = 0;
+        if (c->t_eval) {   /* t_eval[(t_eval > run.t) & (t_eval <= t_stop)] (sorted) */
+            while (eval_at < c->n_eval && !(c->t_eval[eval_at] > r->t)) eval_at++;
+            long hi = eval_at;
+            while (hi < c->n_eval && c->t_eval[hi] <= t_stop) hi++;
+            pr.t_eval = hi > eval_at ? c->t_eval + eval_at : r->y;   /* non-NULL: none */
+            pr.n_eval = hi - eval_at;
+        }
         pr.n_events = r->n_ev;
         pr.ev_coef = r->ev_coef;
         pr.ev_offset = r->ev_offset;
@@ -901,7 +964,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.ev_fun = drv_event;
         pr.ev_terminal = r->ev_terminal;
         pr.ev_direction = r->ev_direction;
-        pr.dense_output = 0;
+        pr.dense_output = c->dense_output;
         pr.controller = c->controller;
         pr.outputs_checked = 1;
         pr.refine_events = 1;
@@ -949,6 +1012,10 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             }
         }
         if (res.status == RADAU5_FAILED) {
+            if (c->dense_output && res.n_out
+                    && add_piece(r, &res, r->t, res.t_out[res.n_out - 1])) {
+                radau5_free(&res); rc = -2; break;
+            }
             r->status = -1;
             r->stop_code = BALLC_DRIVE_FAILED;
             memcpy(o->message, res.message, sizeof o->message);
@@ -958,6 +1025,9 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         if (res.status == RADAU5_REACHED) {
+            if (c->dense_output && add_piece(r, &res, r->t, t_stop)) {
+                radau5_free(&res); rc = -2; break;
+            }
             r->t = t_stop;
             if (t_stop < c->t_end) {   /* a rest check (ballc.resting) */
                 if (!res.n_out) { radau5_free(&res); rc = -1; break; }
@@ -979,6 +1049,9 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         if (fired < 0) { radau5_free(&res); rc = -1; break; }
+        if (c->dense_output && add_piece(r, &res, r->t, t_fired)) {
+            radau5_free(&res); rc = -2; break;
+        }
         double h_next = res.h_next;
         r->t = t_fired;
         memcpy(r->y, res.hit_y + (size_t)fired_hit * N, sizeof r->y);

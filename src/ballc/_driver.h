@@ -1,9 +1,10 @@
-/* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1 and 2a:
- * the rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back).
+/* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1, 2a -- the
+ * rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back -- and 2b:
+ * t_eval and dense output).
  *
- * ballc_drive runs a whole simulation of the "map subset" -- exact Coulomb friction
- * (or none), no compliant law, no t_eval, no user events, no dense output, no progress
- * bar, method radau5 or dop853 -- and reproduces the Python driver (simulate.py with
+ * ballc_drive runs a whole simulation of the subset -- exact Coulomb friction (or
+ * none), no compliant law, no user events, no progress bar, no exact flight, method
+ * radau5 or dop853 -- and reproduces the Python driver (simulate.py with
  * events.py, stickslip.py, modes.py, samples.py) bit for bit: the same floating-point
  * operations in the same order.  What it does not port ends the run with
  * BALLC_DRIVE_FALLBACK, and simulate() then runs the Python driver from the start.
@@ -55,6 +56,10 @@ typedef struct {                       /* constants of one run, filled by the br
     int term_index[2][2][2];
     double term_coef[2][2][2];
     double slip_map[2][2][BALLC_N_STATES];
+    /* stage 2b: t_eval (sorted, within [0, t_end]; NULL: none) and dense output */
+    const double *t_eval;
+    long n_eval;
+    int dense_output;
     /* the rest checks (ballc.resting; stage 2a), constants computed by Python */
     int observer_massive;              /* observer_mass > 0 */
     int rolls_allowed;                 /* flight.scene_allows: uniform motion possible */
@@ -77,6 +82,10 @@ typedef struct {
 
 typedef struct { long contact; double t; int phase; } ballc_phase_rec;  /* 0 slip, 1 stick */
 
+/* dense output: one piece (t0, t1) per segment, its steps [step0, step0 + n_steps) of
+ * dense_t / dense_kind and their coefficients from dense_c[coef0], (1 + terms) N each */
+typedef struct { double t0, t1; long step0, n_steps, coef0; int terms; } ballc_piece_rec;
+
 typedef struct {
     long n, cap;                        /* samples: t (n), y (n x N_STATES) */
     double *t, *y;
@@ -89,6 +98,11 @@ typedef struct {
     long n_phases, cap_phases;
     ballc_phase_rec *phases;
     int open[2];                        /* open contact per plane, -1 none */
+    long n_pieces, cap_pieces;          /* dense output (stage 2b) */
+    ballc_piece_rec *pieces;
+    long n_steps, cap_steps, n_coef, cap_coef;
+    double *dense_t, *dense_c;
+    int *dense_kind;
     /* the end */
     int stop_code, status, stop_plane;
     double t_run;                       /* run.t at the end */

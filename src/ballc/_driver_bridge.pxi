@@ -35,6 +35,9 @@ cdef extern from "_driver.h":
         int term_index[2][2][2]
         double term_coef[2][2][2]
         double slip_map[2][2][19]
+        const double *t_eval
+        long n_eval
+        int dense_output
         int observer_massive, rolls_allowed, orbit_applies
         double rest_threshold, rho_eq, z_eq, rest_weight, observer_weight
         double rolls_dv, rolls_level, half_mass
@@ -54,6 +57,10 @@ cdef extern from "_driver.h":
         long contact
         double t
         int phase
+    ctypedef struct ballc_piece_rec:
+        double t0, t1
+        long step0, n_steps, coef0
+        int terms
     ctypedef struct ballc_drive_output:
         long n
         double *t
@@ -67,6 +74,12 @@ cdef extern from "_driver.h":
         long n_phases
         ballc_phase_rec *phases
         int open[2]
+        long n_pieces
+        ballc_piece_rec *pieces
+        long n_steps, n_coef
+        double *dense_t
+        double *dense_c
+        int *dense_kind
         int stop_code, status, stop_plane
         double t_run, fail_end
         int in_contact[2]
@@ -142,6 +155,10 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     cdef ballc_contact_rec rec
     cdef Py_ssize_t i
     cdef const double[:, :, ::1] smap = k["slip_map"]
+    cdef const double[::1] t_eval = k["t_eval"]   # None: no t_eval
+    cdef ballc_piece_rec piece
+    cdef double[:, ::1] dtv, dcv
+    cdef int[::1] dkv
     if params.shape[0] != BALLC_N_PARAMETERS or y0.shape[0] != BALLC_N_STATES:
         raise ValueError("params or y0 of the wrong length")
     c.params = &params[0]
@@ -163,6 +180,12 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.rest_period = k["rest_period"]
     c.resting_plane = k["resting_plane"]
     c.checks_rest = k["checks_rest"]
+    c.t_eval = NULL
+    c.n_eval = 0
+    if t_eval is not None:
+        c.n_eval = t_eval.shape[0]
+        c.t_eval = &t_eval[0] if c.n_eval else &y0[0]   # non-NULL: t_eval given
+    c.dense_output = k["dense_output"]
     c.observer_massive = k["observer_massive"]
     c.rolls_allowed = k["rolls_allowed"]
     c.orbit_applies = k["orbit_applies"]
@@ -229,8 +252,24 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                 lost=(rec.lost[0], rec.lost[1])))
         phases = [(o.phases[i].contact, o.phases[i].t, o.phases[i].phase)
                   for i in range(o.n_phases)]
+        pieces = []   # dense output: (t0, t1, dense_t, dense_c, terms, dense_kind)
+        for i in range(o.n_pieces):
+            piece = o.pieces[i]
+            dense_t = np.empty((piece.n_steps, 2))
+            dense_c = np.empty((piece.n_steps, (1 + piece.terms) * BALLC_N_STATES))
+            dense_kind = np.empty(piece.n_steps, dtype=np.intc)
+            if piece.n_steps:
+                dtv = dense_t
+                dcv = dense_c
+                dkv = dense_kind
+                memcpy(&dtv[0, 0], o.dense_t + 2 * piece.step0,
+                       piece.n_steps * 2 * sizeof(double))
+                memcpy(&dcv[0, 0], o.dense_c + piece.coef0,
+                       piece.n_steps * (1 + piece.terms) * BALLC_N_STATES * sizeof(double))
+                memcpy(&dkv[0], o.dense_kind + piece.step0, piece.n_steps * sizeof(int))
+            pieces.append((piece.t0, piece.t1, dense_t, dense_c, piece.terms, dense_kind))
         return dict(t=t, rows=rows, counts=counts, block_flags=block_flags, latches=latches,
-                    contacts=contacts, phases=phases, open=(o.open[0], o.open[1]),
+                    contacts=contacts, phases=phases, pieces=pieces, open=(o.open[0], o.open[1]),
                     stop_code=o.stop_code, status=o.status, stop_plane=o.stop_plane,
                     t_run=o.t_run, fail_end=o.fail_end, message=o.message.decode(),
                     in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),

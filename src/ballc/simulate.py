@@ -20,7 +20,7 @@ import numpy as np
 from . import (_core, _radau5, automaton, compliantmodes, events as ev, layout, modes,
                orbit, outcome, resting, stickslip)
 from ._format import plain
-from .dense import PiecewiseSolution
+from .dense import CompiledInterpolant, PiecewiseSolution
 from .flight import FreeFlight, scene_allows as flight_scene_allows
 from .integrate import Segment, failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
@@ -896,13 +896,18 @@ def _c_numerics_agree():
 
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
-    in the C loop's subset: method radau5 or dop853, one float atol, no t_eval, user
-    events, dense output or progress bar, no compliant law, no exact flight, slip rows of
-    at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
+    in the C loop's subset: method radau5 or dop853, one float atol, no user events or
+    progress bar, no compliant law, no exact flight, t_eval (if given) strictly
+    increasing, slip rows of at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
     process's hypot and dot as the C loop reproduces them (_c_numerics_agree)."""
-    if (options.method not in _C_METHODS or options.t_eval is not None or options.events
-            or options.dense_output or type(options.atol) is not float):
+    if (options.method not in _C_METHODS or options.events
+            or type(options.atol) is not float):
         return None
+    t_eval = options.t_eval
+    if t_eval is not None:   # the C loop takes each segment's points as a range
+        t_eval = np.ascontiguousarray(t_eval, dtype=float)
+        if t_eval.ndim != 1 or not np.all(np.diff(t_eval) > 0):
+            return None
     if progress or (progress is None and sys.stderr.isatty()):
         return None
     if scene.tangential_model == "compliant" or compliantmodes.uses_modes(scene):
@@ -952,7 +957,8 @@ def _c_config(scene, options, progress, rest):
         hertz_k=scene.hertz_stiffness, total_mass=scene.mass + scene.observer_mass,
         rest_period=period,
         resting_plane=-1 if resting_plane is None else PLANES.index(resting_plane),
-        checks_rest=int(bool(rest)),
+        checks_rest=int(bool(rest) and t_eval is None),
+        t_eval=t_eval, dense_output=int(bool(options.dense_output)),
         rho_scale=[entry[3] for entry in planes], rho_offset=[entry[4] for entry in planes],
         through_offset=[entry[7].offset for entry in planes],
         threshold_base=[entry[5] for entry in planes],
@@ -970,6 +976,8 @@ def _simulate_c(scene, options, y, config):
     rows = out["rows"]
     block_flags, latches = out["block_flags"], out["latches"]
     end_kind = out["end_kind"]
+    pieces = [(t0, t1, CompiledInterpolant(dense_t, dense_c, terms, kinds))
+              for t0, t1, dense_t, dense_c, terms, kinds in out["pieces"]]
     if end_kind:   # a rest check found an end state: to t_end in closed form
         when, y_end = out["end_t"], out["end_y"]
         if end_kind == _END_REST:
@@ -978,6 +986,8 @@ def _simulate_c(scene, options, y, config):
         else:
             closed = FreeFlight(when, y_end, 0.0, t_max=options.t_end)
             times = resting.rolling_samples(when, options.t_end, closed.rate)
+        if options.dense_output:
+            pieces.append((when, options.t_end, closed))
         t = np.concatenate([t, times])
         rows = np.concatenate([rows, closed(times).T])
         counts = np.append(counts, times.size)
@@ -1049,7 +1059,8 @@ def _simulate_c(scene, options, y, config):
                    f"{out['t_run']:.6g} s (penetration reached the ball's radius)")
     result = Result(t=t, y=states, scene=scene, status=status, message=message,
                     nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], contacts=contacts,
-                    flags=flags, latch=latch, t_events=[], y_events=[], sol=None,
+                    flags=flags, latch=latch, t_events=[], y_events=[],
+                    sol=PiecewiseSolution(pieces) if options.dense_output else None,
                     method_switches=None)
     result._driver = "c"
     result._driver_counts = {key: out[key] for key in (
