@@ -28,6 +28,9 @@ import numpy as np
 import ballc
 
 METHODS = ("dop853", "radau5")
+#: tests/test_auto_method.py's stiff scene (method "auto" switches on it)
+STEEL = dict(tangential_model="friction", ball_youngs_modulus=2e11, plane_youngs_modulus=2e11,
+             c_tau=0.5, observer_mass=0.0, position=(0.0, 0.0, 2.0), velocity=(0.5, 0.0, 0.0))
 
 
 def cases(quick=False):
@@ -117,17 +120,57 @@ def cases(quick=False):
              1.2, dict(method=method, rtol=1e-3, atol=1e-3, max_nfev=300, dense_output=True),
              True),
         ]
+    # stage 2c: method "auto" (method_switches compared too)
+    out += [
+        ("auto: seed 5 s", {}, 5.0, dict(method="auto"), True),
+        ("auto: seed 5 s 1e-6, dense output", {}, 5.0,
+         dict(method="auto", rtol=1e-6, atol=1e-6, dense_output=True), True),
+        ("auto: seed 30 s 1e-6 (rest checks)", {}, 30.0,
+         dict(method="auto", rtol=1e-6, atol=1e-6), True),
+        ("auto: steel ball 1e-9, dense (switches)", STEEL, 3.0,
+         dict(method="auto", rtol=1e-9, atol=1e-9, dense_output=True, exact_flight=False),
+         True),
+        ("auto: steel ball 1e-10 (switches)", STEEL, 5.0,
+         dict(method="auto", rtol=1e-10, atol=1e-10, exact_flight=False), True),
+        ("auto: steel ball 1e-9, t_eval", STEEL, 3.0,
+         dict(method="auto", rtol=1e-9, atol=1e-9, t_eval=np.linspace(0.0, 3.0, 301),
+              exact_flight=False), True),
+        ("auto: map cell", dict(mixture=0.3, friction_coefficient=0.2), 1.2,
+         dict(method="auto", rtol=1e-3, atol=1e-3), True),
+        ("auto: drop, rests", dict(velocity=(0, 0, 0), observer_mass=0), 1e6,
+         dict(method="auto", rtol=1e-6, atol=1e-6, exact_flight=False), True),
+    ]
+    # stage 2c: exact flight (ballc.flight: a massless observer's scene)
+    throw = dict(observer_mass=0, position=(0, 0, 3.0), velocity=(2.0, 0.5, 4.0),
+                 angular_velocity=(3.0, -1.0, 20.0))
+    for method in METHODS + ("auto",):
+        out += [
+            (f"flight: throw 5 s {method}", throw, 5.0, dict(method=method), True),
+            (f"flight: throw 5 s {method} 1e-6, dense, t_eval", throw, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, dense_output=True,
+                  t_eval=np.linspace(0.0, 5.0, 77)), True),
+            (f"flight: Scene(observer_mass=0) 100 s {method} 1e-6", dict(observer_mass=0),
+             100.0, dict(method=method, rtol=1e-6, atol=1e-6), True),
+            (f"flight: Scene(observer_mass=0) 1e6 s {method} 1e-6, dense",
+             dict(observer_mass=0), 1e6, dict(method=method, rtol=1e-6, atol=1e-6,
+                                              dense_output=True), True),
+            (f"flight: drop, rests {method}", dict(velocity=(0, 0, 0), observer_mass=0), 1e6,
+             dict(method=method, rtol=1e-6, atol=1e-6), True),
+            (f"flight: steel, max_step {method}", STEEL, 3.0,
+             dict(method=method, rtol=1e-8, atol=1e-8, max_step=0.01), True),
+        ]
+    out += [("flight: ceiling, massless", dict(observer_mass=0, position=(0, 0, 2.0),
+                                               velocity=(1.0, 0, 14.0), ceiling_height=5.0,
+                                               friction_coefficient=0.6), 2.0,
+             dict(method="dop853", rtol=1e-6, atol=1e-6, dense_output=True), True)]
     # must fall back
     out += [
         ("fallback: a user event", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
                                                 events=lambda t, y: y[6] - 0.5), False),
-        ("fallback: method auto", {}, 1.2, dict(method="auto", rtol=1e-3, atol=1e-3), False),
         ("fallback: compliant", dict(tangential_model="compliant"), 1.2,
          dict(method="radau5", rtol=1e-3, atol=1e-3), False),
         ("fallback: an orbit's trial (seed 100 s)", {}, 100.0,
          dict(method="dop853", rtol=1e-6, atol=1e-6), False),
-        ("fallback: exact flight (Scene(observer_mass=0))", dict(observer_mass=0), 100.0,
-         dict(method="radau5", rtol=1e-6, atol=1e-6), False),
         ("fallback: scipy Radau", {}, 0.3, dict(method="Radau", rtol=1e-3, atol=1e-3), False),
     ]
     return out
@@ -181,7 +224,7 @@ def sol_values(result):
 def differences(p, c):
     found = [] if same(sol_values(p), sol_values(c)) else ["sol"]
     for name in ("t", "y", "flags", "latch", "status", "message", "nfev", "njev", "nlu",
-                 "t_events", "y_events", "contacts"):
+                 "t_events", "y_events", "contacts", "method_switches"):
         if not same(getattr(p, name), getattr(c, name)):
             found.append(name)
     return found

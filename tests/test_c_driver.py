@@ -86,9 +86,9 @@ def test_a_failure_and_the_call_budget_are_bit_identical(monkeypatch):
 
 
 @pytest.mark.parametrize("kwargs", [
-    dict(method="Radau"), dict(method="auto"), dict(events=lambda t, y: y[6] - 0.5),
+    dict(method="Radau"), dict(events=lambda t, y: y[6] - 0.5),
     dict(atol=np.full(_core.N_STATES, 1e-3)),
-], ids=["scipy", "auto", "user event", "atol per state"])
+], ids=["scipy", "user event", "atol per state"])
 def test_runs_outside_the_subset_fall_back(monkeypatch, kwargs):
     kwargs = dict(dict(method="dop853", rtol=1e-3, atol=1e-3), **kwargs)
     result = _run(monkeypatch, False, ballc.Scene(), 0.5, **kwargs)
@@ -151,6 +151,50 @@ def test_t_eval_and_dense_output_are_bit_identical(monkeypatch, method):
                 if b > a and getattr(f, "steps", np.ones(1)).size:
                     times = np.linspace(a, b, 7)
                     assert np.array_equal(f(times), g(times))
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("scene, t_end, kw", [
+    ({}, 5.0, {}),
+    (dict(tangential_model="friction", ball_youngs_modulus=2e11, plane_youngs_modulus=2e11,
+          c_tau=0.5, observer_mass=0.0, position=(0.0, 0.0, 2.0), velocity=(0.5, 0.0, 0.0)),
+     3.0, dict(rtol=1e-9, atol=1e-9, dense_output=True, exact_flight=False)),
+    (dict(velocity=(0, 0, 0), observer_mass=0), 1e6,
+     dict(rtol=1e-6, atol=1e-6, exact_flight=False, dense_output=True)),
+], ids=["seed", "steel", "rests"])
+def test_method_auto_is_bit_identical(monkeypatch, scene, t_end, kw):
+    """Stage 2c: method "auto", its switches and the method carried across segments."""
+    scene = ballc.Scene(**scene)
+    kw = dict(kw, method="auto")
+    p = _run(monkeypatch, True, scene, t_end, **kw)
+    c = _run(monkeypatch, False, scene, t_end, **kw)
+    _assert_identical(p, c)
+    assert p.method_switches == c.method_switches
+    if kw.get("dense_output"):
+        times = np.linspace(0.0, t_end if t_end < 10 else 100.0, 501)
+        assert np.array_equal(p.sol(times), c.sol(times))
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5", "auto"])
+def test_exact_flight_is_bit_identical(monkeypatch, method):
+    """Stage 2c: a massless observer's throw (ballc.flight's closed-form segments and
+    contact starts), with t_eval and dense output, and a run that rolls on."""
+    throw = ballc.Scene(observer_mass=0, position=(0, 0, 3.0), velocity=(2.0, 0.5, 4.0),
+                        angular_velocity=(3.0, -1.0, 20.0))
+    for scene, t_end, kw in [
+            (throw, 5.0, {}),
+            (throw, 5.0, dict(rtol=1e-6, atol=1e-6, dense_output=True,
+                              t_eval=np.linspace(0.0, 5.0, 41))),
+            (ballc.Scene(observer_mass=0), 100.0, dict(rtol=1e-6, atol=1e-6))]:
+        kw = dict(kw, method=method)
+        p = _run(monkeypatch, True, scene, t_end, **kw)
+        c = _run(monkeypatch, False, scene, t_end, **kw)
+        _assert_identical(p, c)
+        assert p.method_switches == c.method_switches
+        if kw.get("dense_output"):
+            times = np.linspace(0.0, t_end, 501)
+            assert np.array_equal(p.sol(times), c.sol(times))
 
 
 @needs_c_numerics

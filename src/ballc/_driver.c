@@ -158,6 +158,8 @@ void ballc_drive_free(ballc_drive_output *o)
     free(o->t); free(o->y); free(o->block_count); free(o->block_flags);
     free(o->block_latch); free(o->contacts); free(o->phases);
     free(o->pieces); free(o->dense_t); free(o->dense_c); free(o->dense_kind);
+    free(o->switch_t); free(o->switch_to);
+    o->switch_t = NULL; o->switch_to = NULL;
     o->pieces = NULL; o->dense_t = o->dense_c = NULL; o->dense_kind = NULL;
     o->t = o->y = o->block_latch = NULL;
     o->block_count = NULL; o->block_flags = NULL; o->contacts = NULL; o->phases = NULL;
@@ -657,23 +659,184 @@ static int add_block(run_t *r, const double *t, const double *y, long count, int
 }
 
 /* Samples.add_later (first = 1: a segment's first sample is its start) */
-static int add_later(run_t *r, const radau5_result *res, double after, int flags)
+static int add_later_rows(run_t *r, long n, const double *t, const double *y_out,
+                          double after, int flags)
 {
-    long n = res->n_out, first = r->c->t_eval ? 0 : 1;   /* simulate: skip */
-    const double *t = res->t_out;
+    long first = r->c->t_eval ? 0 : 1;   /* simulate: skip */
     while (first < n && t[first] <= after) first++;
     for (long k = 0; k < r->n_rearmed; k++) {
         double when = r->rearmed_t[k];
         long cut = 0;   /* searchsorted(t, when, 'right') */
         while (cut < n && t[cut] <= when) cut++;
         if (cut < first) cut = first;
-        if (add_block(r, t + first, res->y_out + (size_t)first * N, cut - first, flags,
+        if (add_block(r, t + first, y_out + (size_t)first * N, cut - first, flags,
                       r->rearmed_latch + (size_t)k * NL))
             return -1;
         first = cut;
     }
-    return add_block(r, t + first, res->y_out + (size_t)first * N, n - first, flags,
+    return add_block(r, t + first, y_out + (size_t)first * N, n - first, flags,
                      r->latch);
+}
+
+static int add_later(run_t *r, const radau5_result *res, double after, int flags)
+{
+    return add_later_rows(r, res->n_out, res->t_out, res->y_out, after, flags);
+}
+
+/* ---- exact free flight (ballc.flight; stage 2c) ---- */
+
+#define FLIGHT_MIN_INTERVALS 32          /* flight.MIN_INTERVALS */
+#define FLIGHT_MAX_SAMPLES 100000000L    /* more: fall back (Python would allocate them) */
+
+typedef struct { double t0, rate, c[5][N]; } flight_t;
+
+/* flight.FreeFlight.__init__ */
+static void flight_init(flight_t *f, double t0, const double *y0, double gravity)
+{
+    f->t0 = t0;
+    double wx = y0[BALLC_STATE_OMEGA_X], wy = y0[BALLC_STATE_OMEGA_Y], wz = y0[BALLC_STATE_OMEGA_Z];
+    f->rate = sqrt(wx * wx + wy * wy + wz * wz);
+    double nx = 0.0, ny = 0.0, nz = 0.0;
+    if (f->rate > 0) { nx = wx / f->rate; ny = wy / f->rate; nz = wz / f->rate; }
+    double qw = y0[BALLC_STATE_QW], qx = y0[BALLC_STATE_QX], qy = y0[BALLC_STATE_QY],
+           qz = y0[BALLC_STATE_QZ];
+    double turned[4] = {-(nx * qx + ny * qy + nz * qz), nx * qw + ny * qz - nz * qy,
+                        ny * qw + nz * qx - nx * qz, nz * qw + nx * qy - ny * qx};
+    memset(f->c, 0, sizeof f->c);
+    memcpy(f->c[0], y0, N * sizeof(double));
+    for (int i = 0; i < 4; i++) {
+        f->c[0][BALLC_STATE_QW + i] = 0.0;
+        f->c[3][BALLC_STATE_QW + i] = y0[BALLC_STATE_QW + i];
+        f->c[4][BALLC_STATE_QW + i] = turned[i];
+    }
+    for (int i = 0; i < 3; i++) f->c[1][BALLC_STATE_X + i] = y0[BALLC_STATE_VX + i];
+    f->c[1][BALLC_STATE_VZ] = -gravity;
+    f->c[2][BALLC_STATE_Z] = -0.5 * gravity;
+}
+
+/* FreeFlight.__call__ at an array of times, one time: basis 1, s, s*s, cos, sin and
+ * np.einsum("kn,km->nm"), which sums the 5 products in order from +0.0 */
+static void flight_at(const flight_t *f, double t, double *y)
+{
+    double s = t - f->t0;
+    double half = 0.5 * f->rate * s;
+    double basis[5] = {1.0, s, s * s, cos(half), sin(half)};
+    for (int n = 0; n < N; n++) {
+        double acc = 0.0;
+        for (int k = 0; k < 5; k++) acc += f->c[k][n] * basis[k];
+        y[n] = acc;
+    }
+}
+
+/* flight.crossings for one terminal event of count 1: the first root, or -1 (none) */
+static int first_crossing(double c0, double c1, double c2, int direction, double s_max,
+                          double *root)
+{
+    double roots[2];
+    int rising[2], m;
+    if (c2 == 0) {
+        if (c1 == 0) return 0;
+        roots[0] = -c0 / c1;
+        rising[0] = c1 > 0;
+        m = 1;
+    } else {
+        double disc = c1 * c1 - 4.0 * c2 * c0;
+        if (!(disc > 0)) return 0;
+        double q = -0.5 * (c1 + copysign(sqrt(disc), c1));
+        double a = q / c2, b = c0 / q;
+        if (b < a) { roots[0] = b; roots[1] = a; }   /* sorted((a, b)) */
+        else { roots[0] = a; roots[1] = b; }
+        rising[0] = c2 < 0;
+        rising[1] = c2 > 0;
+        m = 2;
+    }
+    for (int i = 0; i < m; i++)
+        if (0 <= roots[i] && roots[i] <= s_max
+                && (direction == 0 || (direction > 0) == rising[i])) {
+            *root = roots[i];
+            return 1;
+        }
+    return 0;
+}
+
+
+/* flight.propagate of a segment from (r->t, r->y) to t1 whose events are the contact
+ * starts (no contact: flags 0): its samples (t_eval's points from ev[0], n_eval of them,
+ * or the even grid) stored as integrate_segment's, its dense piece.  Returns 0 (reached
+ * t1), 1 (the event *fired hit at *t_fired, state y_event), -1 (fall back), -2 (memory). */
+static int flight_segment(run_t *r, double t1, const double *ev, long n_eval, int flags,
+                          int *fired, double *t_fired, double *y_event)
+{
+    const ballc_drive_config *c = r->c;
+    double t0 = r->t;
+    flight_t f;
+    flight_init(&f, t0, r->y, c->gravity);
+    double span = t1 - t0, best = INFINITY;
+    int stop = -1;
+    for (int e = 0; e < r->n_ev; e++) {   /* FreeFlight.event_polynomial, crossings */
+        if (r->ev_kind[e] != K_ENTER || r->ev_terminal[e] != 1) return -1;
+        double scale = r->ev_coef[(size_t)e * N + BALLC_STATE_Z];
+        double c0 = scale * r->y[BALLC_STATE_Z] + r->ev_offset[e];
+        double c1 = scale * r->y[BALLC_STATE_VZ];
+        double c2 = -0.5 * scale * c->gravity;
+        double root;
+        if (first_crossing(c0, c1, c2, r->ev_direction[e], span, &root) && root < best) {
+            best = root;   /* sorted (s, k): the earliest, the first listed on a tie */
+            stop = e;
+        }
+    }
+    double t_end = t1;
+    if (stop >= 0) t_end = py_min(t0 + best, t1);
+    long n;
+    double *times, *rows;
+    if (c->t_eval) {   /* t[(t >= t0) & (t <= t_stop)] of the segment's points */
+        n = 0;
+        while (n < n_eval && ev[n] <= t_end) n++;
+        long lo = 0;
+        while (lo < n && !(ev[lo] >= t0)) lo++;
+        ev += lo;
+        n -= lo;
+        times = malloc((size_t)(n ? n : 1) * sizeof(double));
+        if (!times) return -2;
+        if (n) memcpy(times, ev, (size_t)n * sizeof(double));
+    } else {
+        double turn = f.rate * (t_end - t0) / (M_PI / 16);
+        double longest = c->max_step < INFINITY ? (t_end - t0) / c->max_step : 0.0;
+        if (!(fabs(turn) < 1e8) || !(fabs(longest) < 1e8)) return -1;
+        double m = py_max(py_max((double)FLIGHT_MIN_INTERVALS, ceil(turn)), ceil(longest));
+        long intervals = (long)m;
+        n = intervals + 1;
+        times = malloc((size_t)n * sizeof(double));
+        if (!times) return -2;
+        double dt = t_end - t0;
+        for (long i = 0; i <= intervals; i++)
+            times[i] = t0 + dt * ((double)i / (double)intervals);
+        times[intervals] = t_end;
+    }
+    rows = malloc((size_t)(n ? n : 1) * N * sizeof(double));
+    if (!rows) { free(times); return -2; }
+    for (long i = 0; i < n; i++) flight_at(&f, times[i], rows + (size_t)i * N);
+    int rc = add_later_rows(r, n, times, rows, t0, flags) ? -2 : 0;
+    free(times);
+    free(rows);
+    if (rc) return rc;
+    r->o->segments++;
+    if (c->dense_output) {   /* the piece: FreeFlight(t0, y0, gravity, t_max) */
+        ballc_drive_output *o = r->o;
+        if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1, sizeof(ballc_piece_rec)))
+            return -2;
+        ballc_piece_rec *k = &o->pieces[o->n_pieces++];
+        memset(k, 0, sizeof *k);
+        k->t0 = t0;
+        k->t1 = t_end;
+        k->flight = 1;
+        memcpy(k->y0, r->y, sizeof k->y0);
+    }
+    if (stop < 0) return 0;
+    *fired = stop;
+    *t_fired = t_end;
+    flight_at(&f, t_end, y_event);
+    return 1;
 }
 
 /* ---- the rest checks (ballc.resting; stage 2a) ---- */
@@ -839,6 +1002,7 @@ static int add_piece(run_t *r, const radau5_result *res, double t0, double t1)
     ballc_piece_rec *k = &o->pieces[o->n_pieces++];
     k->t0 = t0;
     k->t1 = t1;
+    k->flight = 0;
     k->step0 = o->n_steps;
     k->n_steps = m;
     k->coef0 = o->n_coef;
@@ -911,6 +1075,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     for (int i = 0; i < N; i++) atol[i] = c->atol;
     double first = c->first_step;
     int has_first = c->has_first_step;
+    int implicit = 0;   /* method "auto": the segment starts with radau5 */
     long nfev = 0, njev = 0, nlu = 0;
     int stiff_found = 0;
 
@@ -929,6 +1094,34 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         for (int i = 0; i < NL; i++)
             if (!isfinite(r->latch[i])) rc = -1;
         if (rc) break;
+        if (c->exact_flight && flags == 0) {   /* integrate_segment: flight.applies */
+            int fired = -1;
+            double t_fired = 0.0, y_event[N];
+            long n_eval = 0;
+            const double *ev = NULL;
+            if (c->t_eval) {
+                while (eval_at < c->n_eval && !(c->t_eval[eval_at] > r->t)) eval_at++;
+                long hi = eval_at;
+                while (hi < c->n_eval && c->t_eval[hi] <= t_stop) hi++;
+                ev = c->t_eval + eval_at;
+                n_eval = hi - eval_at;
+            }
+            int got = flight_segment(r, t_stop, ev, n_eval, flags, &fired, &t_fired, y_event);
+            has_first = 0;
+            implicit = 0;
+            if (got < 0) { rc = got; break; }
+            if (got == 0) {   /* reached t_stop: no contact, so no rest check, t_end */
+                r->t = t_stop;
+                if (t_stop < c->t_end) { rc = -1; break; }
+                break;
+            }
+            r->t = t_fired;
+            memcpy(r->y, y_event, sizeof r->y);
+            double h = ballc_py_hypot(4, r->y + BALLC_STATE_QW);
+            for (int i = 0; i < 4; i++) r->y[BALLC_STATE_QW + i] /= h;
+            if (begin_contact(r, r->ev_plane[fired])) { rc = -1; break; }
+            continue;
+        }
         radau5_problem pr;
         memset(&pr, 0, sizeof pr);
         pr.n = N;
@@ -972,11 +1165,12 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.rearm = drv_rearm;
         pr.method = c->method;
         pr.jacobian_ahead = 0;
-        pr.auto_implicit = 0;
+        pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
         radau5_result res;
         int solved = radau5_solve(&pr, &res);
         o->segments++;
         has_first = 0;
+        implicit = 0;
 #ifdef RADAU5_PROFILE
         o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
 #endif
@@ -988,6 +1182,21 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             o->stiff_at = res.stiff_at;
             stiff_found = 1;
         }
+        if (c->method == RADAU5_METHOD_AUTO && res.n_switches) {   /* switches += ... */
+            long cs = o->cap_switches;
+            if (grow((void **)&o->switch_t, &cs, o->n_switches + res.n_switches,
+                     sizeof(double))) { radau5_free(&res); rc = -2; break; }
+            int *to = realloc(o->switch_to, (size_t)cs * sizeof(int));
+            if (!to) { radau5_free(&res); rc = -2; break; }
+            o->switch_to = to;
+            o->cap_switches = cs;
+            memcpy(o->switch_t + o->n_switches, res.switch_t,
+                   (size_t)res.n_switches * sizeof(double));
+            memcpy(o->switch_to + o->n_switches, res.switch_to,
+                   (size_t)res.n_switches * sizeof(int));
+            o->n_switches += res.n_switches;
+        }
+        int ended_implicit = res.method_end == RADAU5_METHOD_RADAU;
         if (add_later(r, &res, r->t, flags)) { radau5_free(&res); rc = -2; break; }
         int fired = -1;
         double t_fired = INFINITY;
@@ -1043,6 +1252,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                     memcpy(o->end_y, r->y, sizeof r->y);
                     break;
                 }
+                implicit = ended_implicit;   /* auto keeps the method it ended with */
                 continue;   /* the next segment starts with its own first step */
             }
             radau5_free(&res);
@@ -1080,6 +1290,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         if (kind >= K_APPROACH && h_next > 0) {   /* CARRY_STEP */
             first = py_min(h_next, c->max_step);
             has_first = 1;
+            implicit = ended_implicit;
         }
     }
     if (rc) r->stop_code = rc == -2 ? BALLC_DRIVE_NO_MEMORY : BALLC_DRIVE_FALLBACK;

@@ -1,10 +1,10 @@
 /* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1, 2a -- the
- * rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back -- and 2b:
- * t_eval and dense output).
+ * rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back --, 2b: t_eval
+ * and dense output, and 2c: method "auto" and exact flight, ballc.flight).
  *
  * ballc_drive runs a whole simulation of the subset -- exact Coulomb friction (or
- * none), no compliant law, no user events, no progress bar, no exact flight, method
- * radau5 or dop853 -- and reproduces the Python driver (simulate.py with
+ * none), no compliant law, no user events, no progress bar, method radau5, dop853 or
+ * auto -- and reproduces the Python driver (simulate.py with
  * events.py, stickslip.py, modes.py, samples.py) bit for bit: the same floating-point
  * operations in the same order.  What it does not port ends the run with
  * BALLC_DRIVE_FALLBACK, and simulate() then runs the Python driver from the start.
@@ -60,6 +60,9 @@ typedef struct {                       /* constants of one run, filled by the br
     const double *t_eval;
     long n_eval;
     int dense_output;
+    /* stage 2c: exact flight (options.exact_flight and flight.scene_allows) */
+    int exact_flight;
+    double gravity;                    /* params[gravity] */
     /* the rest checks (ballc.resting; stage 2a), constants computed by Python */
     int observer_massive;              /* observer_mass > 0 */
     int rolls_allowed;                 /* flight.scene_allows: uniform motion possible */
@@ -84,7 +87,13 @@ typedef struct { long contact; double t; int phase; } ballc_phase_rec;  /* 0 sli
 
 /* dense output: one piece (t0, t1) per segment, its steps [step0, step0 + n_steps) of
  * dense_t / dense_kind and their coefficients from dense_c[coef0], (1 + terms) N each */
-typedef struct { double t0, t1; long step0, n_steps, coef0; int terms; } ballc_piece_rec;
+typedef struct {
+    double t0, t1;
+    long step0, n_steps, coef0;
+    int terms;
+    int flight;                /* exact flight: FreeFlight(t0, y0, gravity, t_max = t1) */
+    double y0[BALLC_N_STATES];
+} ballc_piece_rec;
 
 typedef struct {
     long n, cap;                        /* samples: t (n), y (n x N_STATES) */
@@ -98,6 +107,9 @@ typedef struct {
     long n_phases, cap_phases;
     ballc_phase_rec *phases;
     int open[2];                        /* open contact per plane, -1 none */
+    long n_switches, cap_switches;      /* method "auto": (t, method switched to) */
+    double *switch_t;
+    int *switch_to;
     long n_pieces, cap_pieces;          /* dense output (stage 2b) */
     ballc_piece_rec *pieces;
     long n_steps, cap_steps, n_coef, cap_coef;

@@ -38,6 +38,8 @@ cdef extern from "_driver.h":
         const double *t_eval
         long n_eval
         int dense_output
+        int exact_flight
+        double gravity
         int observer_massive, rolls_allowed, orbit_applies
         double rest_threshold, rho_eq, z_eq, rest_weight, observer_weight
         double rolls_dv, rolls_level, half_mass
@@ -61,6 +63,8 @@ cdef extern from "_driver.h":
         double t0, t1
         long step0, n_steps, coef0
         int terms
+        int flight
+        double y0[19]
     ctypedef struct ballc_drive_output:
         long n
         double *t
@@ -74,6 +78,9 @@ cdef extern from "_driver.h":
         long n_phases
         ballc_phase_rec *phases
         int open[2]
+        long n_switches
+        double *switch_t
+        int *switch_to
         long n_pieces
         ballc_piece_rec *pieces
         long n_steps, n_coef
@@ -186,6 +193,8 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
         c.n_eval = t_eval.shape[0]
         c.t_eval = &t_eval[0] if c.n_eval else &y0[0]   # non-NULL: t_eval given
     c.dense_output = k["dense_output"]
+    c.exact_flight = k["exact_flight"]
+    c.gravity = k["gravity"]
     c.observer_massive = k["observer_massive"]
     c.rolls_allowed = k["rolls_allowed"]
     c.orbit_applies = k["orbit_applies"]
@@ -252,9 +261,13 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                 lost=(rec.lost[0], rec.lost[1])))
         phases = [(o.phases[i].contact, o.phases[i].t, o.phases[i].phase)
                   for i in range(o.n_phases)]
-        pieces = []   # dense output: (t0, t1, dense_t, dense_c, terms, dense_kind)
-        for i in range(o.n_pieces):
+        pieces = []   # dense output: (t0, t1, dense_t, dense_c, terms, dense_kind), or
+        for i in range(o.n_pieces):   # (t0, t1, y0) of an exact flight
             piece = o.pieces[i]
+            if piece.flight:
+                pieces.append((piece.t0, piece.t1,
+                               np.array([piece.y0[j] for j in range(BALLC_N_STATES)])))
+                continue
             dense_t = np.empty((piece.n_steps, 2))
             dense_c = np.empty((piece.n_steps, (1 + piece.terms) * BALLC_N_STATES))
             dense_kind = np.empty(piece.n_steps, dtype=np.intc)
@@ -269,7 +282,9 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                 memcpy(&dkv[0], o.dense_kind + piece.step0, piece.n_steps * sizeof(int))
             pieces.append((piece.t0, piece.t1, dense_t, dense_c, piece.terms, dense_kind))
         return dict(t=t, rows=rows, counts=counts, block_flags=block_flags, latches=latches,
-                    contacts=contacts, phases=phases, pieces=pieces, open=(o.open[0], o.open[1]),
+                    contacts=contacts, phases=phases, pieces=pieces,
+                    switches=[(o.switch_t[i], _METHOD_NAMES[o.switch_to[i]])
+                              for i in range(o.n_switches)], open=(o.open[0], o.open[1]),
                     stop_code=o.stop_code, status=o.status, stop_plane=o.stop_plane,
                     t_run=o.t_run, fail_end=o.fail_end, message=o.message.decode(),
                     in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),

@@ -860,7 +860,7 @@ def _finish(result, options, stiff_at):
 # runs the Python loop from the start.  A rest check that finds rest or uniform motion
 # ends the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
 
-_C_METHODS = ("radau5", "dop853")
+_C_METHODS = ("radau5", "dop853", "auto")
 _END_REST, _END_ROLLING, _END_SLIDING = 1, 2, 3   # _driver.h: BALLC_END_*
 _SEAMS = (integrate_segment, _radau5.solve_system)
 
@@ -896,8 +896,8 @@ def _c_numerics_agree():
 
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
-    in the C loop's subset: method radau5 or dop853, one float atol, no user events or
-    progress bar, no compliant law, no exact flight, t_eval (if given) strictly
+    in the C loop's subset: method radau5, dop853 or auto, one float atol, no user events or
+    progress bar, no compliant law, t_eval (if given) strictly
     increasing, slip rows of at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
     process's hypot and dot as the C loop reproduces them (_c_numerics_agree)."""
     if (options.method not in _C_METHODS or options.events
@@ -915,8 +915,6 @@ def _c_config(scene, options, progress, rest):
     if not _c_numerics_agree():
         return None
     params = scene.parameter_vector()
-    if options.exact_flight and flight_scene_allows(params):
-        return None
     terms = [stickslip.slip_terms(params, plane) for plane in PLANES]
     if any(len(row) > 2 for rows in terms for row in rows):
         return None
@@ -959,6 +957,8 @@ def _c_config(scene, options, progress, rest):
         resting_plane=-1 if resting_plane is None else PLANES.index(resting_plane),
         checks_rest=int(bool(rest) and t_eval is None),
         t_eval=t_eval, dense_output=int(bool(options.dense_output)),
+        exact_flight=int(bool(options.exact_flight and flight_scene_allows(params))),
+        gravity=float(params[_core.PARAMETER_NAMES.index("gravity")]),
         rho_scale=[entry[3] for entry in planes], rho_offset=[entry[4] for entry in planes],
         through_offset=[entry[7].offset for entry in planes],
         threshold_base=[entry[5] for entry in planes],
@@ -976,8 +976,10 @@ def _simulate_c(scene, options, y, config):
     rows = out["rows"]
     block_flags, latches = out["block_flags"], out["latches"]
     end_kind = out["end_kind"]
-    pieces = [(t0, t1, CompiledInterpolant(dense_t, dense_c, terms, kinds))
-              for t0, t1, dense_t, dense_c, terms, kinds in out["pieces"]]
+    gravity = config["gravity"]
+    pieces = [(piece[0], piece[1], FreeFlight(piece[0], piece[2], gravity, t_max=piece[1])
+               if len(piece) == 3 else CompiledInterpolant(*piece[2:]))
+              for piece in out["pieces"]]
     if end_kind:   # a rest check found an end state: to t_end in closed form
         when, y_end = out["end_t"], out["end_y"]
         if end_kind == _END_REST:
@@ -1061,7 +1063,7 @@ def _simulate_c(scene, options, y, config):
                     nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], contacts=contacts,
                     flags=flags, latch=latch, t_events=[], y_events=[],
                     sol=PiecewiseSolution(pieces) if options.dense_output else None,
-                    method_switches=None)
+                    method_switches=out["switches"] if options.method == "auto" else None)
     result._driver = "c"
     result._driver_counts = {key: out[key] for key in (
         "segments", "profiled", "integrator_ns", "drive_ns")}
