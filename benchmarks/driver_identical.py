@@ -163,12 +163,28 @@ def cases(quick=False):
                                                velocity=(1.0, 0, 14.0), ceiling_height=5.0,
                                                friction_coefficient=0.6), 2.0,
              dict(method="dop853", rtol=1e-6, atol=1e-6, dense_output=True), True)]
+    # stage 3: the compliant law's exact modes (ballc.compliantmodes)
+    for method in METHODS + ("auto",):
+        for tol in (1e-4, 1e-6, 1e-9):
+            out.append((f"compliant 5 s {method} {tol:g}", dict(tangential_model="compliant"),
+                        5.0, dict(method=method, rtol=tol, atol=tol), True))
+    out += [
+        ("compliant, steel, dense", dict(STEEL, tangential_model="compliant"), 2.0,
+         dict(method="radau5", rtol=1e-6, atol=1e-6, dense_output=True), True),
+        ("compliant, no damping", dict(tangential_model="compliant",
+                                       tangential_damping_ratio=0.0), 3.0,
+         dict(method="dop853", rtol=1e-6, atol=1e-6), True),
+        ("compliant, smooth (no modes)", dict(tangential_model="compliant",
+                                              friction_regularization="smooth"), 2.0,
+         dict(method="radau5", rtol=1e-6, atol=1e-6), True),
+        ("compliant, massless, rests", dict(tangential_model="compliant", observer_mass=0,
+                                            velocity=(0, 0, 0)), 1e6,
+         dict(method="radau5", rtol=1e-6, atol=1e-6), True),
+    ]
     # must fall back
     out += [
         ("fallback: a user event", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
                                                 events=lambda t, y: y[6] - 0.5), False),
-        ("fallback: compliant", dict(tangential_model="compliant"), 1.2,
-         dict(method="radau5", rtol=1e-3, atol=1e-3), False),
         ("fallback: an orbit's trial (seed 100 s)", {}, 100.0,
          dict(method="dop853", rtol=1e-6, atol=1e-6), False),
         ("fallback: scipy Radau", {}, 0.3, dict(method="Radau", rtol=1e-3, atol=1e-3), False),

@@ -192,9 +192,22 @@ typedef struct {
     int ev_plane_code[MAX_EVENTS], ev_rearm[MAX_EVENTS];
     int ev_kind[MAX_EVENTS], ev_plane[MAX_EVENTS];
     int seg_flags;
+    /* the compliant law's modes (stage 3): per plane */
+    int compliant[2], armed[2], capacity_row[2];   /* COMPLIANT_*, bool, -1 or 4/5 */
+    int has_step[2];
+    double step_bound[2], step_until[2];           /* contact_step: (bound, until) */
+    int fired_row;
+    /* the bridge's _ball_event cache: the last compliant margins computed */
+    double margins_y[N], margins_out[6];
+    int margins_plane, margins_solved;
 } run_t;
 
-enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE };
+enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
+#define CAPACITY_FIRST (2 + 2 * 4)    /* the capacity guards' event codes (rows 4, 5) */
+#define CAPACITY_SECOND (2 + 2 * 5)
+
+enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE,
+       K_ARM, K_YIELD, K_RESTICK, K_CAPACITY };   /* from K_APPROACH on: CARRY_STEP */
 
 /* _Run.flags */
 static int run_flags(const run_t *r, int with_coulomb)
@@ -203,6 +216,13 @@ static int run_flags(const run_t *r, int with_coulomb)
     int flags = c->observer_bits;
     for (int p = 0; p < 2; p++) {
         if (!r->in_contact[p]) continue;
+        if (c->compliant_modes) {   /* compliantmodes.mode_flags */
+            if (r->compliant[p] == COMPLIANT_SLIDING) flags |= c->sliding_bits[p];
+            else if (r->compliant[p] == COMPLIANT_ELASTIC && r->armed[p])
+                flags |= c->elastic_bits[p];
+            else flags |= c->compliant_bits[p];
+            continue;
+        }
         flags |= c->contact_bits[p];
         if (with_coulomb) {
             if (r->coulomb[p] == BALLC_MODE_SLIP) flags |= c->slip_bits[p];
@@ -342,6 +362,141 @@ static int start_coulomb(run_t *r, int p)
     return settle(r, p);
 }
 
+/* ---- the compliant law's modes (ballc.compliantmodes; stage 3) ---- */
+
+static int deflection_x(int p)
+{
+    return p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X;
+}
+
+/* compliantmodes.margins (_core.compliant_margins); -1 where Python raises */
+static int margins_of(run_t *r, int p, const double *y, double *m)
+{
+    if (ballc_compliant_margins(y, r->c->params, r->latch, p, m) != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    return 0;
+}
+
+/* compliantmodes.at_cap: out = y with |s| = s_cap (only_down: not raised to it) */
+static int at_cap(run_t *r, int p, const double *y, int only_down, double *out)
+{
+    int sx = deflection_x(p);
+    memcpy(out, y, N * sizeof(double));
+    double s[2] = {out[sx], out[sx + 1]};
+    double size = ballc_py_hypot(2, s);
+    if (!(size > 0)) return 0;
+    double m[BALLC_COMPLIANT_MARGINS];
+    if (margins_of(r, p, out, m)) return -1;
+    double s_cap = m[2], k_t = m[3];
+    if (only_down && size <= s_cap) return 0;
+    double f = s_cap / size;
+    out[sx] = s[0] * f;
+    out[sx + 1] = s[1] * f;
+    out[BALLC_STATE_DISSIPATED_TANGENTIAL] += 0.5 * k_t * (size * size - s_cap * s_cap);
+    return 0;
+}
+
+/* compliantmodes._along_slip: 1 and along (2), 0 without slip, -1 on failure */
+static int along_slip(run_t *r, int p, const double *y, double *along)
+{
+    double u[2];
+    for (int row = 0; row < 2; row++) {   /* stickslip.slip_velocity_of */
+        double s = 0.0;
+        for (int k = 0; k < r->c->n_terms[p][row]; k++)
+            s += r->c->term_coef[p][row][k] * y[r->c->term_index[p][row][k]];
+        u[row] = s;
+    }
+    double speed = ballc_py_hypot(2, u);
+    if (!(speed > 0)) return 0;
+    double m[BALLC_COMPLIANT_MARGINS];
+    if (margins_of(r, p, y, m)) return -1;
+    double length = m[2] > 0 ? m[2] : 1e-100;   /* START_DEFLECTION */
+    along[0] = length * u[0] / speed;
+    along[1] = length * u[1] / speed;
+    return 1;
+}
+
+/* compliantmodes.decide (start: arming = 1): *mode and the new state */
+static int decide(run_t *r, int p, const double *y, int arming, int *mode, double *out)
+{
+    int sx = deflection_x(p);
+    double trial[N];
+    if (at_cap(r, p, y, 0, trial)) return -1;
+    double s[2] = {y[sx], y[sx + 1]};
+    int relaxed = arming || !(ballc_py_hypot(2, s) > 0);
+    if (relaxed) {
+        double along[2];
+        int got = along_slip(r, p, y, along);
+        if (got < 0) return -1;
+        if (!got) {
+            *mode = COMPLIANT_ELASTIC;
+            memcpy(out, y, N * sizeof(double));
+            return 0;
+        }
+        trial[sx] = along[0];
+        trial[sx + 1] = along[1];
+    }
+    double m[BALLC_COMPLIANT_MARGINS];
+    if (margins_of(r, p, trial, m)) return -1;
+    if (m[1] >= 0) {
+        *mode = COMPLIANT_SLIDING;
+        memcpy(out, relaxed ? trial : y, N * sizeof(double));
+        return 0;
+    }
+    *mode = COMPLIANT_ELASTIC;
+    return at_cap(r, p, y, 1, out);
+}
+
+/* _Run.set_compliant */
+static int set_compliant(run_t *r, int p, int mode)
+{
+    r->compliant[p] = mode;
+    r->capacity_row[p] = -1;
+    r->transitions[p] += 1;
+    return record_phase(r, p, mode == COMPLIANT_SLIDING ? 0 : 1);
+}
+
+/* _Run.begin_contact's compliant part (after the latch) */
+static int start_compliant(run_t *r, int p, double rate)
+{
+    const ballc_drive_config *c = r->c;
+    r->armed[p] = rho_of(r, p, r->y) >= 0.5 * c->arm_depth[p];
+    int mode;
+    double y[N];
+    if (decide(r, p, r->y, 1, &mode, y)) return -1;
+    memcpy(r->y, y, sizeof y);
+    if (set_compliant(r, p, mode)) return -1;
+    double t_c = c->contact_time_base * pow(rate, -0.2);   /* compliantmodes.step_bound */
+    r->has_step[p] = 1;
+    r->step_bound[p] = t_c / 16;
+    r->step_until[p] = r->t + 4 * t_c;
+    return 0;
+}
+
+/* _Run.max_step */
+static double run_max_step(const run_t *r)
+{
+    double step = r->c->max_step;
+    for (int p = 0; p < 2; p++)
+        if (r->has_step[p] && r->step_until[p] > r->t) step = py_min(step, r->step_bound[p]);
+    return step;
+}
+
+/* _Run.step_bound_end */
+static double step_bound_end(const run_t *r)
+{
+    double end = INFINITY;
+    int found = 0;
+    for (int p = 0; p < 2; p++)
+        if (r->has_step[p] && r->step_until[p] > r->t) {
+            end = found ? py_min(end, r->step_until[p]) : r->step_until[p];
+            found = 1;
+        }
+    return end;
+}
+
 /* _Run.begin_contact (with modes.latch_values) */
 static int begin_contact(run_t *r, int p)
 {
@@ -395,7 +550,8 @@ static int begin_contact(run_t *r, int p)
     r->dissipated_at_start[p][1] = y[BALLC_STATE_DISSIPATED_TANGENTIAL];
     r->relatches[p] = r->transitions[p] = 0;
     r->rest_check[p] = p == c->resting_plane ? r->t + c->rest_period : INFINITY;
-    if (c->exact) return start_coulomb(r, p);
+    if (c->exact && start_coulomb(r, p)) return -1;
+    if (c->compliant_modes) return start_compliant(r, p, rate);
     return 0;
 }
 
@@ -407,6 +563,9 @@ static void end_contact(run_t *r, int p)
     r->in_contact[p] = 0;
     r->coulomb[p] = BALLC_MODE_NONE;
     r->has_approach[p] = 0;
+    r->has_step[p] = 0;
+    r->compliant[p] = COMPLIANT_NONE;
+    r->capacity_row[p] = -1;
     ballc_contact_rec *rec = &o->contacts[o->open[p]];
     o->open[p] = -1;
     rec->ended = 1;
@@ -485,6 +644,44 @@ static int coulomb_event(run_t *r, int kind, int p)
     }
 }
 
+/* _Run.compliant_event */
+static int compliant_event(run_t *r, int kind, int p)
+{
+    r->stalled = stalled_at(r, r->t);
+    r->last_transition = r->t;
+    r->has_last_transition = 1;
+    if (unsettled(r, p, r->stalled)) {
+        r->status = -1;
+        r->stop_code = BALLC_DRIVE_UNSETTLED;
+        r->stop_plane = p;
+        r->o->unsettled_compliant = 1;
+        return 0;
+    }
+    if (kind == K_CAPACITY) {   /* no change: the next segment watches the way back */
+        r->capacity_row[p] = r->fired_row == 4 ? 5 : 4;
+        return 0;
+    }
+    double y[N];
+    if (kind == K_ARM) r->armed[p] = 1;
+    else if (kind == K_YIELD) {   /* compliantmodes.load_vanished */
+        double m[BALLC_COMPLIANT_MARGINS];
+        if (margins_of(r, p, r->y, m)) return -1;
+        if (!(m[2] > 0) || m[0] > 0.5) {
+            r->armed[p] = 0;
+            return set_compliant(r, p, COMPLIANT_ELASTIC);
+        }
+    }
+    if (kind == K_ARM || kind == K_YIELD) {
+        int mode;
+        if (decide(r, p, r->y, kind == K_ARM, &mode, y)) return -1;
+        memcpy(r->y, y, sizeof y);
+        return set_compliant(r, p, mode);
+    }
+    if (at_cap(r, p, r->y, 1, y)) return -1;   /* restick */
+    memcpy(r->y, y, sizeof y);
+    return set_compliant(r, p, COMPLIANT_ELASTIC);
+}
+
 /* stickslip.slip_stop_coefficients */
 static void stop_coefficients(const run_t *r, int p, const double *d, double *row)
 {
@@ -513,8 +710,23 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     run_t *r = (run_t *)ctx;
     double out[6];
     (void)t;
-    int status = ballc_stick_state(y, r->c->params, r->latch, r->seg_flags,
-                                   r->ev_plane_code[e], out);
+    int code = r->ev_plane_code[e];
+    if (code >= 2) {   /* a compliant guard: the bridge's _ball_event, with its cache */
+        int row = (code - 2) / 2, plane = code % 2;
+        if (r->margins_plane == plane && (row != 1 || r->margins_solved)
+                && memcmp(r->margins_y, y, N * sizeof(double)) == 0) {
+            g[0] = r->margins_out[row];
+            return BALLC_OK;
+        }
+        int st = ballc_compliant_margins_prepared(y, &r->prepared, r->latch, plane, row,
+                                                  r->margins_out);
+        r->margins_plane = st == BALLC_OK ? plane : -1;
+        r->margins_solved = row == 1;
+        memcpy(r->margins_y, y, N * sizeof(double));
+        g[0] = r->margins_out[row];
+        return st;
+    }
+    int status = ballc_stick_state(y, r->c->params, r->latch, r->seg_flags, code, out);
     g[0] = out[3];
     return status;
 }
@@ -523,6 +735,11 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
 static int drv_rearm(void *ctx, int e, double t, const double *y)
 {
     run_t *r = (run_t *)ctx;
+    int code = r->ev_plane_code[e];
+    if (code >= CAPACITY_FIRST) {   /* the bridge's _ball_rearm: a capacity guard toggles */
+        r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + 2 : code - 2;
+        return 1;
+    }
     int p = r->ev_plane[e];
     long stalled = stalled_at(r, t);
     if (unsettled(r, p, stalled) || r->relatches[p] + 1 > MAX_RELATCH) return 0;
@@ -546,6 +763,7 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
     if (set_mode(r, p, BALLC_MODE_SLIP, d, 1, approach)) return 0;
     stop_coefficients(r, p, d, r->ev_coef + (size_t)e * N);
     r->ev_offset[e] = -approach;
+    r->margins_plane = -1;   /* the margins read the latch */
     return 1;
 }
 
@@ -591,6 +809,7 @@ static int segment_events(run_t *r, int flags)
             add_event(r, K_DEEPEST, p, NULL, BALLC_STATE_VZ, p == 0 ? -1.0 : 1.0, 0.0, 0, -1);
         } else {
             double threshold = py_max(base, rho0 + base);
+            if (c->compliant_modes) threshold = py_max(threshold, c->arm_depth[p]);
             add_event(r, K_ENTER, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
                       c->rho_offset[p] + (-threshold), 1, 1);
         }
@@ -620,6 +839,31 @@ static int segment_events(run_t *r, int flags)
             int k = add_event(r, K_RELEASE, p, NULL, -1, 0, force_scale(r, out[2]), 1, -1);
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = p;
+        }
+        if (r->compliant[p] != COMPLIANT_NONE) {   /* compliantmodes.guard */
+            if (!r->armed[p]) {   /* the penetration rising through the arming depth */
+                add_event(r, K_ARM, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
+                          c->rho_offset[p] + (-c->arm_depth[p]), 1, 1);
+                continue;
+            }
+            double rounding = py_max(64 * DBL_EPSILON, c->ulp8[p] / py_max(rho0, 1e-300));
+            int elastic = r->compliant[p] == COMPLIANT_ELASTIC;
+            double offset = elastic ? rounding
+                                    : rounding * speed_scale(r, y0) * c->restick_factor;
+            int k = add_event(r, elastic ? K_YIELD : K_RESTICK, p, NULL, -1, 0, offset, 1, -1);
+            r->ev_nonlinear[k] = 1;
+            r->ev_plane_code[k] = 2 + 2 * (elastic ? 0 : 1) + p;
+            if (elastic && c->damping_positive) {   /* compliantmodes.capacity_guard */
+                double m[BALLC_COMPLIANT_MARGINS];
+                if (margins_of(r, p, y0, m)) return -1;
+                int row = r->capacity_row[p] >= 0 ? r->capacity_row[p] : (m[4] >= 0 ? 4 : 5);
+                double cap = m[2] * m[3];
+                k = add_event(r, K_CAPACITY, p, NULL, -1, 0, rounding * py_max(cap, 1e-12),
+                              1, -1);
+                r->ev_nonlinear[k] = 1;
+                r->ev_plane_code[k] = 2 + 2 * row + p;
+                r->ev_rearm[k] = 1;
+            }
         }
     }
     return 0;
@@ -800,8 +1044,9 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval, in
         if (!times) return -2;
         if (n) memcpy(times, ev, (size_t)n * sizeof(double));
     } else {
+        double max_step = run_max_step(r);
         double turn = f.rate * (t_end - t0) / (M_PI / 16);
-        double longest = c->max_step < INFINITY ? (t_end - t0) / c->max_step : 0.0;
+        double longest = max_step < INFINITY ? (t_end - t0) / max_step : 0.0;
         if (!(fabs(turn) < 1e8) || !(fabs(longest) < 1e8)) return -1;
         double m = py_max(py_max((double)FLIGHT_MIN_INTERVALS, ceil(turn)), ceil(longest));
         long intervals = (long)m;
@@ -1044,6 +1289,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     ballc_parameters_init(&r->prepared, c->params);
     memcpy(r->y, y0, sizeof r->y);
     r->rest_check[0] = r->rest_check[1] = INFINITY;
+    r->capacity_row[0] = r->capacity_row[1] = -1;
+    r->margins_plane = -1;
     int rc = 0;
     for (int i = 0; i < BALLC_N_PARAMETERS; i++)
         if (!isfinite(c->params[i])) rc = -1;   /* solve_system would raise */
@@ -1088,7 +1335,9 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         if (c->checks_rest && c->resting_plane >= 0 && r->in_contact[c->resting_plane]
                 && !r->in_contact[1 - c->resting_plane])
             t_check = r->rest_check[c->resting_plane];
-        double t_stop = c->t_end < t_check ? c->t_end : t_check;
+        /* a rest check, or the end of a compliant contact's step bound, ends it */
+        double t_stop = py_min(py_min(t_check, c->t_end), step_bound_end(r));
+        double max_step = run_max_step(r);
         for (int i = 0; i < N; i++)
             if (!isfinite(r->y[i])) rc = -1;
         for (int i = 0; i < NL; i++)
@@ -1133,7 +1382,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.y0 = r->y;
         pr.rtol = c->rtol;
         pr.atol = atol;
-        pr.max_step = c->max_step;
+        pr.max_step = max_step;
         pr.first_step = 0.0;
         if (has_first) {   /* integrate.integrate_segment, then the bridge's check */
             double f = py_min(first, t_stop - r->t);
@@ -1164,7 +1413,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.ev_rearm = r->ev_rearm;
         pr.rearm = drv_rearm;
         pr.method = c->method;
-        pr.jacobian_ahead = 0;
+        pr.jacobian_ahead = (flags & c->compliant_any) != 0;
+        r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
         radau5_result res;
         int solved = radau5_solve(&pr, &res);
@@ -1238,10 +1488,14 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 radau5_free(&res); rc = -2; break;
             }
             r->t = t_stop;
-            if (t_stop < c->t_end) {   /* a rest check (ballc.resting) */
+            if (t_stop < c->t_end) {   /* a rest check (ballc.resting) or a step bound's end */
                 if (!res.n_out) { radau5_free(&res); rc = -1; break; }
                 memcpy(r->y, res.y_out + (size_t)(res.n_out - 1) * N, sizeof r->y);
                 radau5_free(&res);
+                if (t_stop != t_check) {   /* only a step bound ended: a fresh step */
+                    implicit = ended_implicit;
+                    continue;
+                }
                 int p = c->resting_plane;
                 int kind = end_state(r, p);
                 if (kind < 0) { rc = -1; break; }
@@ -1269,6 +1523,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         double h = ballc_py_hypot(4, r->y + BALLC_STATE_QW);
         for (int i = 0; i < 4; i++) r->y[BALLC_STATE_QW + i] /= h;
         int kind = r->ev_kind[fired], p = r->ev_plane[fired];
+        if (kind == K_CAPACITY)   /* its row may have toggled inside the segment */
+            r->fired_row = (r->ev_plane_code[fired] - 2) / 2;
         int handled = 0;
         switch (kind) {
         case K_ENTER: handled = begin_contact(r, p); break;
@@ -1284,11 +1540,14 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             r->stop_plane = p;
             break;
         }
+        case K_ARM: case K_YIELD: case K_RESTICK: case K_CAPACITY:
+            handled = compliant_event(r, kind, p);
+            break;
         default: handled = coulomb_event(r, kind, p); break;
         }
         if (handled) { rc = -1; break; }
         if (kind >= K_APPROACH && h_next > 0) {   /* CARRY_STEP */
-            first = py_min(h_next, c->max_step);
+            first = py_min(h_next, run_max_step(r));
             has_first = 1;
             implicit = ended_implicit;
         }

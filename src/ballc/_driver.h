@@ -1,10 +1,11 @@
 /* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1, 2a -- the
  * rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back --, 2b: t_eval
- * and dense output, and 2c: method "auto" and exact flight, ballc.flight).
+ * and dense output, 2c: method "auto" and exact flight, ballc.flight, and 3: the
+ * compliant law's exact modes, ballc.compliantmodes).
  *
- * ballc_drive runs a whole simulation of the subset -- exact Coulomb friction (or
- * none), no compliant law, no user events, no progress bar, method radau5, dop853 or
- * auto -- and reproduces the Python driver (simulate.py with
+ * ballc_drive runs a whole simulation of the subset -- exact Coulomb friction, the
+ * compliant law or no friction, no user events, no progress bar, method radau5,
+ * dop853 or auto -- and reproduces the Python driver (simulate.py with
  * events.py, stickslip.py, modes.py, samples.py) bit for bit: the same floating-point
  * operations in the same order.  What it does not port ends the run with
  * BALLC_DRIVE_FALLBACK, and simulate() then runs the Python driver from the start.
@@ -63,6 +64,15 @@ typedef struct {                       /* constants of one run, filled by the br
     /* stage 2c: exact flight (options.exact_flight and flight.scene_allows) */
     int exact_flight;
     double gravity;                    /* params[gravity] */
+    /* stage 3: the compliant law's exact modes (ballc.compliantmodes) */
+    int compliant_modes;               /* compliantmodes.uses_modes */
+    int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* mode_flags per plane */
+    int compliant_any;                 /* FLOOR_COMPLIANT | CEILING_COMPLIANT */
+    double arm_depth[2];               /* arm_penetration */
+    double ulp8[2];                    /* 8 ulp(plane_position): _rounding */
+    double restick_factor;             /* max(1, mu / max(tangential_stiffness_ratio, 1e-300)) */
+    int damping_positive;              /* tangential_damping_ratio > 0: capacity guards */
+    double contact_time_base;          /* 3.2145 (m_total / k0)^0.4: contact_time */
     /* the rest checks (ballc.resting; stage 2a), constants computed by Python */
     int observer_massive;              /* observer_mass > 0 */
     int rolls_allowed;                 /* flight.scene_allows: uniform motion possible */
@@ -121,6 +131,7 @@ typedef struct {
     double fail_end;                    /* FAILED: t[-1] of the segment, or run.t */
     int in_contact[2];
     long transitions[2], stalled;
+    int unsettled_compliant;            /* UNSETTLED: the compliant law's modes */
     long nfev, njev, nlu;
     double stiff_at;                    /* NaN: none */
     char message[240];                  /* FAILED: the integrator's message */

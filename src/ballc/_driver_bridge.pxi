@@ -40,6 +40,16 @@ cdef extern from "_driver.h":
         int dense_output
         int exact_flight
         double gravity
+        int compliant_modes
+        int compliant_bits[2]
+        int elastic_bits[2]
+        int sliding_bits[2]
+        int compliant_any
+        double arm_depth[2]
+        double ulp8[2]
+        double restick_factor
+        int damping_positive
+        double contact_time_base
         int observer_massive, rolls_allowed, orbit_applies
         double rest_threshold, rho_eq, z_eq, rest_weight, observer_weight
         double rolls_dv, rolls_level, half_mass
@@ -92,6 +102,7 @@ cdef extern from "_driver.h":
         int in_contact[2]
         long transitions[2]
         long stalled
+        int unsettled_compliant
         long nfev, njev, nlu
         double stiff_at
         char message[240]
@@ -195,6 +206,17 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.dense_output = k["dense_output"]
     c.exact_flight = k["exact_flight"]
     c.gravity = k["gravity"]
+    c.compliant_modes = k["compliant_modes"]
+    c.compliant_any = k["compliant_any"]
+    c.restick_factor = k["restick_factor"]
+    c.damping_positive = k["damping_positive"]
+    c.contact_time_base = k["contact_time_base"]
+    for p in range(2):
+        c.compliant_bits[p] = k["compliant_bits"][p]
+        c.elastic_bits[p] = k["elastic_bits"][p]
+        c.sliding_bits[p] = k["sliding_bits"][p]
+        c.arm_depth[p] = k["arm_depth"][p]
+        c.ulp8[p] = k["ulp8"][p]
     c.observer_massive = k["observer_massive"]
     c.rolls_allowed = k["rolls_allowed"]
     c.orbit_applies = k["orbit_applies"]
@@ -289,6 +311,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                     t_run=o.t_run, fail_end=o.fail_end, message=o.message.decode(),
                     in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),
                     transitions=(o.transitions[0], o.transitions[1]), stalled=o.stalled,
+                    unsettled_compliant=bool(o.unsettled_compliant),
                     nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
                     segments=o.segments, end_kind=o.end_kind, end_plane=o.end_plane,
                     end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(BALLC_N_STATES)]),

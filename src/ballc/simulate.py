@@ -897,7 +897,7 @@ def _c_numerics_agree():
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
     in the C loop's subset: method radau5, dop853 or auto, one float atol, no user events or
-    progress bar, no compliant law, t_eval (if given) strictly
+    progress bar, t_eval (if given) strictly
     increasing, slip rows of at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
     process's hypot and dot as the C loop reproduces them (_c_numerics_agree)."""
     if (options.method not in _C_METHODS or options.events
@@ -909,8 +909,6 @@ def _c_config(scene, options, progress, rest):
         if t_eval.ndim != 1 or not np.all(np.diff(t_eval) > 0):
             return None
     if progress or (progress is None and sys.stderr.isatty()):
-        return None
-    if scene.tangential_model == "compliant" or compliantmodes.uses_modes(scene):
         return None
     if not _c_numerics_agree():
         return None
@@ -938,7 +936,21 @@ def _c_config(scene, options, progress, rest):
                                             * math.sqrt(scene.gravity * scene.radius)),
             rolls_level=float(1e3 * np.finfo(float).eps * scene.gravity),
             half_mass=0.5 * resting.total_mass(scene))
+    modes_on = compliantmodes.uses_modes(scene)
+    arm_depth = segment_events.arm_depth or {plane: 0.0 for plane in PLANES}
     return dict(
+        compliant_modes=int(modes_on),
+        compliant_bits=[flags[f"{plane}_compliant"] for plane in PLANES],
+        elastic_bits=[flags[f"{plane}_compliant_elastic"] for plane in PLANES],
+        sliding_bits=[flags[f"{plane}_compliant_sliding"] for plane in PLANES],
+        compliant_any=flags["floor_compliant"] | flags["ceiling_compliant"],
+        arm_depth=[float(arm_depth[plane]) for plane in PLANES],
+        ulp8=[8 * math.ulp(compliantmodes.plane_position(scene, plane)) for plane in PLANES],
+        restick_factor=max(1.0, scene.friction_coefficient
+                           / max(scene.tangential_stiffness_ratio, 1e-300)),
+        damping_positive=int(params[compliantmodes._TANGENTIAL_DAMPING] > 0),
+        contact_time_base=3.2145 * ((scene.mass + scene.observer_mass)
+                                    / scene.hertz_stiffness) ** 0.4,
         observer_massive=int(scene.observer_mass > 0),
         rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbit.applies(scene)),
         **rest_consts,
@@ -1053,7 +1065,9 @@ def _simulate_c(scene, options, y, config):
                    + failure_hint(scene, in_contact, options.atol))
     elif code == _core.DRIVE_UNSETTLED:
         plane = PLANES[out["stop_plane"]]
-        message = (f"stick-slip transitions on the {plane} did not settle: "
+        what = ("the compliant law's elastic/sliding" if out["unsettled_compliant"]
+                else "stick-slip")
+        message = (f"{what} transitions on the {plane} did not settle: "
                    f"{out['transitions'][out['stop_plane']]} mode changes in one contact, "
                    f"{out['stalled']} of them at t = {out['t_run']:.17g} s")
     elif code == _core.DRIVE_THROUGH:
