@@ -6,16 +6,19 @@ One process: each case runs with the Python driver (BALLC_PYTHON_DRIVER=1) and w
 default (the C loop where the run is in its subset), and every output is compared:
 t, y, flags, latch (np.array_equal, NaN equal to NaN, and dtype and memory order),
 status, message, nfev/njev/nlu, t_events/y_events, every field of every contact
-(value and type), and Result.sol's pieces and values.  A case marked C-eligible fails if it ran in Python (``_driver``), so
-a fallback cannot pass vacuously.  Exit status 0 when all are identical, 1 otherwise.
+(value and type), method_switches, and Result.sol's pieces and values.  A case marked
+C-eligible fails if it ran in Python (``_driver``), so a fallback cannot pass vacuously.
+Exit status 0 when all are identical, 1 otherwise.
 
-Cases: the comeback map's cells Scene(mixture=m, friction_coefficient=mu), 1.2 s at
-rtol = atol = 1e-3, m in {0, 0.3, 0.7, 1}, mu in {0, 0.2, 0.5, 1}, both methods; the
-seed scene Scene() for 5 s at the default tolerance and at 1e-6, both methods; and a few
-other paths of the C loop (a start in contact, regularised friction, max_step and
-first_step, y0, passing through, the ceiling, a call budget); the rest checks (rest, uniform
-rolling and sliding, checks that find neither); and runs that must fall back (t_eval,
-dense output, compliant law, an orbit's trial, method "Radau").
+Cases (see cases()): the comeback map's cells Scene(mixture=m, friction_coefficient=mu),
+1.2 s at rtol = atol = 1e-3, m in {0, 0.3, 0.7, 1}, mu in {0, 0.2, 0.5, 1}, both
+methods; the seed scene Scene() for 5 s at the default tolerance and at 1e-6; other
+paths of stage 1 (a start in contact, regularised friction, max_step and first_step, y0,
+passing through, the ceiling, a call budget); stage 2a, the rest checks (rest, uniform
+rolling, checks that find neither); 2b, t_eval and dense output; 2c, method "auto" and
+exact flight; 3, the compliant law's modes at 1e-4/1e-6/1e-9; 4, user events (terminal
+and not, callables and LinearEvents); and runs that must fall back (an orbit's trial,
+method "Radau", a LinearEvent of several states in exact flight).
 """
 from __future__ import annotations
 
@@ -181,13 +184,45 @@ def cases(quick=False):
                                             velocity=(0, 0, 0)), 1e6,
          dict(method="radau5", rtol=1e-6, atol=1e-6), True),
     ]
+    # stage 4: the user's events (callables called back from C; LinearEvents in C)
+    def apex(t, y):   # vz falling through 0: each apex of a bounce
+        return y[12]
+    apex.direction = -1
+
+    def low(t, y):    # z below 0.5 m, terminal
+        return y[6] - 0.5
+    low.terminal = True
+
+    def twice(t, y):  # the second time z falls through 1.2 m stops the run
+        return y[6] - 1.2
+    twice.terminal, twice.direction = 2, -1
+    height = ballc.events.LinearEvent.of_state("z", 1.0, -2.0, terminal=False, direction=0)
+    height_stop = ballc.events.LinearEvent.of_state("z", 1.0, -0.8, terminal=3, direction=-1)
+    for method in METHODS + ("auto",):
+        out += [
+            (f"user: apex, not terminal {method}", {}, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[apex]), True),
+            (f"user: terminal {method}", {}, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[apex, low]), True),
+            (f"user: terminal at the 2nd, dense {method}", {}, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[twice, apex],
+                  dense_output=True), True),
+            (f"user: LinearEvents, flight {method}", dict(observer_mass=0), 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[height, height_stop]), True),
+            (f"user: LinearEvent + callable, flight {method}", dict(observer_mass=0), 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[height, apex],
+                  t_eval=np.linspace(0.0, 5.0, 51)), True),
+            (f"user: compliant, terminal {method}", dict(tangential_model="compliant"), 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[twice]), True),
+        ]
     # must fall back
     out += [
-        ("fallback: a user event", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
-                                                events=lambda t, y: y[6] - 0.5), False),
         ("fallback: an orbit's trial (seed 100 s)", {}, 100.0,
          dict(method="dop853", rtol=1e-6, atol=1e-6), False),
         ("fallback: scipy Radau", {}, 0.3, dict(method="Radau", rtol=1e-3, atol=1e-3), False),
+        ("fallback: a LinearEvent of several states in exact flight", dict(observer_mass=0),
+         2.0, dict(method="dop853", rtol=1e-6, atol=1e-6, events=[ballc.events.LinearEvent(
+             np.eye(19)[6] + np.eye(19)[4], -1.0)]), False),
     ]
     return out
 

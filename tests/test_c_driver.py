@@ -86,12 +86,14 @@ def test_a_failure_and_the_call_budget_are_bit_identical(monkeypatch):
 
 
 @pytest.mark.parametrize("kwargs", [
-    dict(method="Radau"), dict(events=lambda t, y: y[6] - 0.5),
-    dict(atol=np.full(_core.N_STATES, 1e-3)),
-], ids=["scipy", "user event", "atol per state"])
+    dict(method="Radau"), dict(atol=np.full(_core.N_STATES, 1e-3)),
+    dict(events=[ballc.events.LinearEvent(np.eye(_core.N_STATES)[6]
+                                          + np.eye(_core.N_STATES)[4], -1.0)]),
+], ids=["scipy", "atol per state", "LinearEvent of several states"])
 def test_runs_outside_the_subset_fall_back(monkeypatch, kwargs):
     kwargs = dict(dict(method="dop853", rtol=1e-3, atol=1e-3), **kwargs)
-    result = _run(monkeypatch, False, ballc.Scene(), 0.5, **kwargs)
+    # (a massless observer: exact flight would take the LinearEvent with a BLAS dot)
+    result = _run(monkeypatch, False, ballc.Scene(observer_mass=0), 0.5, **kwargs)
     assert result._driver == "python"
 
 
@@ -207,6 +209,55 @@ def test_the_compliant_modes_are_bit_identical(monkeypatch, method, tol):
     _assert_identical(p, c)
     assert any(phase == "stick" for k in c.contacts for _, phase in k.transitions)
     assert any(phase == "slip" for k in c.contacts for _, phase in k.transitions)
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5"])
+def test_user_events_are_bit_identical(monkeypatch, method):
+    """Stage 4: the user's callables (called back from C, as often as by the Python
+    driver), terminal at a count, and LinearEvents (also in exact flight)."""
+    calls = []
+
+    def apex(t, y):
+        calls.append(t)
+        return y[12]
+    apex.direction = -1
+
+    def twice(t, y):
+        return y[6] - 1.2
+    twice.terminal, twice.direction = 2, -1
+    height = ballc.events.LinearEvent.of_state("z", 1.0, -0.8, terminal=3, direction=-1)
+    for scene, kw in [(ballc.Scene(), dict(events=[apex])),
+                      (ballc.Scene(), dict(events=[twice, apex], dense_output=True)),
+                      (ballc.Scene(observer_mass=0), dict(events=[height, apex]))]:
+        kw = dict(kw, method=method, rtol=1e-6, atol=1e-6)
+        calls.clear()
+        p = _run(monkeypatch, True, scene, 5.0, **kw)
+        python_calls = list(calls)
+        calls.clear()
+        c = _run(monkeypatch, False, scene, 5.0, **kw)
+        _assert_identical(p, c)
+        assert calls == python_calls
+        for a, b in zip(p.t_events + p.y_events, c.t_events + c.y_events):
+            assert a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+
+
+@needs_c_numerics
+def test_a_user_event_that_raises_raises_as_in_python(monkeypatch):
+    def bad(t, y):
+        if t > 0.5:
+            raise KeyError("boom")
+        return 1.0
+
+    def nan(t, y):
+        return float("nan") if t > 0.5 else 1.0
+    for event, error in ((bad, KeyError), (nan, ValueError)):
+        messages = []
+        for python in (True, False):
+            with pytest.raises(error) as caught:
+                _run(monkeypatch, python, ballc.Scene(), 2.0, method="dop853", events=[event])
+            messages.append(str(caught.value))
+        assert messages[0] == messages[1]
 
 
 @needs_c_numerics

@@ -17,7 +17,8 @@
 #define N BALLC_N_STATES
 #define NL BALLC_N_LATCH
 #define NLP BALLC_N_LATCH_PER_PLANE
-#define MAX_EVENTS 12
+#define MAX_EVENTS 64     /* the driver's (at most 12) and the user's */
+#define MAX_USER_EVENTS (MAX_EVENTS - 12)
 #define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
 #define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
 
@@ -160,6 +161,8 @@ void ballc_drive_free(ballc_drive_output *o)
     free(o->pieces); free(o->dense_t); free(o->dense_c); free(o->dense_kind);
     free(o->switch_t); free(o->switch_to);
     o->switch_t = NULL; o->switch_to = NULL;
+    free(o->user_hit_event); free(o->user_hit_t); free(o->user_hit_y);
+    o->user_hit_event = NULL; o->user_hit_t = o->user_hit_y = NULL;
     o->pieces = NULL; o->dense_t = o->dense_c = NULL; o->dense_kind = NULL;
     o->t = o->y = o->block_latch = NULL;
     o->block_count = NULL; o->block_flags = NULL; o->contacts = NULL; o->phases = NULL;
@@ -191,7 +194,12 @@ typedef struct {
     int ev_terminal[MAX_EVENTS], ev_direction[MAX_EVENTS], ev_nonlinear[MAX_EVENTS];
     int ev_plane_code[MAX_EVENTS], ev_rearm[MAX_EVENTS];
     int ev_kind[MAX_EVENTS], ev_plane[MAX_EVENTS];
+    int ev_index[MAX_EVENTS];        /* linear in one state: it (exact flight), else -1 */
+    double ev_scale[MAX_EVENTS];     /*   and its coefficient */
     int seg_flags;
+    /* the user's events (stage 4): occurrences so far, a callback's error */
+    long user_seen[MAX_USER_EVENTS];
+    int user_failed;
     /* the compliant law's modes (stage 3): per plane */
     int compliant[2], armed[2], capacity_row[2];   /* COMPLIANT_*, bool, -1 or 4/5 */
     int has_step[2];
@@ -207,7 +215,7 @@ enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
 #define CAPACITY_SECOND (2 + 2 * 5)
 
 enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE,
-       K_ARM, K_YIELD, K_RESTICK, K_CAPACITY };   /* from K_APPROACH on: CARRY_STEP */
+       K_ARM, K_YIELD, K_RESTICK, K_CAPACITY, K_USER };   /* from K_APPROACH on: CARRY_STEP */
 
 /* _Run.flags */
 static int run_flags(const run_t *r, int with_coulomb)
@@ -711,6 +719,11 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     double out[6];
     (void)t;
     int code = r->ev_plane_code[e];
+    if (code <= -2) {   /* the user's callable (the bridge's _user_event) */
+        int st = r->c->user_fun(r->c->user_ctx, -2 - code, t, y, g);
+        if (st) r->user_failed = 1;
+        return st;
+    }
     if (code >= 2) {   /* a compliant guard: the bridge's _ball_event, with its cache */
         int row = (code - 2) / 2, plane = code % 2;
         if (r->margins_plane == plane && (row != 1 || r->margins_solved)
@@ -787,6 +800,8 @@ static int add_event(run_t *r, int kind, int p, const double *coef, int state, d
     r->ev_rearm[k] = 0;
     r->ev_kind[k] = kind;
     r->ev_plane[k] = p;
+    r->ev_index[k] = coef ? -1 : state;
+    r->ev_scale[k] = scale;
     return k;
 }
 
@@ -864,6 +879,20 @@ static int segment_events(run_t *r, int flags)
                 r->ev_plane_code[k] = 2 + 2 * row + p;
                 r->ev_rearm[k] = 1;
             }
+        }
+    }
+    /* the user's (UserEvents.for_segment): terminal = the occurrences left */
+    for (int u = 0; u < c->n_user; u++) {
+        int left = c->user_count[u] ? (int)(c->user_count[u] - r->user_seen[u]) : 0;
+        double offset = c->user_offset[u];
+        if (c->user_linear[u] && left != c->user_count[u]) offset = offset + 0.0;  /* shifted */
+        int k = add_event(r, K_USER, u, c->user_linear[u] ? c->user_coef + (size_t)u * N : NULL,
+                          -1, 0, offset, left, c->user_direction[u]);
+        r->ev_index[k] = c->user_linear[u] ? c->user_index[u] : -1;
+        r->ev_scale[k] = c->user_linear[u] ? c->user_scale[u] : 0.0;
+        if (!c->user_linear[u]) {   /* a callable: evaluated in Python, through the bridge */
+            r->ev_nonlinear[k] = 1;
+            r->ev_plane_code[k] = -2 - u;
         }
     }
     return 0;
@@ -972,12 +1001,13 @@ static void flight_at(const flight_t *f, double t, double *y)
     }
 }
 
-/* flight.crossings for one terminal event of count 1: the first root, or -1 (none) */
-static int first_crossing(double c0, double c1, double c2, int direction, double s_max,
-                          double *root)
+/* flight.crossings: the roots in [0, s_max] where it changes sign in ``direction``, in
+ * increasing order (at most 2) */
+static int crossings(double c0, double c1, double c2, int direction, double s_max,
+                     double *out)
 {
     double roots[2];
-    int rising[2], m;
+    int rising[2], m, n = 0;
     if (c2 == 0) {
         if (c1 == 0) return 0;
         roots[0] = -c0 / c1;
@@ -996,43 +1026,73 @@ static int first_crossing(double c0, double c1, double c2, int direction, double
     }
     for (int i = 0; i < m; i++)
         if (0 <= roots[i] && roots[i] <= s_max
-                && (direction == 0 || (direction > 0) == rising[i])) {
-            *root = roots[i];
-            return 1;
-        }
-    return 0;
+                && (direction == 0 || (direction > 0) == rising[i]))
+            out[n++] = roots[i];
+    return n;
 }
 
 
-/* flight.propagate of a segment from (r->t, r->y) to t1 whose events are the contact
- * starts (no contact: flags 0): its samples (t_eval's points from ev[0], n_eval of them,
- * or the even grid) stored as integrate_segment's, its dense piece.  Returns 0 (reached
- * t1), 1 (the event *fired hit at *t_fired, state y_event), -1 (fall back), -2 (memory). */
-static int flight_segment(run_t *r, double t1, const double *ev, long n_eval, int flags,
-                          int *fired, double *t_fired, double *y_event)
+/* flight.propagate of a segment from (r->t, r->y) to t1 whose events are all linear in
+ * one state that is not the quaternion (the contact starts, the user's LinearEvents):
+ * its samples (t_eval's points from ev, n_eval of them, or the even grid) and its hits,
+ * in ``res`` as the integrator would give them (freed by radau5_free).  Returns 0,
+ * -1 (fall back) or -2 (memory). */
+static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
+                          radau5_result *res)
 {
     const ballc_drive_config *c = r->c;
-    double t0 = r->t;
+    double t0 = r->t, g = c->gravity;
     flight_t f;
-    flight_init(&f, t0, r->y, c->gravity);
-    double span = t1 - t0, best = INFINITY;
-    int stop = -1;
+    flight_init(&f, t0, r->y, g);
+    memset(res, 0, sizeof *res);
+    res->stiff_at = NAN;
+    res->method_end = -1;
+    double span = t1 - t0;
+    /* the hits (s, event), at most 2 per event, sorted as Python sorts the tuples */
+    double hs[2 * MAX_EVENTS];
+    int he[2 * MAX_EVENTS], nh = 0;
     for (int e = 0; e < r->n_ev; e++) {   /* FreeFlight.event_polynomial, crossings */
-        if (r->ev_kind[e] != K_ENTER || r->ev_terminal[e] != 1) return -1;
-        double scale = r->ev_coef[(size_t)e * N + BALLC_STATE_Z];
-        double c0 = scale * r->y[BALLC_STATE_Z] + r->ev_offset[e];
-        double c1 = scale * r->y[BALLC_STATE_VZ];
-        double c2 = -0.5 * scale * c->gravity;
-        double root;
-        if (first_crossing(c0, c1, c2, r->ev_direction[e], span, &root) && root < best) {
-            best = root;   /* sorted (s, k): the earliest, the first listed on a tie */
-            stop = e;
+        int k = r->ev_index[e];
+        if (k < 0 || r->ev_nonlinear[e]) return -1;
+        double scale = r->ev_scale[e], y0k = r->y[k];
+        double c0 = scale * y0k + r->ev_offset[e];
+        double c1 = scale * (k >= BALLC_STATE_X && k <= BALLC_STATE_Z ? r->y[k + 6]
+                             : k == BALLC_STATE_VZ ? -g : 0.0);
+        double c2 = k == BALLC_STATE_Z ? -0.5 * scale * g : 0.0;
+        double roots[2];
+        int n = crossings(c0, c1, c2, r->ev_direction[e], span, roots);
+        if (r->ev_terminal[e] > 0 && n > r->ev_terminal[e]) n = r->ev_terminal[e];
+        for (int i = 0; i < n; i++) {
+            int at = nh++;   /* insertion by (s, event) */
+            while (at > 0 && (hs[at - 1] > roots[i]
+                              || (hs[at - 1] == roots[i] && he[at - 1] > e))) {
+                hs[at] = hs[at - 1];
+                he[at] = he[at - 1];
+                at--;
+            }
+            hs[at] = roots[i];
+            he[at] = e;
         }
     }
+    int seen[MAX_EVENTS], stop = -1;
+    memset(seen, 0, sizeof seen);
+    for (int h = 0; h < nh; h++) {
+        int e = he[h];
+        seen[e]++;
+        if (r->ev_terminal[e] && seen[e] >= r->ev_terminal[e]) { stop = h; break; }
+    }
     double t_end = t1;
-    if (stop >= 0) t_end = py_min(t0 + best, t1);
+    int kept = 0;
+    if (stop >= 0) {
+        for (int h = 0; h < nh; h++)   /* hits <= stop (tuples) */
+            if (hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])) kept++;
+        t_end = py_min(t0 + hs[stop], t1);
+        res->status = RADAU5_EVENT;
+    } else {
+        res->status = RADAU5_REACHED;
+    }
     long n;
-    double *times, *rows;
+    double *times;
     if (c->t_eval) {   /* t[(t >= t0) & (t <= t_stop)] of the segment's points */
         n = 0;
         while (n < n_eval && ev[n] <= t_end) n++;
@@ -1058,30 +1118,24 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval, in
             times[i] = t0 + dt * ((double)i / (double)intervals);
         times[intervals] = t_end;
     }
-    rows = malloc((size_t)(n ? n : 1) * N * sizeof(double));
-    if (!rows) { free(times); return -2; }
-    for (long i = 0; i < n; i++) flight_at(&f, times[i], rows + (size_t)i * N);
-    int rc = add_later_rows(r, n, times, rows, t0, flags) ? -2 : 0;
-    free(times);
-    free(rows);
-    if (rc) return rc;
-    r->o->segments++;
-    if (c->dense_output) {   /* the piece: FreeFlight(t0, y0, gravity, t_max) */
-        ballc_drive_output *o = r->o;
-        if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1, sizeof(ballc_piece_rec)))
-            return -2;
-        ballc_piece_rec *k = &o->pieces[o->n_pieces++];
-        memset(k, 0, sizeof *k);
-        k->t0 = t0;
-        k->t1 = t_end;
-        k->flight = 1;
-        memcpy(k->y0, r->y, sizeof k->y0);
+    res->t_out = times;
+    res->n_out = n;
+    res->y_out = malloc((size_t)(n ? n : 1) * N * sizeof(double));
+    res->hit_event = malloc((size_t)(kept ? kept : 1) * sizeof(int));
+    res->hit_t = malloc((size_t)(kept ? kept : 1) * sizeof(double));
+    res->hit_y = malloc((size_t)(kept ? kept : 1) * N * sizeof(double));
+    if (!res->y_out || !res->hit_event || !res->hit_t || !res->hit_y) return -2;
+    for (long i = 0; i < n; i++) flight_at(&f, times[i], res->y_out + (size_t)i * N);
+    for (int h = 0, m = 0; h < nh && m < kept; h++) {
+        if (!(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop]))) continue;
+        double when = h == stop ? t_end : py_min(t0 + hs[h], t1);
+        res->hit_event[m] = he[h];
+        res->hit_t[m] = when;
+        flight_at(&f, when, res->hit_y + (size_t)m * N);
+        m++;
     }
-    if (stop < 0) return 0;
-    *fired = stop;
-    *t_fired = t_end;
-    flight_at(&f, t_end, y_event);
-    return 1;
+    res->n_hits = kept;
+    return 0;
 }
 
 /* ---- the rest checks (ballc.resting; stage 2a) ---- */
@@ -1227,10 +1281,23 @@ static int end_state(run_t *r, int p)
     return t_to < c->t_end ? -1 : 0;
 }
 
-/* pieces.append((t0, t1, sol.interpolant)): the segment's steps kept (stage 2b) */
-static int add_piece(run_t *r, const radau5_result *res, double t0, double t1)
+/* pieces.append((t0, t1, sol.interpolant)): the segment's steps kept (stage 2b), or an
+ * exact flight's FreeFlight from (t0, r->y) */
+static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, int flown)
 {
     ballc_drive_output *o = r->o;
+    if (flown) {
+        if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1,
+                 sizeof(ballc_piece_rec)))
+            return -1;
+        ballc_piece_rec *k = &o->pieces[o->n_pieces++];
+        memset(k, 0, sizeof *k);
+        k->t0 = t0;
+        k->t1 = t1;
+        k->flight = 1;
+        memcpy(k->y0, r->y, sizeof k->y0);
+        return 0;
+    }
     long m = res->n_dense, width = (long)(1 + res->dense_terms) * N;
     if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1, sizeof(ballc_piece_rec)))
         return -1;
@@ -1343,9 +1410,9 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         for (int i = 0; i < NL; i++)
             if (!isfinite(r->latch[i])) rc = -1;
         if (rc) break;
-        if (c->exact_flight && flags == 0) {   /* integrate_segment: flight.applies */
-            int fired = -1;
-            double t_fired = 0.0, y_event[N];
+        radau5_result res;
+        int solved = RADAU5_DONE, flown = 0;
+        if (c->exact_flight && flags == 0 && c->user_flight) {   /* flight.applies */
             long n_eval = 0;
             const double *ev = NULL;
             if (c->t_eval) {
@@ -1355,22 +1422,10 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 ev = c->t_eval + eval_at;
                 n_eval = hi - eval_at;
             }
-            int got = flight_segment(r, t_stop, ev, n_eval, flags, &fired, &t_fired, y_event);
-            has_first = 0;
-            implicit = 0;
-            if (got < 0) { rc = got; break; }
-            if (got == 0) {   /* reached t_stop: no contact, so no rest check, t_end */
-                r->t = t_stop;
-                if (t_stop < c->t_end) { rc = -1; break; }
-                break;
-            }
-            r->t = t_fired;
-            memcpy(r->y, y_event, sizeof r->y);
-            double h = ballc_py_hypot(4, r->y + BALLC_STATE_QW);
-            for (int i = 0; i < 4; i++) r->y[BALLC_STATE_QW + i] /= h;
-            if (begin_contact(r, r->ev_plane[fired])) { rc = -1; break; }
-            continue;
-        }
+            int got = flight_segment(r, t_stop, ev, n_eval, &res);
+            if (got) { radau5_free(&res); rc = got; break; }
+            flown = 1;
+        } else {
         radau5_problem pr;
         memset(&pr, 0, sizeof pr);
         pr.n = N;
@@ -1416,14 +1471,19 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.jacobian_ahead = (flags & c->compliant_any) != 0;
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
-        radau5_result res;
-        int solved = radau5_solve(&pr, &res);
+        solved = radau5_solve(&pr, &res);
+        }
         o->segments++;
         has_first = 0;
         implicit = 0;
 #ifdef RADAU5_PROFILE
         o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
 #endif
+        if (r->user_failed) {   /* solve_system raises the user's exception */
+            radau5_free(&res);
+            r->stop_code = BALLC_DRIVE_USER_ERROR;
+            break;
+        }
         if (solved != RADAU5_DONE) { radau5_free(&res); rc = -1; break; }
         nfev += res.nfev;
         njev += res.njev;
@@ -1470,9 +1530,30 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 fired_hit = last;
             }
         }
+        for (long h = 0; h < res.n_hits; h++) {   /* users.count, user_t, user_y */
+            int e = res.hit_event[h];
+            if (r->ev_kind[e] != K_USER) continue;
+            int u = r->ev_plane[e];
+            r->user_seen[u]++;
+            long m = o->n_user_hits, cu = o->cap_user_hits;
+            if (grow((void **)&o->user_hit_t, &cu, m + 1, sizeof(double))) { rc = -2; break; }
+            if (cu != o->cap_user_hits) {
+                int *ue = realloc(o->user_hit_event, (size_t)cu * sizeof(int));
+                if (ue) o->user_hit_event = ue;
+                double *uy = realloc(o->user_hit_y, (size_t)cu * N * sizeof(double));
+                if (uy) o->user_hit_y = uy;
+                if (!ue || !uy) { rc = -2; break; }
+                o->cap_user_hits = cu;
+            }
+            o->user_hit_event[m] = u;
+            o->user_hit_t[m] = res.hit_t[h];
+            memcpy(o->user_hit_y + (size_t)m * N, res.hit_y + (size_t)h * N, N * sizeof(double));
+            o->n_user_hits++;
+        }
+        if (rc) { radau5_free(&res); break; }
         if (res.status == RADAU5_FAILED) {
             if (c->dense_output && res.n_out
-                    && add_piece(r, &res, r->t, res.t_out[res.n_out - 1])) {
+                    && add_piece(r, &res, r->t, res.t_out[res.n_out - 1], flown)) {
                 radau5_free(&res); rc = -2; break;
             }
             r->status = -1;
@@ -1484,7 +1565,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         if (res.status == RADAU5_REACHED) {
-            if (c->dense_output && add_piece(r, &res, r->t, t_stop)) {
+            if (c->dense_output && add_piece(r, &res, r->t, t_stop, flown)) {
                 radau5_free(&res); rc = -2; break;
             }
             r->t = t_stop;
@@ -1513,7 +1594,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         if (fired < 0) { radau5_free(&res); rc = -1; break; }
-        if (c->dense_output && add_piece(r, &res, r->t, t_fired)) {
+        if (c->dense_output && add_piece(r, &res, r->t, t_fired, flown)) {
             radau5_free(&res); rc = -2; break;
         }
         double h_next = res.h_next;
@@ -1523,6 +1604,11 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         double h = ballc_py_hypot(4, r->y + BALLC_STATE_QW);
         for (int i = 0; i < 4; i++) r->y[BALLC_STATE_QW + i] /= h;
         int kind = r->ev_kind[fired], p = r->ev_plane[fired];
+        if (kind == K_USER) {   /* a terminal user event: the run stops, status 1 */
+            r->status = 1;
+            r->stop_code = BALLC_DRIVE_TERMINATED;
+            break;
+        }
         if (kind == K_CAPACITY)   /* its row may have toggled inside the segment */
             r->fired_row = (r->ev_plane_code[fired] - 2) / 2;
         int handled = 0;

@@ -1,11 +1,11 @@
 /* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1, 2a -- the
  * rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back --, 2b: t_eval
- * and dense output, 2c: method "auto" and exact flight, ballc.flight, and 3: the
- * compliant law's exact modes, ballc.compliantmodes).
+ * and dense output, 2c: method "auto" and exact flight, ballc.flight, 3: the compliant
+ * law's exact modes, ballc.compliantmodes, and 4: user events).
  *
  * ballc_drive runs a whole simulation of the subset -- exact Coulomb friction, the
- * compliant law or no friction, no user events, no progress bar, method radau5,
- * dop853 or auto -- and reproduces the Python driver (simulate.py with
+ * compliant law or no friction, user events (callables called back through the
+ * bridge), no progress bar, method radau5, dop853 or auto -- and reproduces the Python driver (simulate.py with
  * events.py, stickslip.py, modes.py, samples.py) bit for bit: the same floating-point
  * operations in the same order.  What it does not port ends the run with
  * BALLC_DRIVE_FALLBACK, and simulate() then runs the Python driver from the start.
@@ -34,7 +34,9 @@ enum {
     BALLC_DRIVE_UNSETTLED = 2,   /* stick-slip did not settle (status -1); stop_plane */
     BALLC_DRIVE_THROUGH = 3,     /* passed through stop_plane (status 1) */
     BALLC_DRIVE_FALLBACK = 4,    /* not ported here: run the Python driver */
-    BALLC_DRIVE_NO_MEMORY = 5
+    BALLC_DRIVE_NO_MEMORY = 5,
+    BALLC_DRIVE_TERMINATED = 6,  /* a terminal user event (status 1) */
+    BALLC_DRIVE_USER_ERROR = 7   /* a user event raised: the bridge raises it */
 };
 
 enum { BALLC_MODE_NONE = 0, BALLC_MODE_SLIP, BALLC_MODE_SLIP_FIXED, BALLC_MODE_STICK };
@@ -64,6 +66,16 @@ typedef struct {                       /* constants of one run, filled by the br
     /* stage 2c: exact flight (options.exact_flight and flight.scene_allows) */
     int exact_flight;
     double gravity;                    /* params[gravity] */
+    /* stage 4: the user's events (UserEvents), in order: LinearEvents (a row, offset;
+     * index and scale when one state) or callables (called back through user_fun,
+     * the bridge's, with user_ctx: it keeps an exception for the bridge to raise) */
+    int n_user;
+    const double *user_coef;           /* n_user x N */
+    const double *user_offset, *user_scale;
+    const int *user_linear, *user_index, *user_count, *user_direction;
+    int user_flight;                   /* every one lets exact flight apply */
+    int (*user_fun)(void *ctx, int k, double t, const double *y, double *g);
+    void *user_ctx;
     /* stage 3: the compliant law's exact modes (ballc.compliantmodes) */
     int compliant_modes;               /* compliantmodes.uses_modes */
     int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* mode_flags per plane */
@@ -117,6 +129,9 @@ typedef struct {
     long n_phases, cap_phases;
     ballc_phase_rec *phases;
     int open[2];                        /* open contact per plane, -1 none */
+    long n_user_hits, cap_user_hits;    /* the user's events' hits, in order */
+    int *user_hit_event;
+    double *user_hit_t, *user_hit_y;
     long n_switches, cap_switches;      /* method "auto": (t, method switched to) */
     double *switch_t;
     int *switch_to;

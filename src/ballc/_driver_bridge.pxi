@@ -11,7 +11,8 @@ cdef extern from "_driver.h":
     double ballc_dot3_fma(const double *v) nogil
     enum:
         BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
-        BALLC_DRIVE_FALLBACK, BALLC_DRIVE_NO_MEMORY
+        BALLC_DRIVE_FALLBACK, BALLC_DRIVE_NO_MEMORY, BALLC_DRIVE_TERMINATED,
+        BALLC_DRIVE_USER_ERROR
     ctypedef struct ballc_drive_config:
         const double *params
         double rtol, atol
@@ -40,6 +41,17 @@ cdef extern from "_driver.h":
         int dense_output
         int exact_flight
         double gravity
+        int n_user
+        const double *user_coef
+        const double *user_offset
+        const double *user_scale
+        const int *user_linear
+        const int *user_index
+        const int *user_count
+        const int *user_direction
+        int user_flight
+        int (*user_fun)(void *, int, double, const double *, double *) noexcept nogil
+        void *user_ctx
         int compliant_modes
         int compliant_bits[2]
         int elastic_bits[2]
@@ -88,6 +100,10 @@ cdef extern from "_driver.h":
         long n_phases
         ballc_phase_rec *phases
         int open[2]
+        long n_user_hits
+        int *user_hit_event
+        double *user_hit_t
+        double *user_hit_y
         long n_switches
         double *switch_t
         int *switch_to
@@ -116,8 +132,32 @@ cdef extern from "_driver.h":
     void ballc_drive_free(ballc_drive_output *) nogil
 
 
-DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH = (
-    BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH)
+DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH, DRIVE_TERMINATED = (
+    BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
+    BALLC_DRIVE_TERMINATED)
+
+
+cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
+                           double *g) noexcept nogil:
+    """The user's callable event k at (t, y), as the radau5 bridge's _user_event calls
+    it: ctx is [the events (simulate's CheckedEvent), the exceptions kept]; an exception
+    is kept for drive to raise and the event reads as NaN meanwhile."""
+    cdef double[::1] yv
+    with gil:
+        events, errors = (<list>ctx)[0], (<list>ctx)[1]
+        if errors:
+            g[0] = NAN
+            return -1
+        try:
+            state = np.empty(BALLC_N_STATES)
+            yv = state
+            memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+            g[0] = float(events[k](t, state))
+            return 0
+        except BaseException as error:
+            errors.append(error)
+            g[0] = NAN
+            return -1
 
 
 def _py_hypot(values):
@@ -174,6 +214,11 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     cdef Py_ssize_t i
     cdef const double[:, :, ::1] smap = k["slip_map"]
     cdef const double[::1] t_eval = k["t_eval"]   # None: no t_eval
+    cdef const double[:, ::1] ucoef = k["user_coef"]
+    cdef const double[::1] uoffset = k["user_offset"], uscale = k["user_scale"]
+    cdef const int[::1] ulinear = k["user_linear"], uindex = k["user_index"]
+    cdef const int[::1] ucount = k["user_count"], udirection = k["user_direction"]
+    cdef list user_ctx = [k["user_events"], []]
     cdef ballc_piece_rec piece
     cdef double[:, ::1] dtv, dcv
     cdef int[::1] dkv
@@ -206,6 +251,20 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.dense_output = k["dense_output"]
     c.exact_flight = k["exact_flight"]
     c.gravity = k["gravity"]
+    c.n_user = ucount.shape[0]
+    c.user_flight = k["user_flight"]
+    c.user_fun = _drive_user_event
+    c.user_ctx = <void *>user_ctx
+    c.user_coef = c.user_offset = c.user_scale = NULL
+    c.user_linear = c.user_index = c.user_count = c.user_direction = NULL
+    if c.n_user:
+        c.user_coef = &ucoef[0, 0]
+        c.user_offset = &uoffset[0]
+        c.user_scale = &uscale[0]
+        c.user_linear = &ulinear[0]
+        c.user_index = &uindex[0]
+        c.user_count = &ucount[0]
+        c.user_direction = &udirection[0]
     c.compliant_modes = k["compliant_modes"]
     c.compliant_any = k["compliant_any"]
     c.restick_factor = k["restick_factor"]
@@ -252,6 +311,15 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
             raise MemoryError("ballc_drive: out of memory")
         if rc == BALLC_DRIVE_FALLBACK:
             return None
+        if rc == BALLC_DRIVE_USER_ERROR:   # as solve_system: the user's exception
+            raise user_ctx[1][0]
+        user_event = np.array([o.user_hit_event[i] for i in range(o.n_user_hits)],
+                              dtype=np.intc)
+        user_t = np.array([o.user_hit_t[i] for i in range(o.n_user_hits)], dtype=float)
+        user_y = np.empty((o.n_user_hits, BALLC_N_STATES))
+        if o.n_user_hits:
+            rv = user_y
+            memcpy(&rv[0, 0], o.user_hit_y, o.n_user_hits * BALLC_N_STATES * sizeof(double))
         n = o.n
         t = np.empty(n)
         rows = np.empty((n, BALLC_N_STATES))
@@ -305,6 +373,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
             pieces.append((piece.t0, piece.t1, dense_t, dense_c, piece.terms, dense_kind))
         return dict(t=t, rows=rows, counts=counts, block_flags=block_flags, latches=latches,
                     contacts=contacts, phases=phases, pieces=pieces,
+                    user_hits=(user_event, user_t, user_y),
                     switches=[(o.switch_t[i], _METHOD_NAMES[o.switch_to[i]])
                               for i in range(o.n_switches)], open=(o.open[0], o.open[1]),
                     stop_code=o.stop_code, status=o.status, stop_plane=o.stop_plane,

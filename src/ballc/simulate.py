@@ -21,13 +21,14 @@ from . import (_core, _radau5, automaton, compliantmodes, events as ev, layout, 
                orbit, outcome, resting, stickslip)
 from ._format import plain
 from .dense import CompiledInterpolant, PiecewiseSolution
+from .events import LinearEvent
 from .flight import FreeFlight, scene_allows as flight_scene_allows
 from .integrate import Segment, failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
 from .result import Contact, Result
 from .samples import Samples
-from .user_events import UserEvents
+from .user_events import CheckedEvent, UserEvents
 from .scene import Scene, SceneError
 
 PLANES = layout.PLANES
@@ -896,12 +897,14 @@ def _c_numerics_agree():
 
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
-    in the C loop's subset: method radau5, dop853 or auto, one float atol, no user events or
-    progress bar, t_eval (if given) strictly
+    in the C loop's subset: method radau5, dop853 or auto, one float atol, no progress
+    bar, user events as _c_user_events takes them, t_eval (if given) strictly
     increasing, slip rows of at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
     process's hypot and dot as the C loop reproduces them (_c_numerics_agree)."""
-    if (options.method not in _C_METHODS or options.events
-            or type(options.atol) is not float):
+    if options.method not in _C_METHODS or type(options.atol) is not float:
+        return None
+    users = _c_user_events(options.events)
+    if users is None:
         return None
     t_eval = options.t_eval
     if t_eval is not None:   # the C loop takes each segment's points as a range
@@ -913,6 +916,9 @@ def _c_config(scene, options, progress, rest):
     if not _c_numerics_agree():
         return None
     params = scene.parameter_vector()
+    flight_allowed = bool(options.exact_flight and flight_scene_allows(params))
+    if flight_allowed and users["user_flight"] and users["several_states"]:
+        return None   # exact flight would take their value with a BLAS dot (flight.py)
     terms = [stickslip.slip_terms(params, plane) for plane in PLANES]
     if any(len(row) > 2 for rows in terms for row in rows):
         return None
@@ -967,15 +973,64 @@ def _c_config(scene, options, progress, rest):
         hertz_k=scene.hertz_stiffness, total_mass=scene.mass + scene.observer_mass,
         rest_period=period,
         resting_plane=-1 if resting_plane is None else PLANES.index(resting_plane),
-        checks_rest=int(bool(rest) and t_eval is None),
+        checks_rest=int(bool(rest) and t_eval is None and not options.events),
         t_eval=t_eval, dense_output=int(bool(options.dense_output)),
-        exact_flight=int(bool(options.exact_flight and flight_scene_allows(params))),
+        exact_flight=int(flight_allowed), **users,
         gravity=float(params[_core.PARAMETER_NAMES.index("gravity")]),
         rho_scale=[entry[3] for entry in planes], rho_offset=[entry[4] for entry in planes],
         through_offset=[entry[7].offset for entry in planes],
         threshold_base=[entry[5] for entry in planes],
         slip_terms=terms,
         slip_map=np.ascontiguousarray([stickslip.slip_map(params, plane) for plane in PLANES]))
+
+
+def _c_user_events(events):
+    """The user's events as the C loop takes them (UserEvents.for_segment, the
+    bridge's _event_arrays): a dict of arrays, or None when one is outside the C loop's
+    subset (a LinearEvent subclass, or one with ``rearm``, or something the bridge
+    would refuse; more than 52)."""
+    events = list(events or ())
+    n = len(events)
+    if n > 52:
+        return None
+    users = UserEvents(events)
+    coef, offset = np.zeros((n, _core.N_STATES)), np.zeros(n)
+    scale, index = np.zeros(n), np.full(n, -1, dtype=np.intc)
+    linear, direction = np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc)
+    callables, several, flies = [], False, True
+    for k, event in enumerate(events):
+        try:
+            sign = float(getattr(event, "direction", 0))
+        except (TypeError, ValueError):
+            return None
+        if sign != sign:
+            return None
+        direction[k] = (sign > 0) - (sign < 0)
+        if isinstance(event, LinearEvent):
+            if type(event) is not LinearEvent or getattr(event, "rearm", None) is not None:
+                return None
+            row = np.asarray(event.coefficients, dtype=float)
+            if row.shape != (_core.N_STATES,) or not np.all(np.isfinite(row)) \
+                    or not math.isfinite(float(event.offset)):
+                return None
+            linear[k], coef[k], offset[k] = 1, row, float(event.offset)
+            if event._index is not None:
+                index[k], scale[k] = event._index, event._scale
+            # flight.applies: every event linear without the quaternion
+            quaternion_free = (event._index is not None and event._index >= 4
+                               or not np.any(event.coefficients[_QUATERNION]))
+            flies = flies and quaternion_free
+            several = several or (quaternion_free and event._index is None)
+            callables.append(None)
+        elif callable(event):
+            flies = False
+            callables.append(CheckedEvent(event, k, 0, getattr(event, "direction", 0)))
+        else:
+            return None
+    return dict(user_coef=coef, user_offset=offset, user_scale=scale, user_index=index,
+                user_linear=linear, user_direction=direction,
+                user_count=np.array(users.counts, dtype=np.intc), user_events=callables,
+                user_flight=int(flies), several_states=several)
 
 
 def _simulate_c(scene, options, y, config):
@@ -1055,6 +1110,8 @@ def _simulate_c(scene, options, y, config):
                 plane = contacts[k].plane
                 record_depth(contacts[k], ev.penetration(plane, scene)(0, last), last)
     code, status = out["stop_code"], out["status"]
+    user_event, user_t, user_y = out["user_hits"]
+    n_user = len(config["user_count"])
     if code == _core.DRIVE_FAILED:
         reason = out["message"]
         if "max_nfev" in reason:
@@ -1070,12 +1127,16 @@ def _simulate_c(scene, options, y, config):
         message = (f"{what} transitions on the {plane} did not settle: "
                    f"{out['transitions'][out['stop_plane']]} mode changes in one contact, "
                    f"{out['stalled']} of them at t = {out['t_run']:.17g} s")
+    elif code == _core.DRIVE_TERMINATED:
+        message = "A termination event occurred."
     elif code == _core.DRIVE_THROUGH:
         message = (f"ball passed through the {PLANES[out['stop_plane']]} at t = "
                    f"{out['t_run']:.6g} s (penetration reached the ball's radius)")
     result = Result(t=t, y=states, scene=scene, status=status, message=message,
                     nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], contacts=contacts,
-                    flags=flags, latch=latch, t_events=[], y_events=[],
+                    flags=flags, latch=latch,
+                    t_events=[user_t[user_event == k] for k in range(n_user)],
+                    y_events=[user_y[user_event == k] for k in range(n_user)],
                     sol=PiecewiseSolution(pieces) if options.dense_output else None,
                     method_switches=out["switches"] if options.method == "auto" else None)
     result._driver = "c"
