@@ -5,16 +5,20 @@
 One process: each case runs with the Python driver (BALLC_PYTHON_DRIVER=1) and with the
 default (the C loop where the run is in its subset), and every output is compared:
 t, y, flags, latch (np.array_equal, NaN equal to NaN, and dtype and memory order),
-status, message, nfev/njev/nlu, t_events/y_events and every field of every contact
-(value and type).  A case marked C-eligible fails if it ran in Python (``_driver``), so
-a fallback cannot pass vacuously.  Exit status 0 when all are identical, 1 otherwise.
+status, message, nfev/njev/nlu, t_events/y_events, every field of every contact
+(value and type), method_switches, and Result.sol's pieces and values.  A case marked
+C-eligible fails if it ran in Python (``_driver``), so a fallback cannot pass vacuously.
+Exit status 0 when all are identical, 1 otherwise.
 
-Cases: the comeback map's cells Scene(mixture=m, friction_coefficient=mu), 1.2 s at
-rtol = atol = 1e-3, m in {0, 0.3, 0.7, 1}, mu in {0, 0.2, 0.5, 1}, both methods; the
-seed scene Scene() for 5 s at the default tolerance and at 1e-6, both methods; and a few
-other paths of the C loop (a start in contact, regularised friction, max_step and
-first_step, y0, passing through, the ceiling, a call budget); and runs that must fall
-back (t_eval, dense output, compliant law, a rest check coming due, method "Radau").
+Cases (see cases()): the comeback map's cells Scene(mixture=m, friction_coefficient=mu),
+1.2 s at rtol = atol = 1e-3, m in {0, 0.3, 0.7, 1}, mu in {0, 0.2, 0.5, 1}, both
+methods; the seed scene Scene() for 5 s at the default tolerance and at 1e-6; other
+paths of stage 1 (a start in contact, regularised friction, max_step and first_step, y0,
+passing through, the ceiling, a call budget); stage 2a, the rest checks (rest, uniform
+rolling, checks that find neither); 2b, t_eval and dense output; 2c, method "auto" and
+exact flight; 3, the compliant law's modes at 1e-4/1e-6/1e-9; 4, user events (terminal
+and not, callables and LinearEvents); and runs that must fall back (an orbit's trial,
+method "Radau", a LinearEvent of several states in exact flight).
 """
 from __future__ import annotations
 
@@ -27,6 +31,9 @@ import numpy as np
 import ballc
 
 METHODS = ("dop853", "radau5")
+#: tests/test_auto_method.py's stiff scene (method "auto" switches on it)
+STEEL = dict(tangential_model="friction", ball_youngs_modulus=2e11, plane_youngs_modulus=2e11,
+             c_tau=0.5, observer_mass=0.0, position=(0.0, 0.0, 2.0), velocity=(0.5, 0.0, 0.0))
 
 
 def cases(quick=False):
@@ -66,18 +73,156 @@ def cases(quick=False):
         ("call budget", dict(mixture=0.3, friction_coefficient=0.2), 1.2,
          dict(method="radau5", rtol=1e-3, atol=1e-3, max_nfev=300), True),
     ]
+    # stage 2a: the rest checks (ballc.resting): rest, uniform rolling and sliding, and
+    # checks that find neither (the next one scheduled)
+    for method in METHODS:
+        out += [
+            (f"drop, rests 1e6 s {method} 1e-6", dict(velocity=(0, 0, 0), observer_mass=0),
+             1e6, dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
+            (f"drop, rests 100 s {method} 1e-4", dict(velocity=(0, 0, 0), observer_mass=0),
+             100.0, dict(method=method, rtol=1e-4, atol=1e-4, exact_flight=False), True),
+            (f"seed 30 s {method} 1e-6 (checks)", {}, 30.0,
+             dict(method=method, rtol=1e-6, atol=1e-6), True),
+            (f"massless observer 100 s {method} 1e-6 (rolls)", dict(observer_mass=0), 100.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
+            (f"massless observer 1e6 s {method} 1e-6 (rolls)", dict(observer_mass=0), 1e6,
+             dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
+            (f"rest {method}", dict(position=(0, 0, 0.9999), velocity=(0, 0, 0),
+                                    angular_velocity=(0, 0, 0), c_tau=0.2, observer_mass=0),
+             6.0, dict(method=method, rtol=1e-4, atol=1e-4, exact_flight=False), True),
+            (f"rest, observer below {method}", dict(position=(0, 0, 0.9999),
+                                                   velocity=(0, 0, 0),
+                                                   angular_velocity=(0, 0, 0), c_tau=0.2,
+                                                   observer_position=(0, 0, -0.5)), 6.0,
+             dict(method=method, rtol=1e-4, atol=1e-4), True),
+            (f"mu=0, no end state {method}", dict(observer_mass=0, friction_coefficient=0.0,
+                                            velocity=(1.0, 0, 0)), 60.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False), True),
+        ]
+    # stage 2b: t_eval and dense output (Result.sol compared at its pieces' ends and
+    # on a grid)
+    for method in METHODS:
+        out += [
+            (f"seed 5 s t_eval {method}", {}, 5.0,
+             dict(method=method, t_eval=np.linspace(0, 5.0, 101)), True),
+            (f"seed 5 s t_eval, no 0 {method} 1e-6", {}, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, t_eval=np.linspace(0.01, 4.0, 37)),
+             True),
+            (f"seed 5 s dense output {method}", {}, 5.0,
+             dict(method=method, dense_output=True), True),
+            (f"map cell dense + t_eval {method}", dict(mixture=0.3, friction_coefficient=0.2),
+             1.2, dict(method=method, rtol=1e-3, atol=1e-3, dense_output=True,
+                       t_eval=[0.0, 0.3, 0.6, 1.2]), True),
+            (f"drop, rests, dense output {method}", dict(velocity=(0, 0, 0), observer_mass=0),
+             1e6, dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False,
+                       dense_output=True), True),
+            (f"rolls, dense output {method}", dict(observer_mass=0), 100.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, exact_flight=False,
+                  dense_output=True), True),
+            (f"call budget, dense output {method}", dict(mixture=0.3, friction_coefficient=0.2),
+             1.2, dict(method=method, rtol=1e-3, atol=1e-3, max_nfev=300, dense_output=True),
+             True),
+        ]
+    # stage 2c: method "auto" (method_switches compared too)
+    out += [
+        ("auto: seed 5 s", {}, 5.0, dict(method="auto"), True),
+        ("auto: seed 5 s 1e-6, dense output", {}, 5.0,
+         dict(method="auto", rtol=1e-6, atol=1e-6, dense_output=True), True),
+        ("auto: seed 30 s 1e-6 (rest checks)", {}, 30.0,
+         dict(method="auto", rtol=1e-6, atol=1e-6), True),
+        ("auto: steel ball 1e-9, dense (switches)", STEEL, 3.0,
+         dict(method="auto", rtol=1e-9, atol=1e-9, dense_output=True, exact_flight=False),
+         True),
+        ("auto: steel ball 1e-10 (switches)", STEEL, 5.0,
+         dict(method="auto", rtol=1e-10, atol=1e-10, exact_flight=False), True),
+        ("auto: steel ball 1e-9, t_eval", STEEL, 3.0,
+         dict(method="auto", rtol=1e-9, atol=1e-9, t_eval=np.linspace(0.0, 3.0, 301),
+              exact_flight=False), True),
+        ("auto: map cell", dict(mixture=0.3, friction_coefficient=0.2), 1.2,
+         dict(method="auto", rtol=1e-3, atol=1e-3), True),
+        ("auto: drop, rests", dict(velocity=(0, 0, 0), observer_mass=0), 1e6,
+         dict(method="auto", rtol=1e-6, atol=1e-6, exact_flight=False), True),
+    ]
+    # stage 2c: exact flight (ballc.flight: a massless observer's scene)
+    throw = dict(observer_mass=0, position=(0, 0, 3.0), velocity=(2.0, 0.5, 4.0),
+                 angular_velocity=(3.0, -1.0, 20.0))
+    for method in METHODS + ("auto",):
+        out += [
+            (f"flight: throw 5 s {method}", throw, 5.0, dict(method=method), True),
+            (f"flight: throw 5 s {method} 1e-6, dense, t_eval", throw, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, dense_output=True,
+                  t_eval=np.linspace(0.0, 5.0, 77)), True),
+            (f"flight: Scene(observer_mass=0) 100 s {method} 1e-6", dict(observer_mass=0),
+             100.0, dict(method=method, rtol=1e-6, atol=1e-6), True),
+            (f"flight: Scene(observer_mass=0) 1e6 s {method} 1e-6, dense",
+             dict(observer_mass=0), 1e6, dict(method=method, rtol=1e-6, atol=1e-6,
+                                              dense_output=True), True),
+            (f"flight: drop, rests {method}", dict(velocity=(0, 0, 0), observer_mass=0), 1e6,
+             dict(method=method, rtol=1e-6, atol=1e-6), True),
+            (f"flight: steel, max_step {method}", STEEL, 3.0,
+             dict(method=method, rtol=1e-8, atol=1e-8, max_step=0.01), True),
+        ]
+    out += [("flight: ceiling, massless", dict(observer_mass=0, position=(0, 0, 2.0),
+                                               velocity=(1.0, 0, 14.0), ceiling_height=5.0,
+                                               friction_coefficient=0.6), 2.0,
+             dict(method="dop853", rtol=1e-6, atol=1e-6, dense_output=True), True)]
+    # stage 3: the compliant law's exact modes (ballc.compliantmodes)
+    for method in METHODS + ("auto",):
+        for tol in (1e-4, 1e-6, 1e-9):
+            out.append((f"compliant 5 s {method} {tol:g}", dict(tangential_model="compliant"),
+                        5.0, dict(method=method, rtol=tol, atol=tol), True))
+    out += [
+        ("compliant, steel, dense", dict(STEEL, tangential_model="compliant"), 2.0,
+         dict(method="radau5", rtol=1e-6, atol=1e-6, dense_output=True), True),
+        ("compliant, no damping", dict(tangential_model="compliant",
+                                       tangential_damping_ratio=0.0), 3.0,
+         dict(method="dop853", rtol=1e-6, atol=1e-6), True),
+        ("compliant, smooth (no modes)", dict(tangential_model="compliant",
+                                              friction_regularization="smooth"), 2.0,
+         dict(method="radau5", rtol=1e-6, atol=1e-6), True),
+        ("compliant, massless, rests", dict(tangential_model="compliant", observer_mass=0,
+                                            velocity=(0, 0, 0)), 1e6,
+         dict(method="radau5", rtol=1e-6, atol=1e-6), True),
+    ]
+    # stage 4: the user's events (callables called back from C; LinearEvents in C)
+    def apex(t, y):   # vz falling through 0: each apex of a bounce
+        return y[12]
+    apex.direction = -1
+
+    def low(t, y):    # z below 0.5 m, terminal
+        return y[6] - 0.5
+    low.terminal = True
+
+    def twice(t, y):  # the second time z falls through 1.2 m stops the run
+        return y[6] - 1.2
+    twice.terminal, twice.direction = 2, -1
+    height = ballc.events.LinearEvent.of_state("z", 1.0, -2.0, terminal=False, direction=0)
+    height_stop = ballc.events.LinearEvent.of_state("z", 1.0, -0.8, terminal=3, direction=-1)
+    for method in METHODS + ("auto",):
+        out += [
+            (f"user: apex, not terminal {method}", {}, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[apex]), True),
+            (f"user: terminal {method}", {}, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[apex, low]), True),
+            (f"user: terminal at the 2nd, dense {method}", {}, 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[twice, apex],
+                  dense_output=True), True),
+            (f"user: LinearEvents, flight {method}", dict(observer_mass=0), 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[height, height_stop]), True),
+            (f"user: LinearEvent + callable, flight {method}", dict(observer_mass=0), 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[height, apex],
+                  t_eval=np.linspace(0.0, 5.0, 51)), True),
+            (f"user: compliant, terminal {method}", dict(tangential_model="compliant"), 5.0,
+             dict(method=method, rtol=1e-6, atol=1e-6, events=[twice]), True),
+        ]
     # must fall back
     out += [
-        ("fallback: t_eval", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
-                                          t_eval=np.linspace(0, 1.2, 7)), False),
-        ("fallback: dense output", {}, 1.2, dict(method="dop853", rtol=1e-3, atol=1e-3,
-                                                dense_output=True), False),
-        ("fallback: compliant", dict(tangential_model="compliant"), 1.2,
-         dict(method="radau5", rtol=1e-3, atol=1e-3), False),
-        ("fallback: a rest check due", dict(position=(0, 0, 0.9999), velocity=(0, 0, 0),
-                                            angular_velocity=(0, 0, 0), c_tau=0.2), 6.0,
-         dict(method="radau5", rtol=1e-4, atol=1e-4), False),
+        ("fallback: an orbit's trial (seed 100 s)", {}, 100.0,
+         dict(method="dop853", rtol=1e-6, atol=1e-6), False),
         ("fallback: scipy Radau", {}, 0.3, dict(method="Radau", rtol=1e-3, atol=1e-3), False),
+        ("fallback: a LinearEvent of several states in exact flight", dict(observer_mass=0),
+         2.0, dict(method="dop853", rtol=1e-6, atol=1e-6, events=[ballc.events.LinearEvent(
+             np.eye(19)[6] + np.eye(19)[4], -1.0)]), False),
     ]
     return out
 
@@ -111,10 +256,26 @@ def same(a, b):
     return a == b
 
 
+def sol_values(result):
+    """Result.sol at its pieces' ends and on a grid of 1001 times (None without)."""
+    sol = result.sol
+    if sol is None:
+        return None
+    times = np.concatenate([[a for a, _, _ in sol.pieces], [b for _, b, _ in sol.pieces],
+                            np.linspace(sol.t_min, sol.t_max, 1001)])
+    out = [np.array([(a, b) for a, b, _ in sol.pieces])]
+    for where in [times] + [np.linspace(a, b, 11) for a, b, _ in sol.pieces]:
+        try:
+            out.append(sol(where))
+        except (ValueError, IndexError) as error:   # a piece without steps: as Python's
+            out.append(type(error).__name__)
+    return out
+
+
 def differences(p, c):
-    found = []
+    found = [] if same(sol_values(p), sol_values(c)) else ["sol"]
     for name in ("t", "y", "flags", "latch", "status", "message", "nfev", "njev", "nlu",
-                 "t_events", "y_events", "contacts"):
+                 "t_events", "y_events", "contacts", "method_switches"):
         if not same(getattr(p, name), getattr(c, name)):
             found.append(name)
     return found

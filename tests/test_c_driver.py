@@ -86,28 +86,178 @@ def test_a_failure_and_the_call_budget_are_bit_identical(monkeypatch):
 
 
 @pytest.mark.parametrize("kwargs", [
-    dict(t_eval=np.linspace(0.0, 0.5, 6)), dict(dense_output=True), dict(method="Radau"),
-    dict(method="auto"), dict(events=lambda t, y: y[6] - 0.5),
-    dict(atol=np.full(_core.N_STATES, 1e-3)),
-], ids=["t_eval", "dense_output", "scipy", "auto", "user event", "atol per state"])
+    dict(method="Radau"), dict(atol=np.full(_core.N_STATES, 1e-3)),
+    dict(events=[ballc.events.LinearEvent(np.eye(_core.N_STATES)[6]
+                                          + np.eye(_core.N_STATES)[4], -1.0)]),
+], ids=["scipy", "atol per state", "LinearEvent of several states"])
 def test_runs_outside_the_subset_fall_back(monkeypatch, kwargs):
     kwargs = dict(dict(method="dop853", rtol=1e-3, atol=1e-3), **kwargs)
-    result = _run(monkeypatch, False, ballc.Scene(), 0.5, **kwargs)
+    # (a massless observer: exact flight would take the LinearEvent with a BLAS dot)
+    result = _run(monkeypatch, False, ballc.Scene(observer_mass=0), 0.5, **kwargs)
     assert result._driver == "python"
 
 
-def test_compliant_scene_and_a_due_rest_check_fall_back(monkeypatch):
-    compliant = _run(monkeypatch, False, ballc.Scene(tangential_model="compliant"), 0.5,
-                     method="radau5", rtol=1e-3, atol=1e-3)
-    assert compliant._driver == "python"
-    # a ball placed on the floor: its rest check falls due at 20 T0 = 4.3 s, which the
-    # C loop does not port -- it falls back and the result is the Python driver's
-    scene = ballc.Scene(position=(0.0, 0.0, 0.9999), velocity=(0.0, 0.0, 0.0),
-                        angular_velocity=(0.0, 0.0, 0.0), c_tau=0.2)
-    c = _run(monkeypatch, False, scene, 6.0, method="radau5", rtol=1e-4, atol=1e-4)
-    p = _run(monkeypatch, True, scene, 6.0, method="radau5", rtol=1e-4, atol=1e-4)
+def test_an_orbit_trial_falls_back(monkeypatch):
+    # the seed rolls on from 30.9 s: its rest checks find neither rest nor uniform motion
+    # (it is Routh's sphere), and one where an orbit's trial may start falls back
+    kw = dict(method="dop853", rtol=1e-6, atol=1e-6)
+    c = _run(monkeypatch, False, ballc.Scene(), 100.0, **kw)
+    p = _run(monkeypatch, True, ballc.Scene(), 100.0, **kw)
     assert c._driver == "python"
-    assert np.array_equal(c.t, p.t) and np.array_equal(c.y, p.y)
+    assert np.array_equal(c.t, p.t) and np.array_equal(c.y, p.y) and c.message == p.message
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5"])
+@pytest.mark.parametrize("case", ["rest", "rolling", "checks"])
+def test_the_rest_checks_are_bit_identical(monkeypatch, method, case):
+    """Stage 2a: a rest check that finds rest, uniform rolling (then the closed-form
+    end), or nothing (the seed before an orbit's trial could fit)."""
+    scene, t_end, kw = {
+        "rest": (ballc.Scene(velocity=(0, 0, 0), observer_mass=0), 1e6,
+                 dict(exact_flight=False)),
+        "rolling": (ballc.Scene(observer_mass=0), 1e6, dict(exact_flight=False)),
+        "checks": (ballc.Scene(), 30.0, {}),
+    }[case]
+    kw = dict(kw, method=method, rtol=1e-6, atol=1e-6)
+    p = _run(monkeypatch, True, scene, t_end, **kw)
+    expected = {"rest": "came to rest", "rolling": "rolls uniformly",
+                "checks": ""}[case]
+    assert expected in p.message
+    _assert_identical(p, _run(monkeypatch, False, scene, t_end, **kw))
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5"])
+def test_t_eval_and_dense_output_are_bit_identical(monkeypatch, method):
+    """Stage 2b: t_eval (with and without 0) and Result.sol, here with a rest end's
+    closed-form piece too, and on a failed run."""
+    seed = ballc.Scene()
+    drop = ballc.Scene(velocity=(0, 0, 0), observer_mass=0)
+    cell = ballc.Scene(mixture=0.3, friction_coefficient=0.2)
+    for scene, t_end, kw in [
+            (seed, 5.0, dict(t_eval=np.linspace(0.0, 5.0, 51))),
+            (seed, 5.0, dict(t_eval=[0.5, 1.5, 2.5], dense_output=True)),
+            (drop, 1e6, dict(rtol=1e-6, atol=1e-6, exact_flight=False, dense_output=True)),
+            (cell, 1.2, dict(rtol=1e-3, atol=1e-3, max_nfev=300, dense_output=True))]:
+        kw = dict(kw, method=method)
+        p = _run(monkeypatch, True, scene, t_end, **kw)
+        c = _run(monkeypatch, False, scene, t_end, **kw)
+        _assert_identical(p, c)
+        if kw.get("dense_output"):
+            assert [(a, b) for a, b, _ in p.sol.pieces] == [(a, b) for a, b, _ in c.sol.pieces]
+            for (a, b, f), (_, _, g) in zip(p.sol.pieces, c.sol.pieces):
+                if b > a and getattr(f, "steps", np.ones(1)).size:
+                    times = np.linspace(a, b, 7)
+                    assert np.array_equal(f(times), g(times))
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("scene, t_end, kw", [
+    ({}, 5.0, {}),
+    (dict(tangential_model="friction", ball_youngs_modulus=2e11, plane_youngs_modulus=2e11,
+          c_tau=0.5, observer_mass=0.0, position=(0.0, 0.0, 2.0), velocity=(0.5, 0.0, 0.0)),
+     3.0, dict(rtol=1e-9, atol=1e-9, dense_output=True, exact_flight=False)),
+    (dict(velocity=(0, 0, 0), observer_mass=0), 1e6,
+     dict(rtol=1e-6, atol=1e-6, exact_flight=False, dense_output=True)),
+], ids=["seed", "steel", "rests"])
+def test_method_auto_is_bit_identical(monkeypatch, scene, t_end, kw):
+    """Stage 2c: method "auto", its switches and the method carried across segments."""
+    scene = ballc.Scene(**scene)
+    kw = dict(kw, method="auto")
+    p = _run(monkeypatch, True, scene, t_end, **kw)
+    c = _run(monkeypatch, False, scene, t_end, **kw)
+    _assert_identical(p, c)
+    assert p.method_switches == c.method_switches
+    if kw.get("dense_output"):
+        times = np.linspace(0.0, t_end if t_end < 10 else 100.0, 501)
+        assert np.array_equal(p.sol(times), c.sol(times))
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5", "auto"])
+def test_exact_flight_is_bit_identical(monkeypatch, method):
+    """Stage 2c: a massless observer's throw (ballc.flight's closed-form segments and
+    contact starts), with t_eval and dense output, and a run that rolls on."""
+    throw = ballc.Scene(observer_mass=0, position=(0, 0, 3.0), velocity=(2.0, 0.5, 4.0),
+                        angular_velocity=(3.0, -1.0, 20.0))
+    for scene, t_end, kw in [
+            (throw, 5.0, {}),
+            (throw, 5.0, dict(rtol=1e-6, atol=1e-6, dense_output=True,
+                              t_eval=np.linspace(0.0, 5.0, 41))),
+            (ballc.Scene(observer_mass=0), 100.0, dict(rtol=1e-6, atol=1e-6))]:
+        kw = dict(kw, method=method)
+        p = _run(monkeypatch, True, scene, t_end, **kw)
+        c = _run(monkeypatch, False, scene, t_end, **kw)
+        _assert_identical(p, c)
+        assert p.method_switches == c.method_switches
+        if kw.get("dense_output"):
+            times = np.linspace(0.0, t_end, 501)
+            assert np.array_equal(p.sol(times), c.sol(times))
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5", "auto"])
+@pytest.mark.parametrize("tol", [1e-4, 1e-6, 1e-9])
+def test_the_compliant_modes_are_bit_identical(monkeypatch, method, tol):
+    """Stage 3: the compliant law's exact modes (arming, yield/decide, re-stick, the
+    capacity guard re-armed in C, the step bound's segment ends)."""
+    scene = ballc.Scene(tangential_model="compliant")
+    kw = dict(method=method, rtol=tol, atol=tol)
+    p = _run(monkeypatch, True, scene, 5.0, **kw)
+    c = _run(monkeypatch, False, scene, 5.0, **kw)
+    _assert_identical(p, c)
+    assert any(phase == "stick" for k in c.contacts for _, phase in k.transitions)
+    assert any(phase == "slip" for k in c.contacts for _, phase in k.transitions)
+
+
+@needs_c_numerics
+@pytest.mark.parametrize("method", ["dop853", "radau5"])
+def test_user_events_are_bit_identical(monkeypatch, method):
+    """Stage 4: the user's callables (called back from C, as often as by the Python
+    driver), terminal at a count, and LinearEvents (also in exact flight)."""
+    calls = []
+
+    def apex(t, y):
+        calls.append(t)
+        return y[12]
+    apex.direction = -1
+
+    def twice(t, y):
+        return y[6] - 1.2
+    twice.terminal, twice.direction = 2, -1
+    height = ballc.events.LinearEvent.of_state("z", 1.0, -0.8, terminal=3, direction=-1)
+    for scene, kw in [(ballc.Scene(), dict(events=[apex])),
+                      (ballc.Scene(), dict(events=[twice, apex], dense_output=True)),
+                      (ballc.Scene(observer_mass=0), dict(events=[height, apex]))]:
+        kw = dict(kw, method=method, rtol=1e-6, atol=1e-6)
+        calls.clear()
+        p = _run(monkeypatch, True, scene, 5.0, **kw)
+        python_calls = list(calls)
+        calls.clear()
+        c = _run(monkeypatch, False, scene, 5.0, **kw)
+        _assert_identical(p, c)
+        assert calls == python_calls
+        for a, b in zip(p.t_events + p.y_events, c.t_events + c.y_events):
+            assert a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+
+
+@needs_c_numerics
+def test_a_user_event_that_raises_raises_as_in_python(monkeypatch):
+    def bad(t, y):
+        if t > 0.5:
+            raise KeyError("boom")
+        return 1.0
+
+    def nan(t, y):
+        return float("nan") if t > 0.5 else 1.0
+    for event, error in ((bad, KeyError), (nan, ValueError)):
+        messages = []
+        for python in (True, False):
+            with pytest.raises(error) as caught:
+                _run(monkeypatch, python, ballc.Scene(), 2.0, method="dop853", events=[event])
+            messages.append(str(caught.value))
+        assert messages[0] == messages[1]
 
 
 @needs_c_numerics

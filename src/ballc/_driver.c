@@ -17,7 +17,8 @@
 #define N BALLC_N_STATES
 #define NL BALLC_N_LATCH
 #define NLP BALLC_N_LATCH_PER_PLANE
-#define MAX_EVENTS 12
+#define MAX_EVENTS 64     /* the driver's (at most 12) and the user's */
+#define MAX_USER_EVENTS (MAX_EVENTS - 12)
 #define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
 #define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
 
@@ -30,6 +31,10 @@
 #define MAX_TRANSITIONS 100000
 #define MAX_STALLED 100
 #define MIN_IMPACT_RATE 1e-9
+#define ORBIT_TRIAL_PERIODS 3.5   /* orbit.TRIAL_PERIODS */
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 /* ---- numerics that must match CPython and numpy ---- */
 
@@ -153,6 +158,12 @@ void ballc_drive_free(ballc_drive_output *o)
 {
     free(o->t); free(o->y); free(o->block_count); free(o->block_flags);
     free(o->block_latch); free(o->contacts); free(o->phases);
+    free(o->pieces); free(o->dense_t); free(o->dense_c); free(o->dense_kind);
+    free(o->switch_t); free(o->switch_to);
+    o->switch_t = NULL; o->switch_to = NULL;
+    free(o->user_hit_event); free(o->user_hit_t); free(o->user_hit_y);
+    o->user_hit_event = NULL; o->user_hit_t = o->user_hit_y = NULL;
+    o->pieces = NULL; o->dense_t = o->dense_c = NULL; o->dense_kind = NULL;
     o->t = o->y = o->block_latch = NULL;
     o->block_count = NULL; o->block_flags = NULL; o->contacts = NULL; o->phases = NULL;
 }
@@ -183,10 +194,28 @@ typedef struct {
     int ev_terminal[MAX_EVENTS], ev_direction[MAX_EVENTS], ev_nonlinear[MAX_EVENTS];
     int ev_plane_code[MAX_EVENTS], ev_rearm[MAX_EVENTS];
     int ev_kind[MAX_EVENTS], ev_plane[MAX_EVENTS];
+    int ev_index[MAX_EVENTS];        /* linear in one state: it (exact flight), else -1 */
+    double ev_scale[MAX_EVENTS];     /*   and its coefficient */
     int seg_flags;
+    /* the user's events (stage 4): occurrences so far, a callback's error */
+    long user_seen[MAX_USER_EVENTS];
+    int user_failed;
+    /* the compliant law's modes (stage 3): per plane */
+    int compliant[2], armed[2], capacity_row[2];   /* COMPLIANT_*, bool, -1 or 4/5 */
+    int has_step[2];
+    double step_bound[2], step_until[2];           /* contact_step: (bound, until) */
+    int fired_row;
+    /* the bridge's _ball_event cache: the last compliant margins computed */
+    double margins_y[N], margins_out[6];
+    int margins_plane, margins_solved;
 } run_t;
 
-enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE };
+enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
+#define CAPACITY_FIRST (2 + 2 * 4)    /* the capacity guards' event codes (rows 4, 5) */
+#define CAPACITY_SECOND (2 + 2 * 5)
+
+enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE,
+       K_ARM, K_YIELD, K_RESTICK, K_CAPACITY, K_USER };   /* from K_APPROACH on: CARRY_STEP */
 
 /* _Run.flags */
 static int run_flags(const run_t *r, int with_coulomb)
@@ -195,6 +224,13 @@ static int run_flags(const run_t *r, int with_coulomb)
     int flags = c->observer_bits;
     for (int p = 0; p < 2; p++) {
         if (!r->in_contact[p]) continue;
+        if (c->compliant_modes) {   /* compliantmodes.mode_flags */
+            if (r->compliant[p] == COMPLIANT_SLIDING) flags |= c->sliding_bits[p];
+            else if (r->compliant[p] == COMPLIANT_ELASTIC && r->armed[p])
+                flags |= c->elastic_bits[p];
+            else flags |= c->compliant_bits[p];
+            continue;
+        }
         flags |= c->contact_bits[p];
         if (with_coulomb) {
             if (r->coulomb[p] == BALLC_MODE_SLIP) flags |= c->slip_bits[p];
@@ -334,6 +370,141 @@ static int start_coulomb(run_t *r, int p)
     return settle(r, p);
 }
 
+/* ---- the compliant law's modes (ballc.compliantmodes; stage 3) ---- */
+
+static int deflection_x(int p)
+{
+    return p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X;
+}
+
+/* compliantmodes.margins (_core.compliant_margins); -1 where Python raises */
+static int margins_of(run_t *r, int p, const double *y, double *m)
+{
+    if (ballc_compliant_margins(y, r->c->params, r->latch, p, m) != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    return 0;
+}
+
+/* compliantmodes.at_cap: out = y with |s| = s_cap (only_down: not raised to it) */
+static int at_cap(run_t *r, int p, const double *y, int only_down, double *out)
+{
+    int sx = deflection_x(p);
+    memcpy(out, y, N * sizeof(double));
+    double s[2] = {out[sx], out[sx + 1]};
+    double size = ballc_py_hypot(2, s);
+    if (!(size > 0)) return 0;
+    double m[BALLC_COMPLIANT_MARGINS];
+    if (margins_of(r, p, out, m)) return -1;
+    double s_cap = m[2], k_t = m[3];
+    if (only_down && size <= s_cap) return 0;
+    double f = s_cap / size;
+    out[sx] = s[0] * f;
+    out[sx + 1] = s[1] * f;
+    out[BALLC_STATE_DISSIPATED_TANGENTIAL] += 0.5 * k_t * (size * size - s_cap * s_cap);
+    return 0;
+}
+
+/* compliantmodes._along_slip: 1 and along (2), 0 without slip, -1 on failure */
+static int along_slip(run_t *r, int p, const double *y, double *along)
+{
+    double u[2];
+    for (int row = 0; row < 2; row++) {   /* stickslip.slip_velocity_of */
+        double s = 0.0;
+        for (int k = 0; k < r->c->n_terms[p][row]; k++)
+            s += r->c->term_coef[p][row][k] * y[r->c->term_index[p][row][k]];
+        u[row] = s;
+    }
+    double speed = ballc_py_hypot(2, u);
+    if (!(speed > 0)) return 0;
+    double m[BALLC_COMPLIANT_MARGINS];
+    if (margins_of(r, p, y, m)) return -1;
+    double length = m[2] > 0 ? m[2] : 1e-100;   /* START_DEFLECTION */
+    along[0] = length * u[0] / speed;
+    along[1] = length * u[1] / speed;
+    return 1;
+}
+
+/* compliantmodes.decide (start: arming = 1): *mode and the new state */
+static int decide(run_t *r, int p, const double *y, int arming, int *mode, double *out)
+{
+    int sx = deflection_x(p);
+    double trial[N];
+    if (at_cap(r, p, y, 0, trial)) return -1;
+    double s[2] = {y[sx], y[sx + 1]};
+    int relaxed = arming || !(ballc_py_hypot(2, s) > 0);
+    if (relaxed) {
+        double along[2];
+        int got = along_slip(r, p, y, along);
+        if (got < 0) return -1;
+        if (!got) {
+            *mode = COMPLIANT_ELASTIC;
+            memcpy(out, y, N * sizeof(double));
+            return 0;
+        }
+        trial[sx] = along[0];
+        trial[sx + 1] = along[1];
+    }
+    double m[BALLC_COMPLIANT_MARGINS];
+    if (margins_of(r, p, trial, m)) return -1;
+    if (m[1] >= 0) {
+        *mode = COMPLIANT_SLIDING;
+        memcpy(out, relaxed ? trial : y, N * sizeof(double));
+        return 0;
+    }
+    *mode = COMPLIANT_ELASTIC;
+    return at_cap(r, p, y, 1, out);
+}
+
+/* _Run.set_compliant */
+static int set_compliant(run_t *r, int p, int mode)
+{
+    r->compliant[p] = mode;
+    r->capacity_row[p] = -1;
+    r->transitions[p] += 1;
+    return record_phase(r, p, mode == COMPLIANT_SLIDING ? 0 : 1);
+}
+
+/* _Run.begin_contact's compliant part (after the latch) */
+static int start_compliant(run_t *r, int p, double rate)
+{
+    const ballc_drive_config *c = r->c;
+    r->armed[p] = rho_of(r, p, r->y) >= 0.5 * c->arm_depth[p];
+    int mode;
+    double y[N];
+    if (decide(r, p, r->y, 1, &mode, y)) return -1;
+    memcpy(r->y, y, sizeof y);
+    if (set_compliant(r, p, mode)) return -1;
+    double t_c = c->contact_time_base * pow(rate, -0.2);   /* compliantmodes.step_bound */
+    r->has_step[p] = 1;
+    r->step_bound[p] = t_c / 16;
+    r->step_until[p] = r->t + 4 * t_c;
+    return 0;
+}
+
+/* _Run.max_step */
+static double run_max_step(const run_t *r)
+{
+    double step = r->c->max_step;
+    for (int p = 0; p < 2; p++)
+        if (r->has_step[p] && r->step_until[p] > r->t) step = py_min(step, r->step_bound[p]);
+    return step;
+}
+
+/* _Run.step_bound_end */
+static double step_bound_end(const run_t *r)
+{
+    double end = INFINITY;
+    int found = 0;
+    for (int p = 0; p < 2; p++)
+        if (r->has_step[p] && r->step_until[p] > r->t) {
+            end = found ? py_min(end, r->step_until[p]) : r->step_until[p];
+            found = 1;
+        }
+    return end;
+}
+
 /* _Run.begin_contact (with modes.latch_values) */
 static int begin_contact(run_t *r, int p)
 {
@@ -387,7 +558,8 @@ static int begin_contact(run_t *r, int p)
     r->dissipated_at_start[p][1] = y[BALLC_STATE_DISSIPATED_TANGENTIAL];
     r->relatches[p] = r->transitions[p] = 0;
     r->rest_check[p] = p == c->resting_plane ? r->t + c->rest_period : INFINITY;
-    if (c->exact) return start_coulomb(r, p);
+    if (c->exact && start_coulomb(r, p)) return -1;
+    if (c->compliant_modes) return start_compliant(r, p, rate);
     return 0;
 }
 
@@ -399,6 +571,9 @@ static void end_contact(run_t *r, int p)
     r->in_contact[p] = 0;
     r->coulomb[p] = BALLC_MODE_NONE;
     r->has_approach[p] = 0;
+    r->has_step[p] = 0;
+    r->compliant[p] = COMPLIANT_NONE;
+    r->capacity_row[p] = -1;
     ballc_contact_rec *rec = &o->contacts[o->open[p]];
     o->open[p] = -1;
     rec->ended = 1;
@@ -477,6 +652,44 @@ static int coulomb_event(run_t *r, int kind, int p)
     }
 }
 
+/* _Run.compliant_event */
+static int compliant_event(run_t *r, int kind, int p)
+{
+    r->stalled = stalled_at(r, r->t);
+    r->last_transition = r->t;
+    r->has_last_transition = 1;
+    if (unsettled(r, p, r->stalled)) {
+        r->status = -1;
+        r->stop_code = BALLC_DRIVE_UNSETTLED;
+        r->stop_plane = p;
+        r->o->unsettled_compliant = 1;
+        return 0;
+    }
+    if (kind == K_CAPACITY) {   /* no change: the next segment watches the way back */
+        r->capacity_row[p] = r->fired_row == 4 ? 5 : 4;
+        return 0;
+    }
+    double y[N];
+    if (kind == K_ARM) r->armed[p] = 1;
+    else if (kind == K_YIELD) {   /* compliantmodes.load_vanished */
+        double m[BALLC_COMPLIANT_MARGINS];
+        if (margins_of(r, p, r->y, m)) return -1;
+        if (!(m[2] > 0) || m[0] > 0.5) {
+            r->armed[p] = 0;
+            return set_compliant(r, p, COMPLIANT_ELASTIC);
+        }
+    }
+    if (kind == K_ARM || kind == K_YIELD) {
+        int mode;
+        if (decide(r, p, r->y, kind == K_ARM, &mode, y)) return -1;
+        memcpy(r->y, y, sizeof y);
+        return set_compliant(r, p, mode);
+    }
+    if (at_cap(r, p, r->y, 1, y)) return -1;   /* restick */
+    memcpy(r->y, y, sizeof y);
+    return set_compliant(r, p, COMPLIANT_ELASTIC);
+}
+
 /* stickslip.slip_stop_coefficients */
 static void stop_coefficients(const run_t *r, int p, const double *d, double *row)
 {
@@ -505,8 +718,28 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     run_t *r = (run_t *)ctx;
     double out[6];
     (void)t;
-    int status = ballc_stick_state(y, r->c->params, r->latch, r->seg_flags,
-                                   r->ev_plane_code[e], out);
+    int code = r->ev_plane_code[e];
+    if (code <= -2) {   /* the user's callable (the bridge's _user_event) */
+        int st = r->c->user_fun(r->c->user_ctx, -2 - code, t, y, g);
+        if (st) r->user_failed = 1;
+        return st;
+    }
+    if (code >= 2) {   /* a compliant guard: the bridge's _ball_event, with its cache */
+        int row = (code - 2) / 2, plane = code % 2;
+        if (r->margins_plane == plane && (row != 1 || r->margins_solved)
+                && memcmp(r->margins_y, y, N * sizeof(double)) == 0) {
+            g[0] = r->margins_out[row];
+            return BALLC_OK;
+        }
+        int st = ballc_compliant_margins_prepared(y, &r->prepared, r->latch, plane, row,
+                                                  r->margins_out);
+        r->margins_plane = st == BALLC_OK ? plane : -1;
+        r->margins_solved = row == 1;
+        memcpy(r->margins_y, y, N * sizeof(double));
+        g[0] = r->margins_out[row];
+        return st;
+    }
+    int status = ballc_stick_state(y, r->c->params, r->latch, r->seg_flags, code, out);
     g[0] = out[3];
     return status;
 }
@@ -515,6 +748,11 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
 static int drv_rearm(void *ctx, int e, double t, const double *y)
 {
     run_t *r = (run_t *)ctx;
+    int code = r->ev_plane_code[e];
+    if (code >= CAPACITY_FIRST) {   /* the bridge's _ball_rearm: a capacity guard toggles */
+        r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + 2 : code - 2;
+        return 1;
+    }
     int p = r->ev_plane[e];
     long stalled = stalled_at(r, t);
     if (unsettled(r, p, stalled) || r->relatches[p] + 1 > MAX_RELATCH) return 0;
@@ -538,6 +776,7 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
     if (set_mode(r, p, BALLC_MODE_SLIP, d, 1, approach)) return 0;
     stop_coefficients(r, p, d, r->ev_coef + (size_t)e * N);
     r->ev_offset[e] = -approach;
+    r->margins_plane = -1;   /* the margins read the latch */
     return 1;
 }
 
@@ -561,6 +800,8 @@ static int add_event(run_t *r, int kind, int p, const double *coef, int state, d
     r->ev_rearm[k] = 0;
     r->ev_kind[k] = kind;
     r->ev_plane[k] = p;
+    r->ev_index[k] = coef ? -1 : state;
+    r->ev_scale[k] = scale;
     return k;
 }
 
@@ -583,6 +824,7 @@ static int segment_events(run_t *r, int flags)
             add_event(r, K_DEEPEST, p, NULL, BALLC_STATE_VZ, p == 0 ? -1.0 : 1.0, 0.0, 0, -1);
         } else {
             double threshold = py_max(base, rho0 + base);
+            if (c->compliant_modes) threshold = py_max(threshold, c->arm_depth[p]);
             add_event(r, K_ENTER, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
                       c->rho_offset[p] + (-threshold), 1, 1);
         }
@@ -612,6 +854,45 @@ static int segment_events(run_t *r, int flags)
             int k = add_event(r, K_RELEASE, p, NULL, -1, 0, force_scale(r, out[2]), 1, -1);
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = p;
+        }
+        if (r->compliant[p] != COMPLIANT_NONE) {   /* compliantmodes.guard */
+            if (!r->armed[p]) {   /* the penetration rising through the arming depth */
+                add_event(r, K_ARM, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
+                          c->rho_offset[p] + (-c->arm_depth[p]), 1, 1);
+                continue;
+            }
+            double rounding = py_max(64 * DBL_EPSILON, c->ulp8[p] / py_max(rho0, 1e-300));
+            int elastic = r->compliant[p] == COMPLIANT_ELASTIC;
+            double offset = elastic ? rounding
+                                    : rounding * speed_scale(r, y0) * c->restick_factor;
+            int k = add_event(r, elastic ? K_YIELD : K_RESTICK, p, NULL, -1, 0, offset, 1, -1);
+            r->ev_nonlinear[k] = 1;
+            r->ev_plane_code[k] = 2 + 2 * (elastic ? 0 : 1) + p;
+            if (elastic && c->damping_positive) {   /* compliantmodes.capacity_guard */
+                double m[BALLC_COMPLIANT_MARGINS];
+                if (margins_of(r, p, y0, m)) return -1;
+                int row = r->capacity_row[p] >= 0 ? r->capacity_row[p] : (m[4] >= 0 ? 4 : 5);
+                double cap = m[2] * m[3];
+                k = add_event(r, K_CAPACITY, p, NULL, -1, 0, rounding * py_max(cap, 1e-12),
+                              1, -1);
+                r->ev_nonlinear[k] = 1;
+                r->ev_plane_code[k] = 2 + 2 * row + p;
+                r->ev_rearm[k] = 1;
+            }
+        }
+    }
+    /* the user's (UserEvents.for_segment): terminal = the occurrences left */
+    for (int u = 0; u < c->n_user; u++) {
+        int left = c->user_count[u] ? (int)(c->user_count[u] - r->user_seen[u]) : 0;
+        double offset = c->user_offset[u];
+        if (c->user_linear[u] && left != c->user_count[u]) offset = offset + 0.0;  /* shifted */
+        int k = add_event(r, K_USER, u, c->user_linear[u] ? c->user_coef + (size_t)u * N : NULL,
+                          -1, 0, offset, left, c->user_direction[u]);
+        r->ev_index[k] = c->user_linear[u] ? c->user_index[u] : -1;
+        r->ev_scale[k] = c->user_linear[u] ? c->user_scale[u] : 0.0;
+        if (!c->user_linear[u]) {   /* a callable: evaluated in Python, through the bridge */
+            r->ev_nonlinear[k] = 1;
+            r->ev_plane_code[k] = -2 - u;
         }
     }
     return 0;
@@ -651,23 +932,401 @@ static int add_block(run_t *r, const double *t, const double *y, long count, int
 }
 
 /* Samples.add_later (first = 1: a segment's first sample is its start) */
-static int add_later(run_t *r, const radau5_result *res, double after, int flags)
+static int add_later_rows(run_t *r, long n, const double *t, const double *y_out,
+                          double after, int flags)
 {
-    long n = res->n_out, first = 1;
-    const double *t = res->t_out;
+    long first = r->c->t_eval ? 0 : 1;   /* simulate: skip */
     while (first < n && t[first] <= after) first++;
     for (long k = 0; k < r->n_rearmed; k++) {
         double when = r->rearmed_t[k];
         long cut = 0;   /* searchsorted(t, when, 'right') */
         while (cut < n && t[cut] <= when) cut++;
         if (cut < first) cut = first;
-        if (add_block(r, t + first, res->y_out + (size_t)first * N, cut - first, flags,
+        if (add_block(r, t + first, y_out + (size_t)first * N, cut - first, flags,
                       r->rearmed_latch + (size_t)k * NL))
             return -1;
         first = cut;
     }
-    return add_block(r, t + first, res->y_out + (size_t)first * N, n - first, flags,
+    return add_block(r, t + first, y_out + (size_t)first * N, n - first, flags,
                      r->latch);
+}
+
+static int add_later(run_t *r, const radau5_result *res, double after, int flags)
+{
+    return add_later_rows(r, res->n_out, res->t_out, res->y_out, after, flags);
+}
+
+/* ---- exact free flight (ballc.flight; stage 2c) ---- */
+
+#define FLIGHT_MIN_INTERVALS 32          /* flight.MIN_INTERVALS */
+#define FLIGHT_MAX_SAMPLES 100000000L    /* more: fall back (Python would allocate them) */
+
+typedef struct { double t0, rate, c[5][N]; } flight_t;
+
+/* flight.FreeFlight.__init__ */
+static void flight_init(flight_t *f, double t0, const double *y0, double gravity)
+{
+    f->t0 = t0;
+    double wx = y0[BALLC_STATE_OMEGA_X], wy = y0[BALLC_STATE_OMEGA_Y], wz = y0[BALLC_STATE_OMEGA_Z];
+    f->rate = sqrt(wx * wx + wy * wy + wz * wz);
+    double nx = 0.0, ny = 0.0, nz = 0.0;
+    if (f->rate > 0) { nx = wx / f->rate; ny = wy / f->rate; nz = wz / f->rate; }
+    double qw = y0[BALLC_STATE_QW], qx = y0[BALLC_STATE_QX], qy = y0[BALLC_STATE_QY],
+           qz = y0[BALLC_STATE_QZ];
+    double turned[4] = {-(nx * qx + ny * qy + nz * qz), nx * qw + ny * qz - nz * qy,
+                        ny * qw + nz * qx - nx * qz, nz * qw + nx * qy - ny * qx};
+    memset(f->c, 0, sizeof f->c);
+    memcpy(f->c[0], y0, N * sizeof(double));
+    for (int i = 0; i < 4; i++) {
+        f->c[0][BALLC_STATE_QW + i] = 0.0;
+        f->c[3][BALLC_STATE_QW + i] = y0[BALLC_STATE_QW + i];
+        f->c[4][BALLC_STATE_QW + i] = turned[i];
+    }
+    for (int i = 0; i < 3; i++) f->c[1][BALLC_STATE_X + i] = y0[BALLC_STATE_VX + i];
+    f->c[1][BALLC_STATE_VZ] = -gravity;
+    f->c[2][BALLC_STATE_Z] = -0.5 * gravity;
+}
+
+/* FreeFlight.__call__ at an array of times, one time: basis 1, s, s*s, cos, sin and
+ * np.einsum("kn,km->nm"), which sums the 5 products in order from +0.0 */
+static void flight_at(const flight_t *f, double t, double *y)
+{
+    double s = t - f->t0;
+    double half = 0.5 * f->rate * s;
+    double basis[5] = {1.0, s, s * s, cos(half), sin(half)};
+    for (int n = 0; n < N; n++) {
+        double acc = 0.0;
+        for (int k = 0; k < 5; k++) acc += f->c[k][n] * basis[k];
+        y[n] = acc;
+    }
+}
+
+/* flight.crossings: the roots in [0, s_max] where it changes sign in ``direction``, in
+ * increasing order (at most 2) */
+static int crossings(double c0, double c1, double c2, int direction, double s_max,
+                     double *out)
+{
+    double roots[2];
+    int rising[2], m, n = 0;
+    if (c2 == 0) {
+        if (c1 == 0) return 0;
+        roots[0] = -c0 / c1;
+        rising[0] = c1 > 0;
+        m = 1;
+    } else {
+        double disc = c1 * c1 - 4.0 * c2 * c0;
+        if (!(disc > 0)) return 0;
+        double q = -0.5 * (c1 + copysign(sqrt(disc), c1));
+        double a = q / c2, b = c0 / q;
+        if (b < a) { roots[0] = b; roots[1] = a; }   /* sorted((a, b)) */
+        else { roots[0] = a; roots[1] = b; }
+        rising[0] = c2 < 0;
+        rising[1] = c2 > 0;
+        m = 2;
+    }
+    for (int i = 0; i < m; i++)
+        if (0 <= roots[i] && roots[i] <= s_max
+                && (direction == 0 || (direction > 0) == rising[i]))
+            out[n++] = roots[i];
+    return n;
+}
+
+
+/* flight.propagate of a segment from (r->t, r->y) to t1 whose events are all linear in
+ * one state that is not the quaternion (the contact starts, the user's LinearEvents):
+ * its samples (t_eval's points from ev, n_eval of them, or the even grid) and its hits,
+ * in ``res`` as the integrator would give them (freed by radau5_free).  Returns 0,
+ * -1 (fall back) or -2 (memory). */
+static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
+                          radau5_result *res)
+{
+    const ballc_drive_config *c = r->c;
+    double t0 = r->t, g = c->gravity;
+    flight_t f;
+    flight_init(&f, t0, r->y, g);
+    memset(res, 0, sizeof *res);
+    res->stiff_at = NAN;
+    res->method_end = -1;
+    double span = t1 - t0;
+    /* the hits (s, event), at most 2 per event, sorted as Python sorts the tuples */
+    double hs[2 * MAX_EVENTS];
+    int he[2 * MAX_EVENTS], nh = 0;
+    for (int e = 0; e < r->n_ev; e++) {   /* FreeFlight.event_polynomial, crossings */
+        int k = r->ev_index[e];
+        if (k < 0 || r->ev_nonlinear[e]) return -1;
+        double scale = r->ev_scale[e], y0k = r->y[k];
+        double c0 = scale * y0k + r->ev_offset[e];
+        double c1 = scale * (k >= BALLC_STATE_X && k <= BALLC_STATE_Z ? r->y[k + 6]
+                             : k == BALLC_STATE_VZ ? -g : 0.0);
+        double c2 = k == BALLC_STATE_Z ? -0.5 * scale * g : 0.0;
+        double roots[2];
+        int n = crossings(c0, c1, c2, r->ev_direction[e], span, roots);
+        if (r->ev_terminal[e] > 0 && n > r->ev_terminal[e]) n = r->ev_terminal[e];
+        for (int i = 0; i < n; i++) {
+            int at = nh++;   /* insertion by (s, event) */
+            while (at > 0 && (hs[at - 1] > roots[i]
+                              || (hs[at - 1] == roots[i] && he[at - 1] > e))) {
+                hs[at] = hs[at - 1];
+                he[at] = he[at - 1];
+                at--;
+            }
+            hs[at] = roots[i];
+            he[at] = e;
+        }
+    }
+    int seen[MAX_EVENTS], stop = -1;
+    memset(seen, 0, sizeof seen);
+    for (int h = 0; h < nh; h++) {
+        int e = he[h];
+        seen[e]++;
+        if (r->ev_terminal[e] && seen[e] >= r->ev_terminal[e]) { stop = h; break; }
+    }
+    double t_end = t1;
+    int kept = 0;
+    if (stop >= 0) {
+        for (int h = 0; h < nh; h++)   /* hits <= stop (tuples) */
+            if (hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])) kept++;
+        t_end = py_min(t0 + hs[stop], t1);
+        res->status = RADAU5_EVENT;
+    } else {
+        res->status = RADAU5_REACHED;
+    }
+    long n;
+    double *times;
+    if (c->t_eval) {   /* t[(t >= t0) & (t <= t_stop)] of the segment's points */
+        n = 0;
+        while (n < n_eval && ev[n] <= t_end) n++;
+        long lo = 0;
+        while (lo < n && !(ev[lo] >= t0)) lo++;
+        ev += lo;
+        n -= lo;
+        times = malloc((size_t)(n ? n : 1) * sizeof(double));
+        if (!times) return -2;
+        if (n) memcpy(times, ev, (size_t)n * sizeof(double));
+    } else {
+        double max_step = run_max_step(r);
+        double turn = f.rate * (t_end - t0) / (M_PI / 16);
+        double longest = max_step < INFINITY ? (t_end - t0) / max_step : 0.0;
+        if (!(fabs(turn) < 1e8) || !(fabs(longest) < 1e8)) return -1;
+        double m = py_max(py_max((double)FLIGHT_MIN_INTERVALS, ceil(turn)), ceil(longest));
+        long intervals = (long)m;
+        n = intervals + 1;
+        times = malloc((size_t)n * sizeof(double));
+        if (!times) return -2;
+        double dt = t_end - t0;
+        for (long i = 0; i <= intervals; i++)
+            times[i] = t0 + dt * ((double)i / (double)intervals);
+        times[intervals] = t_end;
+    }
+    res->t_out = times;
+    res->n_out = n;
+    res->y_out = malloc((size_t)(n ? n : 1) * N * sizeof(double));
+    res->hit_event = malloc((size_t)(kept ? kept : 1) * sizeof(int));
+    res->hit_t = malloc((size_t)(kept ? kept : 1) * sizeof(double));
+    res->hit_y = malloc((size_t)(kept ? kept : 1) * N * sizeof(double));
+    if (!res->y_out || !res->hit_event || !res->hit_t || !res->hit_y) return -2;
+    for (long i = 0; i < n; i++) flight_at(&f, times[i], res->y_out + (size_t)i * N);
+    for (int h = 0, m = 0; h < nh && m < kept; h++) {
+        if (!(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop]))) continue;
+        double when = h == stop ? t_end : py_min(t0 + hs[h], t1);
+        res->hit_event[m] = he[h];
+        res->hit_t[m] = when;
+        flight_at(&f, when, res->hit_y + (size_t)m * N);
+        m++;
+    }
+    res->n_hits = kept;
+    return 0;
+}
+
+/* ---- the rest checks (ballc.resting; stage 2a) ---- */
+
+/* _core.energies of one state row */
+static void energy_of(const run_t *r, const double *y, double *e)
+{
+    ballc_energy(y, r->c->params, r->prepared.constants, NULL, e);
+}
+
+/* resting._booked: the energy y has above ``new`` added to dissipated_normal */
+static void booked(const run_t *r, const double *y, double *new_y)
+{
+    double a[BALLC_ENERGY_NOUT], b[BALLC_ENERGY_NOUT];
+    energy_of(r, y, a);
+    energy_of(r, new_y, b);
+    double before = a[0] + a[1] + a[2] + a[3] + a[4] + a[5];
+    double after = b[0] + b[1] + b[2] + b[3] + b[4] + b[5];
+    new_y[BALLC_STATE_DISSIPATED_NORMAL] += before - after;
+}
+
+/* the Hertz spring plus gravity above rho_eq (resting.energy_above_rest, rolls); x > -1 */
+static double normal_above(const ballc_drive_config *c, double x)
+{
+    return c->rest_weight * c->rho_eq * (0.4 * expm1(2.5 * (x == 0.0 ? x : log1p(x))) - x);
+}
+
+/* resting.at_rest (criteria 2-4); -1 where Python would raise */
+static int at_rest(const run_t *r, const double *y, double t_start, double t)
+{
+    const ballc_drive_config *c = r->c;
+    if (t - t_start < c->rest_period) return 0;
+    double across = 0.0, up = 0.0;
+    if (c->observer_massive) {   /* resting._observer_offset */
+        double where[BALLC_OBSERVER_POSITION_NOUT], d[3];
+        ballc_observer_position(y, c->params, r->prepared.constants, NULL, where);
+        for (int i = 0; i < 3; i++) d[i] = where[i] - y[BALLC_STATE_X + i];
+        across = ballc_py_hypot(2, d);
+        up = d[2];
+        if (up >= 0) return 0;
+    }
+    double e[BALLC_ENERGY_NOUT];
+    energy_of(r, y, e);
+    double kinetic = e[0], spring = e[4] + e[5];
+    double rho = c->radius - y[BALLC_STATE_Z];
+    double x = (rho - c->rho_eq) / c->rho_eq;
+    double normal = INFINITY;
+    if (x > -1) {
+        normal = normal_above(c, x);
+        if (!isfinite(normal) && isfinite(x)) return -1;   /* math.expm1 overflow */
+    }
+    double observer = 0.0;
+    if (c->observer_massive) {
+        double pair[2] = {across, up};
+        double reach = ballc_py_hypot(2, pair);
+        observer = reach > 0 ? c->observer_weight * across * across / (reach + fabs(up)) : 0.0;
+    }
+    double above = kinetic + py_max(normal, 0.0) + spring + observer;
+    return above <= c->rest_threshold;
+}
+
+/* np.max(np.abs(v)) of n values: NaN when one is NaN */
+static double max_abs(const double *v, int n)
+{
+    double m = fabs(v[0]);
+    for (int i = 0; i < n; i++) {
+        if (isnan(v[i])) return NAN;
+        if (fabs(v[i]) > m) m = fabs(v[i]);
+    }
+    return m;
+}
+
+/* resting.rolls: BALLC_END_ROLLING / SLIDING with ``roll`` the uniform state, 0 none,
+ * -1 where Python would raise */
+static int rolls(const run_t *r, const double *y, double t_start, double t,
+                 double slip_speed, double *roll)
+{
+    const ballc_drive_config *c = r->c;
+    if (t - t_start < c->rest_period || !c->rolls_allowed) return 0;
+    double e[BALLC_ENERGY_NOUT];
+    energy_of(r, y, e);
+    double x = (c->radius - y[BALLC_STATE_Z] - c->rho_eq) / c->rho_eq;
+    if (!(x > -1)) return 0;
+    double normal = normal_above(c, x);
+    if (!isfinite(normal) && isfinite(x)) return -1;
+    double above = c->half_mass * pow(y[BALLC_STATE_VZ], 2.0) + (e[4] + e[5])
+                   + py_max(normal, 0.0);
+    if (!(above <= c->rest_threshold)) return 0;
+    memcpy(roll, y, N * sizeof(double));   /* resting.rolling_state */
+    roll[BALLC_STATE_Z] = c->z_eq;
+    roll[BALLC_STATE_VZ] = 0.0;
+    roll[BALLC_STATE_FLOOR_DEFLECTION_X] = roll[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
+    roll[BALLC_STATE_CEILING_DEFLECTION_X] = roll[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+    booked(r, y, roll);
+    double rate[N];
+    if (ballc_rhs(roll, c->params, r->latch, run_flags(r, 1), rate) != BALLC_OK) return -1;
+    double level = c->rolls_level;
+    if (max_abs(rate + BALLC_STATE_VX, 3) > level
+            || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level
+            || max_abs(rate + BALLC_STATE_FLOOR_DEFLECTION_X, 2) > level
+            || max_abs(rate + BALLC_STATE_CEILING_DEFLECTION_X, 2) > level)
+        return 0;
+    return slip_speed <= c->rolls_dv ? BALLC_END_ROLLING : BALLC_END_SLIDING;
+}
+
+/* _Run.end_state at a rest check on plane p at (r->t, r->y): BALLC_END_* when the run
+ * finishes in closed form from here (r->y the new state), 0 to go on (the next check
+ * scheduled), -1 to fall back (an orbit's trial would start, or Python would raise) */
+static int end_state(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    const ballc_contact_rec *k = &r->o->contacts[r->o->open[p]];
+    int rest = at_rest(r, r->y, k->t_start, r->t);
+    if (rest < 0) return -1;
+    if (rest) {   /* resting.rest_state */
+        double new_y[N];
+        memcpy(new_y, r->y, sizeof new_y);
+        for (int i = 0; i < 3; i++) new_y[BALLC_STATE_VX + i] = new_y[BALLC_STATE_OMEGA_X + i] = 0.0;
+        new_y[BALLC_STATE_Z] = c->z_eq;
+        new_y[BALLC_STATE_FLOOR_DEFLECTION_X] = new_y[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
+        new_y[BALLC_STATE_CEILING_DEFLECTION_X] = new_y[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+        booked(r, r->y, new_y);
+        memcpy(r->y, new_y, sizeof new_y);
+        return BALLC_END_REST;
+    }
+    /* resting.next_check */
+    r->rest_check[p] = r->t + py_max(c->rest_period, 0.25 * (r->t - k->t_start));
+    double u[2], speed, error, clear, roll[N];
+    slip(r, p, r->y, u, &speed, &error, &clear);
+    int kind = rolls(r, r->y, k->t_start, r->t, speed, roll);
+    if (kind < 0) return -1;
+    if (kind) {
+        memcpy(r->y, roll, sizeof roll);
+        return kind;
+    }
+    if (!c->orbit_applies) return 0;
+    /* _Run.plan_orbit_trial: a trial may start (then orbit.equivariant, not ported,
+     * decides): fall back; with no spin, or a trial that would end after t_end, none */
+    double rate = sqrt(ballc_dot3_fma(r->y + BALLC_STATE_OMEGA_X));
+    if (!(rate > 0)) return 0;
+    double guess = 2 * M_PI / rate;
+    double t_to = r->t + ORBIT_TRIAL_PERIODS * guess;
+    return t_to < c->t_end ? -1 : 0;
+}
+
+/* pieces.append((t0, t1, sol.interpolant)): the segment's steps kept (stage 2b), or an
+ * exact flight's FreeFlight from (t0, r->y) */
+static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, int flown)
+{
+    ballc_drive_output *o = r->o;
+    if (flown) {
+        if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1,
+                 sizeof(ballc_piece_rec)))
+            return -1;
+        ballc_piece_rec *k = &o->pieces[o->n_pieces++];
+        memset(k, 0, sizeof *k);
+        k->t0 = t0;
+        k->t1 = t1;
+        k->flight = 1;
+        memcpy(k->y0, r->y, sizeof k->y0);
+        return 0;
+    }
+    long m = res->n_dense, width = (long)(1 + res->dense_terms) * N;
+    if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1, sizeof(ballc_piece_rec)))
+        return -1;
+    long cs = o->cap_steps;
+    if (grow((void **)&o->dense_kind, &cs, o->n_steps + m, sizeof(int))) return -1;
+    if (cs != o->cap_steps) {
+        double *dt = realloc(o->dense_t, (size_t)cs * 2 * sizeof(double));
+        if (!dt) return -1;
+        o->dense_t = dt;
+        o->cap_steps = cs;
+    }
+    if (grow((void **)&o->dense_c, &o->cap_coef, o->n_coef + m * width, sizeof(double)))
+        return -1;
+    ballc_piece_rec *k = &o->pieces[o->n_pieces++];
+    k->t0 = t0;
+    k->t1 = t1;
+    k->flight = 0;
+    k->step0 = o->n_steps;
+    k->n_steps = m;
+    k->coef0 = o->n_coef;
+    k->terms = res->dense_terms;
+    if (m) {
+        memcpy(o->dense_t + 2 * o->n_steps, res->dense_t, (size_t)m * 2 * sizeof(double));
+        memcpy(o->dense_kind + o->n_steps, res->dense_kind, (size_t)m * sizeof(int));
+        memcpy(o->dense_c + o->n_coef, res->dense_c, (size_t)(m * width) * sizeof(double));
+    }
+    o->n_steps += m;
+    o->n_coef += m * width;
+    return 0;
 }
 
 /* ---- the loop (simulate.simulate) ---- */
@@ -697,17 +1356,40 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     ballc_parameters_init(&r->prepared, c->params);
     memcpy(r->y, y0, sizeof r->y);
     r->rest_check[0] = r->rest_check[1] = INFINITY;
+    r->capacity_row[0] = r->capacity_row[1] = -1;
+    r->margins_plane = -1;
     int rc = 0;
     for (int i = 0; i < BALLC_N_PARAMETERS; i++)
         if (!isfinite(c->params[i])) rc = -1;   /* solve_system would raise */
     for (int p = 0; p < 2 && !rc; p++)
         if (rho_of(r, p, r->y) > 0) rc = begin_contact(r, p);
     double t0 = 0.0;
-    if (!rc) rc = add_block(r, &t0, r->y, 1, run_flags(r, 1), r->latch);
+    if (!rc && !c->t_eval) rc = add_block(r, &t0, r->y, 1, run_flags(r, 1), r->latch);
+    long eval_at = 0;   /* t_eval: the first point after run.t */
+    if (!rc && c->t_eval) {   /* the points at 0 (t_eval == 0.0), each the initial state */
+        long keep = 0;
+        for (long i = 0; i < c->n_eval; i++) keep += c->t_eval[i] == 0.0;
+        double *rows = malloc((size_t)(keep ? keep : 1) * N * sizeof(double));
+        double *times = malloc((size_t)(keep ? keep : 1) * sizeof(double));
+        if (!rows || !times) rc = -2;
+        else {
+            long j = 0;
+            for (long i = 0; i < c->n_eval; i++)
+                if (c->t_eval[i] == 0.0) {
+                    times[j] = c->t_eval[i];
+                    memcpy(rows + j * N, r->y, N * sizeof(double));
+                    j++;
+                }
+            rc = add_block(r, times, rows, keep, run_flags(r, 1), r->latch) ? -2 : 0;
+        }
+        free(rows);
+        free(times);
+    }
     double atol[N];
     for (int i = 0; i < N; i++) atol[i] = c->atol;
     double first = c->first_step;
     int has_first = c->has_first_step;
+    int implicit = 0;   /* method "auto": the segment starts with radau5 */
     long nfev = 0, njev = 0, nlu = 0;
     int stiff_found = 0;
 
@@ -720,12 +1402,30 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         if (c->checks_rest && c->resting_plane >= 0 && r->in_contact[c->resting_plane]
                 && !r->in_contact[1 - c->resting_plane])
             t_check = r->rest_check[c->resting_plane];
-        double t_stop = c->t_end < t_check ? c->t_end : t_check;
+        /* a rest check, or the end of a compliant contact's step bound, ends it */
+        double t_stop = py_min(py_min(t_check, c->t_end), step_bound_end(r));
+        double max_step = run_max_step(r);
         for (int i = 0; i < N; i++)
             if (!isfinite(r->y[i])) rc = -1;
         for (int i = 0; i < NL; i++)
             if (!isfinite(r->latch[i])) rc = -1;
         if (rc) break;
+        radau5_result res;
+        int solved = RADAU5_DONE, flown = 0;
+        if (c->exact_flight && flags == 0 && c->user_flight) {   /* flight.applies */
+            long n_eval = 0;
+            const double *ev = NULL;
+            if (c->t_eval) {
+                while (eval_at < c->n_eval && !(c->t_eval[eval_at] > r->t)) eval_at++;
+                long hi = eval_at;
+                while (hi < c->n_eval && c->t_eval[hi] <= t_stop) hi++;
+                ev = c->t_eval + eval_at;
+                n_eval = hi - eval_at;
+            }
+            int got = flight_segment(r, t_stop, ev, n_eval, &res);
+            if (got) { radau5_free(&res); rc = got; break; }
+            flown = 1;
+        } else {
         radau5_problem pr;
         memset(&pr, 0, sizeof pr);
         pr.n = N;
@@ -737,7 +1437,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.y0 = r->y;
         pr.rtol = c->rtol;
         pr.atol = atol;
-        pr.max_step = c->max_step;
+        pr.max_step = max_step;
         pr.first_step = 0.0;
         if (has_first) {   /* integrate.integrate_segment, then the bridge's check */
             double f = py_min(first, t_stop - r->t);
@@ -747,6 +1447,13 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.max_nfev = c->max_nfev ? (c->max_nfev - nfev > 1 ? c->max_nfev - nfev : 1) : 0;
         pr.t_eval = NULL;
         pr.n_eval = 0;
+        if (c->t_eval) {   /* t_eval[(t_eval > run.t) & (t_eval <= t_stop)] (sorted) */
+            while (eval_at < c->n_eval && !(c->t_eval[eval_at] > r->t)) eval_at++;
+            long hi = eval_at;
+            while (hi < c->n_eval && c->t_eval[hi] <= t_stop) hi++;
+            pr.t_eval = hi > eval_at ? c->t_eval + eval_at : r->y;   /* non-NULL: none */
+            pr.n_eval = hi - eval_at;
+        }
         pr.n_events = r->n_ev;
         pr.ev_coef = r->ev_coef;
         pr.ev_offset = r->ev_offset;
@@ -754,22 +1461,29 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.ev_fun = drv_event;
         pr.ev_terminal = r->ev_terminal;
         pr.ev_direction = r->ev_direction;
-        pr.dense_output = 0;
+        pr.dense_output = c->dense_output;
         pr.controller = c->controller;
         pr.outputs_checked = 1;
         pr.refine_events = 1;
         pr.ev_rearm = r->ev_rearm;
         pr.rearm = drv_rearm;
         pr.method = c->method;
-        pr.jacobian_ahead = 0;
-        pr.auto_implicit = 0;
-        radau5_result res;
-        int solved = radau5_solve(&pr, &res);
+        pr.jacobian_ahead = (flags & c->compliant_any) != 0;
+        r->margins_plane = -1;   /* a fresh bridge context per segment */
+        pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
+        solved = radau5_solve(&pr, &res);
+        }
         o->segments++;
         has_first = 0;
+        implicit = 0;
 #ifdef RADAU5_PROFILE
         o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
 #endif
+        if (r->user_failed) {   /* solve_system raises the user's exception */
+            radau5_free(&res);
+            r->stop_code = BALLC_DRIVE_USER_ERROR;
+            break;
+        }
         if (solved != RADAU5_DONE) { radau5_free(&res); rc = -1; break; }
         nfev += res.nfev;
         njev += res.njev;
@@ -778,6 +1492,21 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             o->stiff_at = res.stiff_at;
             stiff_found = 1;
         }
+        if (c->method == RADAU5_METHOD_AUTO && res.n_switches) {   /* switches += ... */
+            long cs = o->cap_switches;
+            if (grow((void **)&o->switch_t, &cs, o->n_switches + res.n_switches,
+                     sizeof(double))) { radau5_free(&res); rc = -2; break; }
+            int *to = realloc(o->switch_to, (size_t)cs * sizeof(int));
+            if (!to) { radau5_free(&res); rc = -2; break; }
+            o->switch_to = to;
+            o->cap_switches = cs;
+            memcpy(o->switch_t + o->n_switches, res.switch_t,
+                   (size_t)res.n_switches * sizeof(double));
+            memcpy(o->switch_to + o->n_switches, res.switch_to,
+                   (size_t)res.n_switches * sizeof(int));
+            o->n_switches += res.n_switches;
+        }
+        int ended_implicit = res.method_end == RADAU5_METHOD_RADAU;
         if (add_later(r, &res, r->t, flags)) { radau5_free(&res); rc = -2; break; }
         int fired = -1;
         double t_fired = INFINITY;
@@ -801,7 +1530,32 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 fired_hit = last;
             }
         }
+        for (long h = 0; h < res.n_hits; h++) {   /* users.count, user_t, user_y */
+            int e = res.hit_event[h];
+            if (r->ev_kind[e] != K_USER) continue;
+            int u = r->ev_plane[e];
+            r->user_seen[u]++;
+            long m = o->n_user_hits, cu = o->cap_user_hits;
+            if (grow((void **)&o->user_hit_t, &cu, m + 1, sizeof(double))) { rc = -2; break; }
+            if (cu != o->cap_user_hits) {
+                int *ue = realloc(o->user_hit_event, (size_t)cu * sizeof(int));
+                if (ue) o->user_hit_event = ue;
+                double *uy = realloc(o->user_hit_y, (size_t)cu * N * sizeof(double));
+                if (uy) o->user_hit_y = uy;
+                if (!ue || !uy) { rc = -2; break; }
+                o->cap_user_hits = cu;
+            }
+            o->user_hit_event[m] = u;
+            o->user_hit_t[m] = res.hit_t[h];
+            memcpy(o->user_hit_y + (size_t)m * N, res.hit_y + (size_t)h * N, N * sizeof(double));
+            o->n_user_hits++;
+        }
+        if (rc) { radau5_free(&res); break; }
         if (res.status == RADAU5_FAILED) {
+            if (c->dense_output && res.n_out
+                    && add_piece(r, &res, r->t, res.t_out[res.n_out - 1], flown)) {
+                radau5_free(&res); rc = -2; break;
+            }
             r->status = -1;
             r->stop_code = BALLC_DRIVE_FAILED;
             memcpy(o->message, res.message, sizeof o->message);
@@ -811,12 +1565,38 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         if (res.status == RADAU5_REACHED) {
-            radau5_free(&res);
+            if (c->dense_output && add_piece(r, &res, r->t, t_stop, flown)) {
+                radau5_free(&res); rc = -2; break;
+            }
             r->t = t_stop;
-            if (t_stop < c->t_end) { rc = -1; break; }   /* a rest check: not ported */
+            if (t_stop < c->t_end) {   /* a rest check (ballc.resting) or a step bound's end */
+                if (!res.n_out) { radau5_free(&res); rc = -1; break; }
+                memcpy(r->y, res.y_out + (size_t)(res.n_out - 1) * N, sizeof r->y);
+                radau5_free(&res);
+                if (t_stop != t_check) {   /* only a step bound ended: a fresh step */
+                    implicit = ended_implicit;
+                    continue;
+                }
+                int p = c->resting_plane;
+                int kind = end_state(r, p);
+                if (kind < 0) { rc = -1; break; }
+                if (kind) {   /* to t_end in closed form: the samples are Python's */
+                    o->end_kind = kind;
+                    o->end_plane = p;
+                    o->end_t = r->t;
+                    memcpy(o->end_y, r->y, sizeof r->y);
+                    break;
+                }
+                implicit = ended_implicit;   /* auto keeps the method it ended with */
+                continue;   /* the next segment starts with its own first step */
+            }
+            radau5_free(&res);
             break;
         }
         if (fired < 0) { radau5_free(&res); rc = -1; break; }
+        if (c->dense_output && add_piece(r, &res, r->t, t_fired, flown)) {
+            radau5_free(&res); rc = -2; break;
+        }
         double h_next = res.h_next;
         r->t = t_fired;
         memcpy(r->y, res.hit_y + (size_t)fired_hit * N, sizeof r->y);
@@ -824,6 +1604,13 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         double h = ballc_py_hypot(4, r->y + BALLC_STATE_QW);
         for (int i = 0; i < 4; i++) r->y[BALLC_STATE_QW + i] /= h;
         int kind = r->ev_kind[fired], p = r->ev_plane[fired];
+        if (kind == K_USER) {   /* a terminal user event: the run stops, status 1 */
+            r->status = 1;
+            r->stop_code = BALLC_DRIVE_TERMINATED;
+            break;
+        }
+        if (kind == K_CAPACITY)   /* its row may have toggled inside the segment */
+            r->fired_row = (r->ev_plane_code[fired] - 2) / 2;
         int handled = 0;
         switch (kind) {
         case K_ENTER: handled = begin_contact(r, p); break;
@@ -839,12 +1626,16 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             r->stop_plane = p;
             break;
         }
+        case K_ARM: case K_YIELD: case K_RESTICK: case K_CAPACITY:
+            handled = compliant_event(r, kind, p);
+            break;
         default: handled = coulomb_event(r, kind, p); break;
         }
         if (handled) { rc = -1; break; }
         if (kind >= K_APPROACH && h_next > 0) {   /* CARRY_STEP */
-            first = py_min(h_next, c->max_step);
+            first = py_min(h_next, run_max_step(r));
             has_first = 1;
+            implicit = ended_implicit;
         }
     }
     if (rc) r->stop_code = rc == -2 ? BALLC_DRIVE_NO_MEMORY : BALLC_DRIVE_FALLBACK;

@@ -11,7 +11,8 @@ cdef extern from "_driver.h":
     double ballc_dot3_fma(const double *v) nogil
     enum:
         BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
-        BALLC_DRIVE_FALLBACK, BALLC_DRIVE_NO_MEMORY
+        BALLC_DRIVE_FALLBACK, BALLC_DRIVE_NO_MEMORY, BALLC_DRIVE_TERMINATED,
+        BALLC_DRIVE_USER_ERROR
     ctypedef struct ballc_drive_config:
         const double *params
         double rtol, atol
@@ -35,6 +36,35 @@ cdef extern from "_driver.h":
         int term_index[2][2][2]
         double term_coef[2][2][2]
         double slip_map[2][2][19]
+        const double *t_eval
+        long n_eval
+        int dense_output
+        int exact_flight
+        double gravity
+        int n_user
+        const double *user_coef
+        const double *user_offset
+        const double *user_scale
+        const int *user_linear
+        const int *user_index
+        const int *user_count
+        const int *user_direction
+        int user_flight
+        int (*user_fun)(void *, int, double, const double *, double *) noexcept nogil
+        void *user_ctx
+        int compliant_modes
+        int compliant_bits[2]
+        int elastic_bits[2]
+        int sliding_bits[2]
+        int compliant_any
+        double arm_depth[2]
+        double ulp8[2]
+        double restick_factor
+        int damping_positive
+        double contact_time_base
+        int observer_massive, rolls_allowed, orbit_applies
+        double rest_threshold, rho_eq, z_eq, rest_weight, observer_weight
+        double rolls_dv, rolls_level, half_mass
     ctypedef struct ballc_contact_rec:
         int plane, ended, passed_through, rate_is_kernel_value
         double t_start, t_end
@@ -51,6 +81,12 @@ cdef extern from "_driver.h":
         long contact
         double t
         int phase
+    ctypedef struct ballc_piece_rec:
+        double t0, t1
+        long step0, n_steps, coef0
+        int terms
+        int flight
+        double y0[19]
     ctypedef struct ballc_drive_output:
         long n
         double *t
@@ -64,23 +100,64 @@ cdef extern from "_driver.h":
         long n_phases
         ballc_phase_rec *phases
         int open[2]
+        long n_user_hits
+        int *user_hit_event
+        double *user_hit_t
+        double *user_hit_y
+        long n_switches
+        double *switch_t
+        int *switch_to
+        long n_pieces
+        ballc_piece_rec *pieces
+        long n_steps, n_coef
+        double *dense_t
+        double *dense_c
+        int *dense_kind
         int stop_code, status, stop_plane
         double t_run, fail_end
         int in_contact[2]
         long transitions[2]
         long stalled
+        int unsettled_compliant
         long nfev, njev, nlu
         double stiff_at
         char message[240]
         long segments
+        int end_kind, end_plane
+        double end_t
+        double end_y[19]
         int profiled
         double integrator_ns, drive_ns
     int ballc_drive(const ballc_drive_config *, const double *, ballc_drive_output *) nogil
     void ballc_drive_free(ballc_drive_output *) nogil
 
 
-DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH = (
-    BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH)
+DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH, DRIVE_TERMINATED = (
+    BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
+    BALLC_DRIVE_TERMINATED)
+
+
+cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
+                           double *g) noexcept nogil:
+    """The user's callable event k at (t, y), as the radau5 bridge's _user_event calls
+    it: ctx is [the events (simulate's CheckedEvent), the exceptions kept]; an exception
+    is kept for drive to raise and the event reads as NaN meanwhile."""
+    cdef double[::1] yv
+    with gil:
+        events, errors = (<list>ctx)[0], (<list>ctx)[1]
+        if errors:
+            g[0] = NAN
+            return -1
+        try:
+            state = np.empty(BALLC_N_STATES)
+            yv = state
+            memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+            g[0] = float(events[k](t, state))
+            return 0
+        except BaseException as error:
+            errors.append(error)
+            g[0] = NAN
+            return -1
 
 
 def _py_hypot(values):
@@ -136,6 +213,15 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     cdef ballc_contact_rec rec
     cdef Py_ssize_t i
     cdef const double[:, :, ::1] smap = k["slip_map"]
+    cdef const double[::1] t_eval = k["t_eval"]   # None: no t_eval
+    cdef const double[:, ::1] ucoef = k["user_coef"]
+    cdef const double[::1] uoffset = k["user_offset"], uscale = k["user_scale"]
+    cdef const int[::1] ulinear = k["user_linear"], uindex = k["user_index"]
+    cdef const int[::1] ucount = k["user_count"], udirection = k["user_direction"]
+    cdef list user_ctx = [k["user_events"], []]
+    cdef ballc_piece_rec piece
+    cdef double[:, ::1] dtv, dcv
+    cdef int[::1] dkv
     if params.shape[0] != BALLC_N_PARAMETERS or y0.shape[0] != BALLC_N_STATES:
         raise ValueError("params or y0 of the wrong length")
     c.params = &params[0]
@@ -157,6 +243,50 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.rest_period = k["rest_period"]
     c.resting_plane = k["resting_plane"]
     c.checks_rest = k["checks_rest"]
+    c.t_eval = NULL
+    c.n_eval = 0
+    if t_eval is not None:
+        c.n_eval = t_eval.shape[0]
+        c.t_eval = &t_eval[0] if c.n_eval else &y0[0]   # non-NULL: t_eval given
+    c.dense_output = k["dense_output"]
+    c.exact_flight = k["exact_flight"]
+    c.gravity = k["gravity"]
+    c.n_user = ucount.shape[0]
+    c.user_flight = k["user_flight"]
+    c.user_fun = _drive_user_event
+    c.user_ctx = <void *>user_ctx
+    c.user_coef = c.user_offset = c.user_scale = NULL
+    c.user_linear = c.user_index = c.user_count = c.user_direction = NULL
+    if c.n_user:
+        c.user_coef = &ucoef[0, 0]
+        c.user_offset = &uoffset[0]
+        c.user_scale = &uscale[0]
+        c.user_linear = &ulinear[0]
+        c.user_index = &uindex[0]
+        c.user_count = &ucount[0]
+        c.user_direction = &udirection[0]
+    c.compliant_modes = k["compliant_modes"]
+    c.compliant_any = k["compliant_any"]
+    c.restick_factor = k["restick_factor"]
+    c.damping_positive = k["damping_positive"]
+    c.contact_time_base = k["contact_time_base"]
+    for p in range(2):
+        c.compliant_bits[p] = k["compliant_bits"][p]
+        c.elastic_bits[p] = k["elastic_bits"][p]
+        c.sliding_bits[p] = k["sliding_bits"][p]
+        c.arm_depth[p] = k["arm_depth"][p]
+        c.ulp8[p] = k["ulp8"][p]
+    c.observer_massive = k["observer_massive"]
+    c.rolls_allowed = k["rolls_allowed"]
+    c.orbit_applies = k["orbit_applies"]
+    c.rest_threshold = k["rest_threshold"]
+    c.rho_eq = k["rho_eq"]
+    c.z_eq = k["z_eq"]
+    c.rest_weight = k["rest_weight"]
+    c.observer_weight = k["observer_weight"]
+    c.rolls_dv = k["rolls_dv"]
+    c.rolls_level = k["rolls_level"]
+    c.half_mass = k["half_mass"]
     for p in range(2):
         c.contact_bits[p] = k["contact_bits"][p]
         c.slip_bits[p] = k["slip_bits"][p]
@@ -181,6 +311,15 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
             raise MemoryError("ballc_drive: out of memory")
         if rc == BALLC_DRIVE_FALLBACK:
             return None
+        if rc == BALLC_DRIVE_USER_ERROR:   # as solve_system: the user's exception
+            raise user_ctx[1][0]
+        user_event = np.array([o.user_hit_event[i] for i in range(o.n_user_hits)],
+                              dtype=np.intc)
+        user_t = np.array([o.user_hit_t[i] for i in range(o.n_user_hits)], dtype=float)
+        user_y = np.empty((o.n_user_hits, BALLC_N_STATES))
+        if o.n_user_hits:
+            rv = user_y
+            memcpy(&rv[0, 0], o.user_hit_y, o.n_user_hits * BALLC_N_STATES * sizeof(double))
         n = o.n
         t = np.empty(n)
         rows = np.empty((n, BALLC_N_STATES))
@@ -212,14 +351,40 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                 lost=(rec.lost[0], rec.lost[1])))
         phases = [(o.phases[i].contact, o.phases[i].t, o.phases[i].phase)
                   for i in range(o.n_phases)]
+        pieces = []   # dense output: (t0, t1, dense_t, dense_c, terms, dense_kind), or
+        for i in range(o.n_pieces):   # (t0, t1, y0) of an exact flight
+            piece = o.pieces[i]
+            if piece.flight:
+                pieces.append((piece.t0, piece.t1,
+                               np.array([piece.y0[j] for j in range(BALLC_N_STATES)])))
+                continue
+            dense_t = np.empty((piece.n_steps, 2))
+            dense_c = np.empty((piece.n_steps, (1 + piece.terms) * BALLC_N_STATES))
+            dense_kind = np.empty(piece.n_steps, dtype=np.intc)
+            if piece.n_steps:
+                dtv = dense_t
+                dcv = dense_c
+                dkv = dense_kind
+                memcpy(&dtv[0, 0], o.dense_t + 2 * piece.step0,
+                       piece.n_steps * 2 * sizeof(double))
+                memcpy(&dcv[0, 0], o.dense_c + piece.coef0,
+                       piece.n_steps * (1 + piece.terms) * BALLC_N_STATES * sizeof(double))
+                memcpy(&dkv[0], o.dense_kind + piece.step0, piece.n_steps * sizeof(int))
+            pieces.append((piece.t0, piece.t1, dense_t, dense_c, piece.terms, dense_kind))
         return dict(t=t, rows=rows, counts=counts, block_flags=block_flags, latches=latches,
-                    contacts=contacts, phases=phases, open=(o.open[0], o.open[1]),
+                    contacts=contacts, phases=phases, pieces=pieces,
+                    user_hits=(user_event, user_t, user_y),
+                    switches=[(o.switch_t[i], _METHOD_NAMES[o.switch_to[i]])
+                              for i in range(o.n_switches)], open=(o.open[0], o.open[1]),
                     stop_code=o.stop_code, status=o.status, stop_plane=o.stop_plane,
                     t_run=o.t_run, fail_end=o.fail_end, message=o.message.decode(),
                     in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),
                     transitions=(o.transitions[0], o.transitions[1]), stalled=o.stalled,
+                    unsettled_compliant=bool(o.unsettled_compliant),
                     nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
-                    segments=o.segments, profiled=bool(o.profiled),
+                    segments=o.segments, end_kind=o.end_kind, end_plane=o.end_plane,
+                    end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(BALLC_N_STATES)]),
+                    profiled=bool(o.profiled),
                     integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
     finally:
         ballc_drive_free(&o)

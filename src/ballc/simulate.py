@@ -20,14 +20,15 @@ import numpy as np
 from . import (_core, _radau5, automaton, compliantmodes, events as ev, layout, modes,
                orbit, outcome, resting, stickslip)
 from ._format import plain
-from .dense import PiecewiseSolution
+from .dense import CompiledInterpolant, PiecewiseSolution
+from .events import LinearEvent
 from .flight import FreeFlight, scene_allows as flight_scene_allows
 from .integrate import Segment, failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
 from .result import Contact, Result
 from .samples import Samples
-from .user_events import UserEvents
+from .user_events import CheckedEvent, UserEvents
 from .scene import Scene, SceneError
 
 PLANES = layout.PLANES
@@ -412,15 +413,7 @@ class _Run:
             return None
         self.y, kind = found
         self.enter_motion(plane, kind)
-        v = float(np.hypot(*self.y[layout.VELOCITY][:2]))
-        what = "rolls uniformly" if kind == "rolling" else (
-            "slides uniformly (no force opposes its slip)")
-        self.message = (f"{SUCCESS} The ball {what} on the {plane} from t = "
-                        f"{self.t:.9g} s at {v:.6g} m/s (ballc.resting: static Hertz "
-                        f"equilibrium, penetration "
-                        f"{resting.equilibrium_penetration(self.scene):.6g} m); from there "
-                        f"to t_end the state is that {kind.replace('free_', '')}, in "
-                        "closed form.")
+        self.message = _motion_message(self.scene, plane, self.t, self.y, kind)
         return self.y
 
     def enter_motion(self, plane, kind):
@@ -508,10 +501,7 @@ class _Run:
         self.y = resting.rest_state(self.scene, self.y, plane)
         self.t_rest = contact.t_rest = self.t
         contact.transitions.append((self.t, "rest"))
-        self.message = (f"{SUCCESS} The ball came to rest on the {plane} at t = {self.t:.9g} s "
-                        f"(ballc.resting: static Hertz equilibrium, penetration "
-                        f"{resting.equilibrium_penetration(self.scene):.6g} m); from there "
-                        "to t_end the state is that rest state.")
+        self.message = _rest_message(self.scene, plane, self.t)
         return True
 
     # ---- one event ----
@@ -543,6 +533,28 @@ class _Run:
         self.status = 1
         self.message = (f"ball passed through the {plane} at t = {self.t:.6g} s "
                         "(penetration reached the ball's radius)")
+
+
+def _rest_message(scene, plane, t):
+    """The message of a run that came to rest on ``plane`` at ``t`` (either driver)."""
+    return (f"{SUCCESS} The ball came to rest on the {plane} at t = {t:.9g} s "
+            f"(ballc.resting: static Hertz equilibrium, penetration "
+            f"{resting.equilibrium_penetration(scene):.6g} m); from there "
+            "to t_end the state is that rest state.")
+
+
+def _motion_message(scene, plane, t, y, kind):
+    """The message of a run that goes on uniformly (``kind`` "rolling" or
+    "free_sliding") on ``plane`` from ``t`` in state ``y`` (either driver)."""
+    v = float(np.hypot(*y[layout.VELOCITY][:2]))
+    what = "rolls uniformly" if kind == "rolling" else (
+        "slides uniformly (no force opposes its slip)")
+    return (f"{SUCCESS} The ball {what} on the {plane} from t = "
+            f"{t:.9g} s at {v:.6g} m/s (ballc.resting: static Hertz "
+            f"equilibrium, penetration "
+            f"{resting.equilibrium_penetration(scene):.6g} m); from there "
+            f"to t_end the state is that {kind.replace('free_', '')}, in "
+            "closed form.")
 
 
 def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float = 1e-10,
@@ -844,10 +856,13 @@ def _finish(result, options, stiff_at):
 # environment variable BALLC_PYTHON_DRIVER is not set (to anything non-empty) and the
 # integrator seam is not wrapped (_seams_untouched).  The results are bit-identical to
 # the Python loop above (benchmarks/driver_identical.py, tests/test_c_driver.py).
-# Everything else, and a C run that meets what it does not port (a rest check coming
-# due, a kernel failure where Python raises), runs the Python loop from the start.  ``result._driver`` says which ran ("c" or "python").
+# Everything else, and a C run that meets what it does not port (a rest check on a
+# Routh sphere where an orbit's trial may start, a kernel failure where Python raises),
+# runs the Python loop from the start.  A rest check that finds rest or uniform motion
+# ends the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
 
-_C_METHODS = ("radau5", "dop853")
+_C_METHODS = ("radau5", "dop853", "auto")
+_END_REST, _END_ROLLING, _END_SLIDING = 1, 2, 3   # _driver.h: BALLC_END_*
 _SEAMS = (integrate_segment, _radau5.solve_system)
 
 
@@ -882,22 +897,28 @@ def _c_numerics_agree():
 
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
-    in the C loop's subset: method radau5 or dop853, one float atol, no t_eval, user
-    events, dense output or progress bar, no compliant law, no exact flight, slip rows of
-    at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
+    in the C loop's subset: method radau5, dop853 or auto, one float atol, no progress
+    bar, user events as _c_user_events takes them, t_eval (if given) strictly
+    increasing, slip rows of at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
     process's hypot and dot as the C loop reproduces them (_c_numerics_agree)."""
-    if (options.method not in _C_METHODS or options.t_eval is not None or options.events
-            or options.dense_output or type(options.atol) is not float):
+    if options.method not in _C_METHODS or type(options.atol) is not float:
         return None
+    users = _c_user_events(options.events)
+    if users is None:
+        return None
+    t_eval = options.t_eval
+    if t_eval is not None:   # the C loop takes each segment's points as a range
+        t_eval = np.ascontiguousarray(t_eval, dtype=float)
+        if t_eval.ndim != 1 or not np.all(np.diff(t_eval) > 0):
+            return None
     if progress or (progress is None and sys.stderr.isatty()):
-        return None
-    if scene.tangential_model == "compliant" or compliantmodes.uses_modes(scene):
         return None
     if not _c_numerics_agree():
         return None
     params = scene.parameter_vector()
-    if options.exact_flight and flight_scene_allows(params):
-        return None
+    flight_allowed = bool(options.exact_flight and flight_scene_allows(params))
+    if flight_allowed and users["user_flight"] and users["several_states"]:
+        return None   # exact flight would take their value with a BLAS dot (flight.py)
     terms = [stickslip.slip_terms(params, plane) for plane in PLANES]
     if any(len(row) > 2 for rows in terms for row in rows):
         return None
@@ -908,7 +929,37 @@ def _c_config(scene, options, progress, rest):
     period = resting.REST_PERIODS * resting.oscillation_period(scene) \
         if resting_plane is not None else math.inf
     flags = _core.FLAGS
+    rest_consts = dict(rest_threshold=math.inf, rho_eq=1.0, z_eq=0.0, rest_weight=0.0,
+                       observer_weight=0.0, rolls_dv=0.0, rolls_level=0.0, half_mass=0.0)
+    if resting_plane is not None:   # the rest checks' constants (resting.at_rest, rolls)
+        rho_eq = resting.equilibrium_penetration(scene)
+        rest_consts = dict(
+            rest_threshold=resting.energy_threshold(scene, options.rtol, options.atol),
+            rho_eq=rho_eq, z_eq=scene.radius - rho_eq,
+            rest_weight=resting.total_mass(scene) * scene.gravity,
+            observer_weight=scene.observer_mass * scene.gravity,
+            rolls_dv=resting.REST_FACTOR * (float(np.max(options.atol)) + options.rtol
+                                            * math.sqrt(scene.gravity * scene.radius)),
+            rolls_level=float(1e3 * np.finfo(float).eps * scene.gravity),
+            half_mass=0.5 * resting.total_mass(scene))
+    modes_on = compliantmodes.uses_modes(scene)
+    arm_depth = segment_events.arm_depth or {plane: 0.0 for plane in PLANES}
     return dict(
+        compliant_modes=int(modes_on),
+        compliant_bits=[flags[f"{plane}_compliant"] for plane in PLANES],
+        elastic_bits=[flags[f"{plane}_compliant_elastic"] for plane in PLANES],
+        sliding_bits=[flags[f"{plane}_compliant_sliding"] for plane in PLANES],
+        compliant_any=flags["floor_compliant"] | flags["ceiling_compliant"],
+        arm_depth=[float(arm_depth[plane]) for plane in PLANES],
+        ulp8=[8 * math.ulp(compliantmodes.plane_position(scene, plane)) for plane in PLANES],
+        restick_factor=max(1.0, scene.friction_coefficient
+                           / max(scene.tangential_stiffness_ratio, 1e-300)),
+        damping_positive=int(params[compliantmodes._TANGENTIAL_DAMPING] > 0),
+        contact_time_base=3.2145 * ((scene.mass + scene.observer_mass)
+                                    / scene.hertz_stiffness) ** 0.4,
+        observer_massive=int(scene.observer_mass > 0),
+        rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbit.applies(scene)),
+        **rest_consts,
         params=params, rtol=options.rtol, atol=options.atol, t_end=options.t_end,
         max_step=float(options.max_step), first_step=options.first_step,
         max_nfev=options.max_nfev, method=options.method, observer_bits=observer,
@@ -922,12 +973,64 @@ def _c_config(scene, options, progress, rest):
         hertz_k=scene.hertz_stiffness, total_mass=scene.mass + scene.observer_mass,
         rest_period=period,
         resting_plane=-1 if resting_plane is None else PLANES.index(resting_plane),
-        checks_rest=int(bool(rest)),
+        checks_rest=int(bool(rest) and t_eval is None and not options.events),
+        t_eval=t_eval, dense_output=int(bool(options.dense_output)),
+        exact_flight=int(flight_allowed), **users,
+        gravity=float(params[_core.PARAMETER_NAMES.index("gravity")]),
         rho_scale=[entry[3] for entry in planes], rho_offset=[entry[4] for entry in planes],
         through_offset=[entry[7].offset for entry in planes],
         threshold_base=[entry[5] for entry in planes],
         slip_terms=terms,
         slip_map=np.ascontiguousarray([stickslip.slip_map(params, plane) for plane in PLANES]))
+
+
+def _c_user_events(events):
+    """The user's events as the C loop takes them (UserEvents.for_segment, the
+    bridge's _event_arrays): a dict of arrays, or None when one is outside the C loop's
+    subset (a LinearEvent subclass, or one with ``rearm``, or something the bridge
+    would refuse; more than 52)."""
+    events = list(events or ())
+    n = len(events)
+    if n > 52:
+        return None
+    users = UserEvents(events)
+    coef, offset = np.zeros((n, _core.N_STATES)), np.zeros(n)
+    scale, index = np.zeros(n), np.full(n, -1, dtype=np.intc)
+    linear, direction = np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc)
+    callables, several, flies = [], False, True
+    for k, event in enumerate(events):
+        try:
+            sign = float(getattr(event, "direction", 0))
+        except (TypeError, ValueError):
+            return None
+        if sign != sign:
+            return None
+        direction[k] = (sign > 0) - (sign < 0)
+        if isinstance(event, LinearEvent):
+            if type(event) is not LinearEvent or getattr(event, "rearm", None) is not None:
+                return None
+            row = np.asarray(event.coefficients, dtype=float)
+            if row.shape != (_core.N_STATES,) or not np.all(np.isfinite(row)) \
+                    or not math.isfinite(float(event.offset)):
+                return None
+            linear[k], coef[k], offset[k] = 1, row, float(event.offset)
+            if event._index is not None:
+                index[k], scale[k] = event._index, event._scale
+            # flight.applies: every event linear without the quaternion
+            quaternion_free = (event._index is not None and event._index >= 4
+                               or not np.any(event.coefficients[_QUATERNION]))
+            flies = flies and quaternion_free
+            several = several or (quaternion_free and event._index is None)
+            callables.append(None)
+        elif callable(event):
+            flies = False
+            callables.append(CheckedEvent(event, k, 0, getattr(event, "direction", 0)))
+        else:
+            return None
+    return dict(user_coef=coef, user_offset=offset, user_scale=scale, user_index=index,
+                user_linear=linear, user_direction=direction,
+                user_count=np.array(users.counts, dtype=np.intc), user_events=callables,
+                user_flight=int(flies), several_states=several)
 
 
 def _simulate_c(scene, options, y, config):
@@ -937,9 +1040,31 @@ def _simulate_c(scene, options, y, config):
         return None
     counts = out["counts"]
     t = out["t"]
-    states = out["rows"].T
-    flags = np.repeat(out["block_flags"], counts)
-    latch = np.repeat(out["latches"], counts, axis=0).T
+    rows = out["rows"]
+    block_flags, latches = out["block_flags"], out["latches"]
+    end_kind = out["end_kind"]
+    gravity = config["gravity"]
+    pieces = [(piece[0], piece[1], FreeFlight(piece[0], piece[2], gravity, t_max=piece[1])
+               if len(piece) == 3 else CompiledInterpolant(*piece[2:]))
+              for piece in out["pieces"]]
+    if end_kind:   # a rest check found an end state: to t_end in closed form
+        when, y_end = out["end_t"], out["end_y"]
+        if end_kind == _END_REST:
+            times = np.array([options.t_end])
+            closed = resting.Constant(y_end)
+        else:
+            closed = FreeFlight(when, y_end, 0.0, t_max=options.t_end)
+            times = resting.rolling_samples(when, options.t_end, closed.rate)
+        if options.dense_output:
+            pieces.append((when, options.t_end, closed))
+        t = np.concatenate([t, times])
+        rows = np.concatenate([rows, closed(times).T])
+        counts = np.append(counts, times.size)
+        block_flags = np.append(block_flags, block_flags[-1])
+        latches = np.concatenate([latches, latches[-1:]])
+    states = rows.T
+    flags = np.repeat(block_flags, counts)
+    latch = np.repeat(latches, counts, axis=0).T
     contacts = []
     for rec in out["contacts"]:
         rate = np.float64(rec["rate"]) if rec["rate_is_kernel_value"] else rec["rate"]
@@ -961,6 +1086,23 @@ def _simulate_c(scene, options, y, config):
         contacts.append(contact)
     for k, when, phase in out["phases"]:
         contacts[k].transitions.append((when, "stick" if phase else "slip"))
+    message = SUCCESS
+    if end_kind:   # as _Run.enter_rest / enter_motion
+        plane = PLANES[out["end_plane"]]
+        contact = contacts[out["open"][out["end_plane"]]]
+        when = out["end_t"]
+        if end_kind == _END_REST:
+            contact.t_rest = when
+            contact.transitions.append((when, "rest"))
+            message = _rest_message(scene, plane, when)
+        else:
+            kind = "rolling" if end_kind == _END_ROLLING else "free_sliding"
+            if kind == "rolling":
+                contact.t_rolling = when
+            else:
+                contact.t_sliding = when
+            contact.transitions.append((when, kind))
+            message = _motion_message(scene, plane, when, out["end_y"], kind)
     if counts[-1]:   # still in contact at the end
         last = states[:, -1]
         for k in out["open"]:
@@ -968,7 +1110,8 @@ def _simulate_c(scene, options, y, config):
                 plane = contacts[k].plane
                 record_depth(contacts[k], ev.penetration(plane, scene)(0, last), last)
     code, status = out["stop_code"], out["status"]
-    message = SUCCESS
+    user_event, user_t, user_y = out["user_hits"]
+    n_user = len(config["user_count"])
     if code == _core.DRIVE_FAILED:
         reason = out["message"]
         if "max_nfev" in reason:
@@ -979,16 +1122,23 @@ def _simulate_c(scene, options, y, config):
                    + failure_hint(scene, in_contact, options.atol))
     elif code == _core.DRIVE_UNSETTLED:
         plane = PLANES[out["stop_plane"]]
-        message = (f"stick-slip transitions on the {plane} did not settle: "
+        what = ("the compliant law's elastic/sliding" if out["unsettled_compliant"]
+                else "stick-slip")
+        message = (f"{what} transitions on the {plane} did not settle: "
                    f"{out['transitions'][out['stop_plane']]} mode changes in one contact, "
                    f"{out['stalled']} of them at t = {out['t_run']:.17g} s")
+    elif code == _core.DRIVE_TERMINATED:
+        message = "A termination event occurred."
     elif code == _core.DRIVE_THROUGH:
         message = (f"ball passed through the {PLANES[out['stop_plane']]} at t = "
                    f"{out['t_run']:.6g} s (penetration reached the ball's radius)")
     result = Result(t=t, y=states, scene=scene, status=status, message=message,
                     nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], contacts=contacts,
-                    flags=flags, latch=latch, t_events=[], y_events=[], sol=None,
-                    method_switches=None)
+                    flags=flags, latch=latch,
+                    t_events=[user_t[user_event == k] for k in range(n_user)],
+                    y_events=[user_y[user_event == k] for k in range(n_user)],
+                    sol=PiecewiseSolution(pieces) if options.dense_output else None,
+                    method_switches=out["switches"] if options.method == "auto" else None)
     result._driver = "c"
     result._driver_counts = {key: out[key] for key in (
         "segments", "profiled", "integrator_ns", "drive_ns")}
