@@ -114,11 +114,17 @@ STEPS_PER_CONTACT = 16
 IMPACT_SPAN = 4
 
 
+def contact_time_base(scene) -> float:
+    """3.2145 (m / k0)^(2/5) (s (m/s)^(1/5)): :func:`contact_time` at a unit rate (the C
+    loop multiplies it by rate^(-1/5) in the same order)."""
+    m = scene.mass + scene.observer_mass
+    return 3.2145 * (m / scene.hertz_stiffness) ** 0.4
+
+
 def contact_time(scene, rate: float) -> float:
     """The elastic Hertz contact time (s) at impact rate ``rate`` (m/s):
     t_c = 3.2145 (m / k0)^(2/5) v^(-1/5) (ballc.impact.hertz_contact_time)."""
-    m = scene.mass + scene.observer_mass
-    return 3.2145 * (m / scene.hertz_stiffness) ** 0.4 * rate ** -0.2
+    return contact_time_base(scene) * rate ** -0.2
 
 
 def step_bound(scene, rate: float, t_start: float) -> tuple[float, float]:

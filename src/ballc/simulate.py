@@ -895,6 +895,17 @@ def _c_numerics_agree():
     return _NUMERICS_AGREE[0]
 
 
+#: The C loop's flag bits per plane (floor, ceiling), from the generated flags.
+_FLAG_BITS = dict(
+    compliant_bits=[_core.FLAGS[f"{plane}_compliant"] for plane in PLANES],
+    elastic_bits=[_core.FLAGS[f"{plane}_compliant_elastic"] for plane in PLANES],
+    sliding_bits=[_core.FLAGS[f"{plane}_compliant_sliding"] for plane in PLANES],
+    compliant_any=_core.FLAGS["floor_compliant"] | _core.FLAGS["ceiling_compliant"],
+    slip_bits=[_core.FLAGS[f"{plane}_slip"] for plane in PLANES],
+    slip_fixed_bits=[_core.FLAGS[f"{plane}_slip_fixed"] for plane in PLANES],
+    stick_bits=[_core.FLAGS[f"{plane}_stick"] for plane in PLANES])
+
+
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
     in the C loop's subset: method radau5, dop853 or auto, one float atol, no progress
@@ -928,7 +939,6 @@ def _c_config(scene, options, progress, rest):
     resting_plane = resting.resting_plane(scene)
     period = resting.REST_PERIODS * resting.oscillation_period(scene) \
         if resting_plane is not None else math.inf
-    flags = _core.FLAGS
     rest_consts = dict(rest_threshold=math.inf, rho_eq=1.0, z_eq=0.0, rest_weight=0.0,
                        observer_weight=0.0, rolls_dv=0.0, rolls_level=0.0, half_mass=0.0)
     if resting_plane is not None:   # the rest checks' constants (resting.at_rest, rolls)
@@ -945,18 +955,13 @@ def _c_config(scene, options, progress, rest):
     modes_on = compliantmodes.uses_modes(scene)
     arm_depth = segment_events.arm_depth or {plane: 0.0 for plane in PLANES}
     return dict(
-        compliant_modes=int(modes_on),
-        compliant_bits=[flags[f"{plane}_compliant"] for plane in PLANES],
-        elastic_bits=[flags[f"{plane}_compliant_elastic"] for plane in PLANES],
-        sliding_bits=[flags[f"{plane}_compliant_sliding"] for plane in PLANES],
-        compliant_any=flags["floor_compliant"] | flags["ceiling_compliant"],
+        compliant_modes=int(modes_on), **_FLAG_BITS,
         arm_depth=[float(arm_depth[plane]) for plane in PLANES],
         ulp8=[8 * math.ulp(compliantmodes.plane_position(scene, plane)) for plane in PLANES],
         restick_factor=max(1.0, scene.friction_coefficient
                            / max(scene.tangential_stiffness_ratio, 1e-300)),
         damping_positive=int(params[compliantmodes._TANGENTIAL_DAMPING] > 0),
-        contact_time_base=3.2145 * ((scene.mass + scene.observer_mass)
-                                    / scene.hertz_stiffness) ** 0.4,
+        contact_time_base=compliantmodes.contact_time_base(scene),
         observer_massive=int(scene.observer_mass > 0),
         rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbit.applies(scene)),
         **rest_consts,
@@ -965,9 +970,6 @@ def _c_config(scene, options, progress, rest):
         max_nfev=options.max_nfev, method=options.method, observer_bits=observer,
         contact_bits=[modes.flags(scene, {p: p == plane for p in PLANES}) ^ observer
                       for plane in PLANES],
-        slip_bits=[flags[f"{plane}_slip"] for plane in PLANES],
-        slip_fixed_bits=[flags[f"{plane}_slip_fixed"] for plane in PLANES],
-        stick_bits=[flags[f"{plane}_stick"] for plane in PLANES],
         exact=int(stickslip.uses_exact_coulomb(scene)), radius=float(scene.radius),
         weight=(scene.mass + scene.observer_mass) * abs(scene.gravity),
         hertz_k=scene.hertz_stiffness, total_mass=scene.mass + scene.observer_mass,
@@ -991,8 +993,20 @@ def _c_user_events(events):
     would refuse; more than 52)."""
     events = list(events or ())
     n = len(events)
+    if n == 0:   # the common case: the same (read-only) arrays every run
+        if not _NO_USER_EVENTS:
+            _NO_USER_EVENTS.update(_c_user_events_of([]))
+        return _NO_USER_EVENTS
     if n > 52:
         return None
+    return _c_user_events_of(events)
+
+
+_NO_USER_EVENTS: dict = {}
+
+
+def _c_user_events_of(events):
+    n = len(events)
     users = UserEvents(events)
     coef, offset = np.zeros((n, _core.N_STATES)), np.zeros(n)
     scale, index = np.zeros(n), np.full(n, -1, dtype=np.intc)
