@@ -10,7 +10,7 @@ import difflib
 import functools
 import json
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -247,7 +247,10 @@ class Scene:
 
     def to_dict(self) -> dict:
         """Every field by name (SI units), as ``from_dict`` and the TOML files take them."""
-        values = asdict(self)
+        # every field is a number, a string, None or a tuple of floats (__post_init__):
+        # immutable, so a shallow copy is asdict's (whose deep copy cost a sweep of the
+        # 100 x 100 map ~1 s in its parent process)
+        values = {field.name: getattr(self, field.name) for field in fields(self)}
         for name in getattr(self, "_derived", ()):
             values[name] = None     # computed from another field: not an input
         return values
