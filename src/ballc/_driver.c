@@ -595,18 +595,24 @@ static int unsettled(const run_t *r, int p, long stalled)
     return r->transitions[p] >= MAX_TRANSITIONS || stalled >= MAX_STALLED;
 }
 
-/* _Run.coulomb_event */
-static int coulomb_event(run_t *r, int kind, int p)
+/* _Run.settles: count a mode change of plane p now; 0 (and the run stopped, status -1)
+ * when its transitions have reached a limit, else 1. */
+static int settles(run_t *r, int p)
 {
     r->stalled = stalled_at(r, r->t);
     r->last_transition = r->t;
     r->has_last_transition = 1;
-    if (unsettled(r, p, r->stalled)) {
-        r->status = -1;
-        r->stop_code = BALLC_DRIVE_UNSETTLED;
-        r->stop_plane = p;
-        return 0;
-    }
+    if (!unsettled(r, p, r->stalled)) return 1;
+    r->status = -1;
+    r->stop_code = BALLC_DRIVE_UNSETTLED;
+    r->stop_plane = p;
+    return 0;
+}
+
+/* _Run.coulomb_event */
+static int coulomb_event(run_t *r, int kind, int p)
+{
+    if (!settles(r, p)) return 0;
     double u[2], speed, error, clear, dir[2];
     slip(r, p, r->y, u, &speed, &error, &clear);
     const double *direction = NULL;
@@ -655,13 +661,7 @@ static int coulomb_event(run_t *r, int kind, int p)
 /* _Run.compliant_event */
 static int compliant_event(run_t *r, int kind, int p)
 {
-    r->stalled = stalled_at(r, r->t);
-    r->last_transition = r->t;
-    r->has_last_transition = 1;
-    if (unsettled(r, p, r->stalled)) {
-        r->status = -1;
-        r->stop_code = BALLC_DRIVE_UNSETTLED;
-        r->stop_plane = p;
+    if (!settles(r, p)) {
         r->o->unsettled_compliant = 1;
         return 0;
     }
