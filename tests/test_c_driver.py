@@ -331,3 +331,22 @@ def test_a_wrapped_integrator_seam_gets_the_python_driver(monkeypatch):
     result = _run(monkeypatch, False, ballc.Scene(), 0.5, method="dop853", rtol=1e-3,
                   atol=1e-3)
     assert result._driver == "python" and calls
+
+
+def test_ctrl_c_stops_a_long_c_run():
+    """The C loop asks for pending signals before each segment, as the Python driver could
+    be interrupted between segments: a Ctrl-C (SIGINT, raised here 0.2 s into a run of
+    millions of elastic bounces that would take minutes) ends it with KeyboardInterrupt."""
+    import signal
+    import threading
+    scene = ballc.Scene(velocity=(0.0, 0.0, 0.0), observer_mass=0.0, c_tau=1.0,
+                        tangential_model="friction", friction_coefficient=0.0)
+    assert sys.modules["ballc.simulate"]._c_config(
+        scene, ballc.options.check_options(scene, 1e7), False, True) is not None
+    timer = threading.Timer(0.2, signal.raise_signal, (signal.SIGINT,))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            ballc.simulate(scene, 1e7, progress=False, max_nfev=10**12)
+    finally:
+        timer.cancel()

@@ -1394,6 +1394,10 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     int stiff_found = 0;
 
     while (!rc && r->t < c->t_end && r->status == 0) {
+        if (c->interrupted && c->interrupted(c->user_ctx)) {   /* raised by the bridge */
+            r->stop_code = BALLC_DRIVE_USER_ERROR;
+            break;
+        }
         int flags = run_flags(r, 1);
         r->seg_flags = flags;
         if (segment_events(r, flags)) { rc = -1; break; }

@@ -76,6 +76,9 @@ typedef struct {                       /* constants of one run, filled by the br
     int user_flight;                   /* every one lets exact flight apply */
     int (*user_fun)(void *ctx, int k, double t, const double *y, double *g);
     void *user_ctx;
+    /* asked before each segment (may be NULL): nonzero when the run is to stop now (the
+     * bridge's: a pending Ctrl-C, kept with user_ctx's exceptions for it to raise) */
+    int (*interrupted)(void *ctx);
     /* stage 3: the compliant law's exact modes (ballc.compliantmodes) */
     int compliant_modes;               /* compliantmodes.uses_modes */
     int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* mode_flags per plane */

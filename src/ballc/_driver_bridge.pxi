@@ -3,6 +3,7 @@
 # arrays.  Only converts: simulate.py decides what runs here (simulate._c_config) and
 # builds the Result; _driver.c computes.
 
+from cpython.exc cimport PyErr_CheckSignals
 from libc.stdlib cimport free
 
 cdef extern from "_driver.h":
@@ -52,6 +53,7 @@ cdef extern from "_driver.h":
         int user_flight
         int (*user_fun)(void *, int, double, const double *, double *) noexcept nogil
         void *user_ctx
+        int (*interrupted)(void *) noexcept nogil
         int compliant_modes
         int compliant_bits[2]
         int elastic_bits[2]
@@ -135,6 +137,23 @@ cdef extern from "_driver.h":
 DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH, DRIVE_TERMINATED = (
     BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
     BALLC_DRIVE_TERMINATED)
+
+
+cdef int _check_signals() except -1:
+    return PyErr_CheckSignals()
+
+
+cdef int _drive_interrupted(void *ctx) noexcept nogil:
+    """Before each segment: a pending signal's exception (Ctrl-C: KeyboardInterrupt) is
+    kept with the user events' exceptions (ctx[1]) for drive to raise, and the run
+    stops (the Python driver could be interrupted between segments: so can this)."""
+    with gil:
+        try:
+            _check_signals()
+        except BaseException as error:
+            (<list>ctx)[1].append(error)
+            return 1
+    return 0
 
 
 cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
@@ -255,6 +274,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.user_flight = k["user_flight"]
     c.user_fun = _drive_user_event
     c.user_ctx = <void *>user_ctx
+    c.interrupted = _drive_interrupted
     c.user_coef = c.user_offset = c.user_scale = NULL
     c.user_linear = c.user_index = c.user_count = c.user_direction = NULL
     if c.n_user:
