@@ -82,9 +82,14 @@ def applies(system, events) -> bool:
     whose flight is polynomial (not the quaternion)."""
     if system.flags != 0 or not scene_allows(system.params):
         return False
-    return all(type(e) is LinearEvent and (e._index is not None and e._index >= _QUATERNION.stop
-                                           or not np.any(e.coefficients[_QUATERNION]))
-               for e in events)
+    return all(type(e) is LinearEvent and polynomial_in_flight(e) for e in events)
+
+
+def polynomial_in_flight(event) -> bool:
+    """Whether a LinearEvent leaves the quaternion out: on the exact flight it is then a
+    polynomial in t (its roots in closed form, :meth:`FreeFlight.event_polynomial`)."""
+    return (event._index is not None and event._index >= _QUATERNION.stop
+            or not np.any(event.coefficients[_QUATERNION]))
 
 
 class FreeFlight:

@@ -58,7 +58,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import _core, layout, resting
-from .orientation import quaternion_multiply
+from .orientation import quaternion_multiply, rotation_matrix
 
 _PARAMETER = {name: i for i, name in enumerate(_core.PARAMETER_NAMES)}
 _Q, _P, _W, _V = layout.QUATERNION, layout.POSITION, layout.ANGULAR_VELOCITY, layout.VELOCITY
@@ -177,7 +177,7 @@ def _fit(y0, y1, axis):
     from the centre, psi from the ball's remaining turn about a."""
     turned = []
     for y in (y0, y1):
-        R = _rotation(y[_Q])
+        R = rotation_matrix(y[_Q])
         a = R @ axis
         w = y[_W] / max(math.sqrt(float(y[_W].dot(y[_W]))), 1e-300)
         turned.append((complex(a[0], a[1]), complex(w[0], w[1])))
@@ -191,11 +191,6 @@ def _fit(y0, y1, axis):
     spin = quaternion_multiply(quaternion_multiply(y0[_Q] * conj, vertical * conj), y1[_Q])
     psi = 2.0 * math.atan2(float(spin[1:].dot(axis)), float(spin[0]))
     return Motion(phi, d, psi, axis, y1[_DISSIPATED] - y0[_DISSIPATED])
-
-
-def _rotation(q):
-    from .orientation import rotation_matrix
-    return rotation_matrix(q)
 
 
 class Trial:
@@ -270,16 +265,16 @@ def measure(interpolant, t0, t1, axis, guess, rtol, atol, energy_threshold, para
     samples = int(TILT_SAMPLES * (t1 - t0) / guess) + 2
     times = np.linspace(t0, t1, samples)
     a_z = tilt(interpolant(times), axis)
-    level = 0.5 * (float(a_z.max()) + float(a_z.min()))
-    if float(a_z.max()) - float(a_z.min()) < 1e-6:   # no wobble to measure
+    highest, lowest = float(a_z.max()), float(a_z.min())
+    if highest - lowest < 1e-6:   # no wobble to measure
         return None
+    level = 0.5 * (highest + lowest)
     ups = _crossings(interpolant, t0, t1, axis, level, samples)
     if len(ups) < 3:
         return None
     c0, c1, c2 = ups[:3]
     period = c1 - c0
     y0, y1, y2 = (np.asarray(interpolant(c)) for c in (c0, c1, c2))
-    scale = atol + rtol * np.abs(y1)
     if abs((c2 - c1) - period) * float(np.max(np.abs(y1[_V]))) > resting.REST_FACTOR * (
             float(np.max(atol)) + rtol):
         return None

@@ -99,11 +99,22 @@ def next_check(scene, t_start, t) -> float:
     return t + max(REST_PERIODS * oscillation_period(scene), CHECK_GROWTH * (t - t_start))
 
 
+def speed_tolerance(scene, rtol, atol) -> float:
+    """dv = REST_FACTOR (atol + rtol sqrt(g r)) (m/s): REST_FACTOR integration
+    tolerances of a speed."""
+    return REST_FACTOR * (float(np.max(atol)) + rtol * math.sqrt(scene.gravity * scene.radius))
+
+
+def steady_level(scene) -> float:
+    """The rounding level (1e3 eps g, m/s^2) below which a state's accelerations count as
+    zero (:func:`rolls`' steady state)."""
+    return 1e3 * np.finfo(float).eps * scene.gravity
+
+
 def energy_threshold(scene, rtol, atol) -> float:
     """The energy (J) of an oscillation of REST_FACTOR integration tolerances."""
-    largest_atol = float(np.max(atol))
-    dx = REST_FACTOR * (largest_atol + rtol * scene.radius)
-    dv = REST_FACTOR * (largest_atol + rtol * math.sqrt(scene.gravity * scene.radius))
+    dx = REST_FACTOR * (float(np.max(atol)) + rtol * scene.radius)
+    dv = speed_tolerance(scene, rtol, atol)
     return min(0.5 * linear_stiffness(scene) * dx * dx, 0.5 * total_mass(scene) * dv * dv)
 
 
@@ -203,8 +214,7 @@ def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, fl
         return None
     if not flight.scene_allows(params):
         return None
-    largest_atol = float(np.max(atol))
-    dv = REST_FACTOR * (largest_atol + rtol * math.sqrt(scene.gravity * scene.radius))
+    dv = speed_tolerance(scene, rtol, atol)
     e = _core.energies(np.ascontiguousarray(y[None, :]), params)[0]
     rho_eq = equilibrium_penetration(scene)
     x = (scene.radius - y[_Z] - rho_eq) / rho_eq
@@ -218,7 +228,7 @@ def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, fl
     roll = rolling_state(scene, y)
     rate = _core.rhs(np.ascontiguousarray(roll), np.ascontiguousarray(params, dtype=float),
                      np.ascontiguousarray(latch, dtype=float), int(flags))
-    level = 1e3 * np.finfo(float).eps * scene.gravity
+    level = steady_level(scene)
     if (np.max(np.abs(rate[_VELOCITY])) > level
             or scene.radius * np.max(np.abs(rate[_ANGULAR])) > level
             or np.max(np.abs(rate[_DEFLECTION["floor"]])) > level

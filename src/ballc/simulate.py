@@ -22,7 +22,7 @@ from . import (_core, _radau5, automaton, compliantmodes, events as ev, layout, 
 from ._format import plain
 from .dense import CompiledInterpolant, PiecewiseSolution
 from .events import LinearEvent
-from .flight import FreeFlight, scene_allows as flight_scene_allows
+from .flight import FreeFlight, polynomial_in_flight, scene_allows as flight_scene_allows
 from .integrate import Segment, failure_hint, integrate_segment
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
 from .progress import progress_bar
@@ -36,6 +36,10 @@ _STATE = layout.INDEX
 _QUATERNION, _DISSIPATED, _DEFLECTION = layout.QUATERNION, layout.DISSIPATED, layout.DEFLECTION
 _CENTRE_XY = layout.rows("x", 2)
 SUCCESS = "The solver successfully reached the end of the integration interval."
+TERMINATED = "A termination event occurred."
+#: What the transitions are called in the message of a run whose modes did not settle.
+COULOMB_TRANSITIONS = "stick-slip"
+COMPLIANT_TRANSITIONS = "the compliant law's elastic/sliding"
 #: Events after which the next segment starts with the last segment's next step size.
 CARRY_STEP = ("approach", "stop", "clear", "release", "arm", "yield", "restick", "capacity")
 
@@ -214,14 +218,13 @@ class _Run:
         if not self.unsettled(plane, self.stalled):
             return True
         self.status = -1
-        self.message = (f"{what} transitions on the {plane} did not settle: "
-                        f"{self.transitions[plane]} mode changes in one contact, "
-                        f"{self.stalled} of them at t = {self.t:.17g} s")
+        self.message = _unsettled_message(what, plane, self.transitions[plane], self.stalled,
+                                          self.t)
         return False
 
     def compliant_event(self, kind, plane):
         """The compliant law's next mode after its guard ``kind`` fired on ``plane``."""
-        if not self.settles(plane, "the compliant law's elastic/sliding"):
+        if not self.settles(plane, COMPLIANT_TRANSITIONS):
             return
         if kind == "capacity":   # a kink of the elastic mode: the segment ends, no change;
             first, second = compliantmodes.CAPACITY_ROWS   # the next watches the way back
@@ -277,7 +280,7 @@ class _Run:
 
     def coulomb_event(self, kind, plane):
         """The next exact-Coulomb mode after event ``kind`` on ``plane`` (see stickslip)."""
-        if not self.settles(plane, "stick-slip"):
+        if not self.settles(plane, COULOMB_TRANSITIONS):
             return
         u, speed, error, clear = self.slip(plane, self.y)
         direction = _unit(u, speed) if speed > 0 else None
@@ -382,10 +385,9 @@ class _Run:
         when the contact with ``plane`` has reached an end state -- rest, uniform
         rolling or sliding, the orbit of a wobble whose trial ends now -- else None."""
         if self.check_rest(plane):
-            return np.array([t_end]), resting.Constant(self.y)
+            return _closed_form("rest", self.t, self.y, t_end)
         if self.check_rolling(plane) is not None:
-            rolling = FreeFlight(self.t, self.y, 0.0, t_max=t_end)
-            return resting.rolling_samples(self.t, t_end, rolling.rate), rolling
+            return _closed_form("rolling", self.t, self.y, t_end)
         periodic = self.check_orbit(plane, t_end)
         if periodic is not None:
             return orbit.sample_times(self.t, t_end, periodic.period), periodic
@@ -419,12 +421,7 @@ class _Run:
     def enter_motion(self, plane, kind):
         """Record that ``plane``'s contact goes on in closed form as ``kind``
         ("rolling" or "free_sliding") from now."""
-        contact = self.open[plane]
-        if kind == "rolling":
-            contact.t_rolling = self.t
-        else:
-            contact.t_sliding = self.t
-        contact.transitions.append((self.t, kind))
+        _record_end(self.open[plane], kind, self.t)
 
     # ---- the periodic end state (ballc.orbit) ----
 
@@ -497,10 +494,9 @@ class _Run:
         return orbit.RelativePeriodicOrbit(self.t, t_end, c0, period, motion, interpolant)
 
     def enter_rest(self, plane):
-        contact = self.open[plane]
         self.y = resting.rest_state(self.scene, self.y, plane)
-        self.t_rest = contact.t_rest = self.t
-        contact.transitions.append((self.t, "rest"))
+        self.t_rest = self.t
+        _record_end(self.open[plane], "rest", self.t)
         self.message = _rest_message(self.scene, plane, self.t)
         return True
 
@@ -531,8 +527,7 @@ class _Run:
         self.in_contact[plane] = False
         self.passed.add(plane)
         self.status = 1
-        self.message = (f"ball passed through the {plane} at t = {self.t:.6g} s "
-                        "(penetration reached the ball's radius)")
+        self.message = _through_message(plane, self.t)
 
 
 def _rest_message(scene, plane, t):
@@ -555,6 +550,51 @@ def _motion_message(scene, plane, t, y, kind):
             f"{resting.equilibrium_penetration(scene):.6g} m); from there "
             f"to t_end the state is that {kind.replace('free_', '')}, in "
             "closed form.")
+
+
+def _unsettled_message(what, plane, transitions, stalled, t):
+    """The message of a run stopped because ``plane``'s ``what`` transitions did not
+    settle (either driver)."""
+    return (f"{what} transitions on the {plane} did not settle: {transitions} mode changes "
+            f"in one contact, {stalled} of them at t = {t:.17g} s")
+
+
+def _through_message(plane, t):
+    """The message of a run stopped where the ball passed through ``plane`` (either
+    driver)."""
+    return (f"ball passed through the {plane} at t = {t:.6g} s "
+            "(penetration reached the ball's radius)")
+
+
+def _failure_message(scene, options, reason, nfev, end, in_contact):
+    """The message of a run whose integrator failed at ``end`` after ``nfev`` calls in
+    all, with the integrator's ``reason`` (either driver)."""
+    if "max_nfev" in reason:
+        reason = (f"gave up after {nfev} right-hand-side evaluations in all "
+                  f"(max_nfev = {options.max_nfev})")
+    return (f"integrator failed at t = {end:.6g} s: {reason}"
+            + failure_hint(scene, in_contact, options.atol))
+
+
+def _record_end(contact, kind, t):
+    """Record on ``contact`` the end state ``kind`` ("rest", "rolling" or
+    "free_sliding") it entered at ``t`` (either driver)."""
+    if kind == "rest":
+        contact.t_rest = t
+    elif kind == "rolling":
+        contact.t_rolling = t
+    else:
+        contact.t_sliding = t
+    contact.transitions.append((t, kind))
+
+
+def _closed_form(kind, t, y, t_end):
+    """(sample times after t up to t_end, the closed-form solution from (t, y)) of the
+    end state ``kind``: the rest state, or uniform motion (either driver)."""
+    if kind == "rest":
+        return np.array([t_end]), resting.Constant(y)
+    motion = FreeFlight(t, y, 0.0, t_max=t_end)
+    return resting.rolling_samples(t, t_end, motion.rate), motion
 
 
 def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float = 1e-10,
@@ -756,13 +796,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
 
         if status == -1:
             run.status = -1
-            reason = sol.message
-            if "max_nfev" in reason:
-                reason = (f"gave up after {nfev} right-hand-side evaluations in all "
-                          f"(max_nfev = {options.max_nfev})")
-            end = t[-1] if t.size else run.t
-            run.message = (f"integrator failed at t = {end:.6g} s: {reason}"
-                           + failure_hint(scene, run.in_contact, options.atol))
+            run.message = _failure_message(scene, options, sol.message, nfev,
+                                           t[-1] if t.size else run.t, run.in_contact)
             if options.dense_output and t.size:
                 pieces.append((run.t, float(t[-1]), sol.interpolant))
             break
@@ -805,7 +840,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         quaternion = state[_QUATERNION]   # a view: normalised in place
         quaternion /= math.hypot(*quaternion.tolist())
         if fired >= n_driver:   # a terminal user event
-            run.status, run.message = 1, "A termination event occurred."
+            run.status, run.message = 1, TERMINATED
             break
         kind, plane, run.fired = driver_events[fired]
         if kind == "capacity":   # its row may have toggled inside the segment (C re-arms)
@@ -862,7 +897,8 @@ def _finish(result, options, stiff_at):
 # ends the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
 
 _C_METHODS = ("radau5", "dop853", "auto")
-_END_REST, _END_ROLLING, _END_SLIDING = 1, 2, 3   # _driver.h: BALLC_END_*
+#: The C loop's end states (_driver.h: BALLC_END_*; 0 none) by name.
+_END_KINDS = (None, "rest", "rolling", "free_sliding")
 _SEAMS = (integrate_segment, _radau5.solve_system)
 
 
@@ -948,9 +984,8 @@ def _c_config(scene, options, progress, rest):
             rho_eq=rho_eq, z_eq=scene.radius - rho_eq,
             rest_weight=resting.total_mass(scene) * scene.gravity,
             observer_weight=scene.observer_mass * scene.gravity,
-            rolls_dv=resting.REST_FACTOR * (float(np.max(options.atol)) + options.rtol
-                                            * math.sqrt(scene.gravity * scene.radius)),
-            rolls_level=float(1e3 * np.finfo(float).eps * scene.gravity),
+            rolls_dv=resting.speed_tolerance(scene, options.rtol, options.atol),
+            rolls_level=float(resting.steady_level(scene)),
             half_mass=0.5 * resting.total_mass(scene))
     modes_on = compliantmodes.uses_modes(scene)
     arm_depth = segment_events.arm_depth or {plane: 0.0 for plane in PLANES}
@@ -1030,9 +1065,7 @@ def _c_user_events_of(events):
             linear[k], coef[k], offset[k] = 1, row, float(event.offset)
             if event._index is not None:
                 index[k], scale[k] = event._index, event._scale
-            # flight.applies: every event linear without the quaternion
-            quaternion_free = (event._index is not None and event._index >= 4
-                               or not np.any(event.coefficients[_QUATERNION]))
+            quaternion_free = polynomial_in_flight(event)   # as flight.applies
             flies = flies and quaternion_free
             several = several or (quaternion_free and event._index is None)
             callables.append(None)
@@ -1061,14 +1094,10 @@ def _simulate_c(scene, options, y, config):
     pieces = [(piece[0], piece[1], FreeFlight(piece[0], piece[2], gravity, t_max=piece[1])
                if len(piece) == 3 else CompiledInterpolant(*piece[2:]))
               for piece in out["pieces"]]
-    if end_kind:   # a rest check found an end state: to t_end in closed form
-        when, y_end = out["end_t"], out["end_y"]
-        if end_kind == _END_REST:
-            times = np.array([options.t_end])
-            closed = resting.Constant(y_end)
-        else:
-            closed = FreeFlight(when, y_end, 0.0, t_max=options.t_end)
-            times = resting.rolling_samples(when, options.t_end, closed.rate)
+    end = _END_KINDS[end_kind]
+    if end:   # a rest check found an end state: to t_end in closed form
+        when = out["end_t"]
+        times, closed = _closed_form(end, when, out["end_y"], options.t_end)
         if options.dense_output:
             pieces.append((when, options.t_end, closed))
         t = np.concatenate([t, times])
@@ -1101,22 +1130,12 @@ def _simulate_c(scene, options, y, config):
     for k, when, phase in out["phases"]:
         contacts[k].transitions.append((when, "stick" if phase else "slip"))
     message = SUCCESS
-    if end_kind:   # as _Run.enter_rest / enter_motion
+    if end:   # as _Run.enter_rest / enter_motion
         plane = PLANES[out["end_plane"]]
-        contact = contacts[out["open"][out["end_plane"]]]
         when = out["end_t"]
-        if end_kind == _END_REST:
-            contact.t_rest = when
-            contact.transitions.append((when, "rest"))
-            message = _rest_message(scene, plane, when)
-        else:
-            kind = "rolling" if end_kind == _END_ROLLING else "free_sliding"
-            if kind == "rolling":
-                contact.t_rolling = when
-            else:
-                contact.t_sliding = when
-            contact.transitions.append((when, kind))
-            message = _motion_message(scene, plane, when, out["end_y"], kind)
+        _record_end(contacts[out["open"][out["end_plane"]]], end, when)
+        message = (_rest_message(scene, plane, when) if end == "rest"
+                   else _motion_message(scene, plane, when, out["end_y"], end))
     if counts[-1]:   # still in contact at the end
         last = states[:, -1]
         for k in out["open"]:
@@ -1127,25 +1146,18 @@ def _simulate_c(scene, options, y, config):
     user_event, user_t, user_y = out["user_hits"]
     n_user = len(config["user_count"])
     if code == _core.DRIVE_FAILED:
-        reason = out["message"]
-        if "max_nfev" in reason:
-            reason = (f"gave up after {out['nfev']} right-hand-side evaluations in all "
-                      f"(max_nfev = {options.max_nfev})")
-        in_contact = dict(zip(PLANES, out["in_contact"]))
-        message = (f"integrator failed at t = {out['fail_end']:.6g} s: {reason}"
-                   + failure_hint(scene, in_contact, options.atol))
+        message = _failure_message(scene, options, out["message"], out["nfev"],
+                                   out["fail_end"], dict(zip(PLANES, out["in_contact"])))
     elif code == _core.DRIVE_UNSETTLED:
-        plane = PLANES[out["stop_plane"]]
-        what = ("the compliant law's elastic/sliding" if out["unsettled_compliant"]
-                else "stick-slip")
-        message = (f"{what} transitions on the {plane} did not settle: "
-                   f"{out['transitions'][out['stop_plane']]} mode changes in one contact, "
-                   f"{out['stalled']} of them at t = {out['t_run']:.17g} s")
+        what = (COMPLIANT_TRANSITIONS if out["unsettled_compliant"]
+                else COULOMB_TRANSITIONS)
+        message = _unsettled_message(what, PLANES[out["stop_plane"]],
+                                     out["transitions"][out["stop_plane"]], out["stalled"],
+                                     out["t_run"])
     elif code == _core.DRIVE_TERMINATED:
-        message = "A termination event occurred."
+        message = TERMINATED
     elif code == _core.DRIVE_THROUGH:
-        message = (f"ball passed through the {PLANES[out['stop_plane']]} at t = "
-                   f"{out['t_run']:.6g} s (penetration reached the ball's radius)")
+        message = _through_message(PLANES[out["stop_plane"]], out["t_run"])
     result = Result(t=t, y=states, scene=scene, status=status, message=message,
                     nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], contacts=contacts,
                     flags=flags, latch=latch,
