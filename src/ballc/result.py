@@ -355,6 +355,20 @@ class Result:
                 arrays[name] = np.array(values, dtype=float)
         return arrays
 
+    def event_arrays(self) -> dict:
+        """The user events' occurrences as files store them, all events in one run of
+        rows (a netCDF file has no list of arrays of different lengths): "index" (m,)
+        which event (int), "times" (m,) when (s), "states" (m, len(state_names)) the
+        states there; :func:`load` splits them back into ``t_events`` and ``y_events``."""
+        times = list(self.t_events or [])
+        states = [np.asarray(y, dtype=float).reshape(-1, len(self.state_names))
+                  for y in (self.y_events or [])]
+        return {"index": np.concatenate([np.full(len(t), k, dtype=np.int32)
+                                         for k, t in enumerate(times)] or [np.zeros(0, np.int32)]),
+                "times": np.concatenate([np.asarray(t, dtype=float) for t in times]
+                                        or [np.zeros(0)]),
+                "states": np.concatenate(states or [np.zeros((0, len(self.state_names)))])}
+
     def contact_table(self) -> str:
         """The contacts as a fixed-width text table; a second header line gives the units
         (times in s, penetration in m, centre velocities in m/s)."""
@@ -435,7 +449,20 @@ def load(path) -> Result:
                   contacts=_contacts_from(contacts),
                   state_names=tuple(str(s) for s in arrays["state_names"]),
                   flags=flags if flags.size else None, latch=latch if latch.size else None,
-                  method_switches=_switches_from(header.get("method_switches")))
+                  method_switches=_switches_from(header.get("method_switches")),
+                  **_events_from(header.get("event_count"), arrays))
+
+
+def _events_from(count_text, arrays) -> dict:
+    """A saved run's ``t_events`` and ``y_events`` (:meth:`Result.event_arrays` split
+    per event: an event that never fired gets empty (0,) and (0, n) arrays), or None
+    when the run was given no events or the file was written before they were saved."""
+    count = json.loads(str(count_text)) if count_text is not None else None
+    if count is None:
+        return {"t_events": None, "y_events": None}
+    index = np.asarray(arrays["event_index"])
+    return {"t_events": [arrays["event_times"][index == k] for k in range(count)],
+            "y_events": [arrays["event_states"][index == k] for k in range(count)]}
 
 
 def _switches_from(text) -> list | None:
