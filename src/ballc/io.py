@@ -1,8 +1,8 @@
 """Results on disk: ``.npz`` (numpy, always) and ``.nc`` (netCDF via xarray, optional).
 
 Both hold everything needed to rebuild the :class:`ballc.Result`: the time grid and
-states (bit for bit), the per-sample flags and latched values, the contacts, the
-solver's status, the scene (as JSON) and provenance (ballc version, generator version
+states (bit for bit), the per-sample flags and latched values, the contacts, the user
+events' times and states (``t_events``, ``y_events``), the solver's status, the scene (as JSON) and provenance (ballc version, generator version
 of the compiled kernels, numpy/Python versions, creation time in UTC).
 
 >>> result.save("seed.npz");  again = ballc.load("seed.npz")

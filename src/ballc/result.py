@@ -410,18 +410,20 @@ class Result:
         rows (a netCDF file has no list of arrays of different lengths): "index" (m,)
         which event (int), "times" (m,) when (s), "states" (m, len(state_names)) the
         states there; :func:`load` splits them back into ``t_events`` and ``y_events``."""
-        times = list(self.t_events or [])
-        states = [np.asarray(y, dtype=float).reshape(-1, len(self.state_names))
-                  for y in (self.y_events or [])]
-        return {"index": np.concatenate([np.full(len(t), k, dtype=np.int32)
-                                         for k, t in enumerate(times)] or [np.zeros(0, np.int32)]),
-                "times": np.concatenate([np.asarray(t, dtype=float) for t in times]
-                                        or [np.zeros(0)]),
-                "states": np.concatenate(states or [np.zeros((0, len(self.state_names)))])}
+        n = len(self.state_names)
+        times = [np.asarray(t, dtype=float) for t in self.t_events or []]
+        states = [np.asarray(y, dtype=float).reshape(-1, n) for y in self.y_events or []]
+        index = [np.full(len(t), k, dtype=np.int32) for k, t in enumerate(times)]
+        return {"index": np.concatenate(index or [np.zeros(0, np.int32)]),
+                "times": np.concatenate(times or [np.zeros(0)]),
+                "states": np.concatenate(states or [np.zeros((0, n))])}
 
     def contact_table(self) -> str:
         """The contacts as a fixed-width text table; a second header line gives the units
-        (times in s, penetration in m, centre velocities in m/s)."""
+        (times in s, penetration in m, centre velocities in m/s, the normal rebound ratio
+        1).  Lines under it name the contacts where gravity changed the rebound
+        (``gravity_affected_contacts``), that came to rest, or were continued in closed
+        form."""
         head = (f"{'#':>2} {'plane':7} {'t_start':>8} {'t_end':>8} {'max pen.':>9} "
                 f"{'vx before':>10} {'vx after':>9} {'vy before':>10} {'vy after':>9} "
                 f"{'vz before':>10} {'vz after':>9} {'rebound':>8}")
