@@ -12,9 +12,9 @@ from .orientation import angles_123_from_quaternion
 
 _STATE = layout.INDEX
 #: A contact is under gravity when gravity's impulse over it, g t_c, is more than this
-#: share of its exit normal speed |v_n after| (or the ball did not leave): its rebound
-#: ratio is then off the law's e (by about a third of g t_c / |v_n after|, measured on
-#: the soft and hard default balls), so the contact table says so.
+#: share of its exit normal speed abs(v_n after) (or the ball did not leave): its
+#: rebound ratio is then off the law's e (by about a third of g t_c / abs(v_n after),
+#: measured on the soft and hard default balls), so the contact table says so.
 GRAVITY_IMPULSE_SHARE = 0.1
 #: The unset values of a Contact's vectors (each contact gets its own copy).
 _NAN_3, _NAN_2 = np.full(3, np.nan), np.full(2, np.nan)
@@ -54,9 +54,9 @@ class Contact:
         Time with the tangential force below, and at, the Coulomb cap mu F_n (s).
     transitions : list of (float, str)
         Exact Coulomb friction: the start (s) of each "slip" or "stick" phase.
-    rebound_ratio : float
-        (derived) The measured normal rebound ratio -v_n after / v_n before (1); the
-        scene's restitution e only without gravity (see the property).
+
+    The properties ``duration`` (s) and ``rebound_ratio`` (-v_n after / v_n before, 1:
+    the scene's restitution e only without gravity) are derived from these.
     """
 
     plane: str                       # "floor" or "ceiling"

@@ -88,7 +88,7 @@ class Scene:
         dimensionless Hertz impact, :mod:`ballc.restitution`).  Default None (c_tau).
         It is a parameter of the law, not the rebound a run shows: gravity acts during a
         contact too and lowers a floor rebound (raises a ceiling one) by about a third of
-        g t_c / |v_n after| (t_c the contact time) -- on the default soft ball (contacts
+        g t_c / abs(v_n after) (t_c the contact time) -- on the default soft ball (contacts
         of ~0.1 s) e = 0.1 rebounds from the seed throw's first impact at 0.082 -- and the
         dig-in law pushes along the contact point's velocity at impact, normal part
         included.  Each contact's measured ratio is ``Contact.rebound_ratio``; the
