@@ -332,8 +332,9 @@ def test_contact_csv_without_contacts_has_the_header(tmp_path):
 def test_contact_table_has_units():
     table = ballc.simulate(ballc.Scene(), 0.7).contact_table().splitlines()
     assert table[0].split()[:4] == ["#", "plane", "t_start", "t_end"]
-    assert table[1].split() == ["[s]", "[s]", "[m]"] + ["[m/s]"] * 6
-    assert len(table) == 3 + 2
+    assert table[1].split() == ["[s]", "[s]", "[m]"] + ["[m/s]"] * 6 + ["[1]"]
+    assert table[0].split()[-1] == "rebound" and table[-1].startswith("rebound: ")
+    assert len(table) == 3 + 2 + 1
 
 
 def test_a_run_that_gains_energy_says_gained():

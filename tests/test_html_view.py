@@ -34,10 +34,55 @@ def test_writes_a_self_contained_page(result, tmp_path):
     assert f"{len(result.contacts)} contacts" in text
 
 
-def test_keyframes_follow_fps_and_speed(result):
+def commands(text):
+    """The meshcat commands embedded in a page, unpacked: {path: command} per type."""
+    import base64
+
+    import numpy as np
+    import umsgpack
+    found = {}
+    for blob in re.findall(r'data:application/octet-binary;base64,([A-Za-z0-9+/=]+)', text):
+        command = umsgpack.unpackb(base64.b64decode(blob))
+        key = command.get("path") or command["animations"][0]["path"]
+        found.setdefault(command["type"], {})[key] = command
+    # a transform as its translation (three.js matrices are column-major: 12, 13, 14)
+    found["translation"] = {path: np.asarray(c["matrix"])[12:15]
+                            for path, c in found.get("set_transform", {}).items()}
+    return found
+
+
+def test_the_page_holds_the_scene_and_the_runs_motion(result):
+    """The planes' faces at z = 0 and z = H, a marker at each contact point, and keyframes
+    at fps per second of playback whose centres are the run's (interpolated here)."""
+    import numpy as np
     from ballc.html_view import scene_html
-    slow, fast = scene_html(result, fps=10, speed=0.5), scene_html(result, fps=10, speed=2.0)
-    assert len(slow) > len(fast)      # more keyframes for a slower playback
+    h = result.scene.ceiling_height
+    for fps, speed in ((10, 0.5), (7, 2.0)):
+        page = commands(scene_html(result, fps=fps, speed=speed))
+        base = "/meshcat/ballc"
+        for plane, face in (("floor", 0.0), ("ceiling", h)):
+            box = page["set_object"][f"{base}/planes/{plane}"]["object"]["geometries"][0]
+            z = page["translation"][f"{base}/planes/{plane}"][2]
+            inner = z + box["depth"] / 2 if plane == "floor" else z - box["depth"] / 2
+            assert inner == pytest.approx(face, abs=1e-12), plane
+        for i, contact in enumerate(result.contacts, 1):
+            expected = [*contact.contact_point, 0.0 if contact.plane == "floor" else h]
+            assert page["translation"][f"{base}/contacts/{i}"] == pytest.approx(expected)
+        assert f"{base}/contacts/{len(result.contacts) + 1}" not in page["translation"]
+        clip = page["set_animation"][f"{base}/ball"]["animations"][0]["clip"]
+        assert clip["fps"] == fps
+        tracks = {track["name"]: track["keys"] for track in clip["tracks"]}
+        t0, t1 = result.t[0], result.t[-1]
+        count = int(np.ceil((t1 - t0) / speed * fps)) + 1
+        assert [key["time"] for key in tracks[".position"]] == list(range(count))
+        times = np.linspace(t0, t1, count)
+        for key, t in zip(tracks[".position"], times):
+            centre = [np.interp(t, result.t, row) for row in result.position]
+            assert key["value"] == pytest.approx(centre, abs=1e-12)
+        quaternions = np.array([key["value"] for key in tracks[".quaternion"]])
+        assert np.allclose(np.linalg.norm(quaternions, axis=1), 1.0, atol=1e-12)
+        qw, qx, qy, qz = result.quaternion[:, -1]     # meshcat's order: x, y, z, w
+        assert quaternions[-1] == pytest.approx([qx, qy, qz, qw], abs=1e-12)
 
 
 @pytest.mark.parametrize("options, message", [

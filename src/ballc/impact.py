@@ -210,7 +210,7 @@ def impact(scene: Scene, velocity, angular_velocity=(0.0, 0.0, 0.0), plane: str 
                   velocity_after=va.copy(), angular_velocity_after=wa.copy(),
                   duration=float(contact.duration),
                   max_penetration=float(contact.max_penetration),
-                  normal_restitution=-float(va @ n) / float(vb @ n),
+                  normal_restitution=contact.rebound_ratio,
                   tangential_restitution=e_t, contact_velocity_before=ub,
                   contact_velocity_after=ua, result=result)
 

@@ -1,8 +1,8 @@
 """Results on disk: ``.npz`` (numpy, always) and ``.nc`` (netCDF via xarray, optional).
 
 Both hold everything needed to rebuild the :class:`ballc.Result`: the time grid and
-states (bit for bit), the per-sample flags and latched values, the contacts, the
-solver's status, the scene (as JSON) and provenance (ballc version, generator version
+states (bit for bit), the per-sample flags and latched values, the contacts, the user
+events' times and states (``t_events``, ``y_events``), the solver's status, the scene (as JSON) and provenance (ballc version, generator version
 of the compiled kernels, numpy/Python versions, creation time in UTC).
 
 >>> result.save("seed.npz");  again = ballc.load("seed.npz")
@@ -42,7 +42,11 @@ def _header(result) -> dict:
             # is a string or a number)
             "method_switches": json.dumps(None if result.method_switches is None else
                                           [[float(t), str(m)] for t, m in
-                                           result.method_switches])}
+                                           result.method_switches]),
+            # how many user events the run was given (their occurrences are the
+            # event_* arrays), or null: none given
+            "event_count": json.dumps(None if result.t_events is None else
+                                      len(result.t_events))}
 
 
 def _check_provenance(path, stored: dict, state_names) -> None:
@@ -79,11 +83,12 @@ def save(result, path) -> None:
         return
     header = _header(result)
     contacts = {f"contact_{k}": v for k, v in result.contact_arrays().items()}
+    events = {f"event_{k}": v for k, v in result.event_arrays().items()}
     np.savez_compressed(
         path, t=result.t, y=result.y, state_names=np.array(result.state_names, dtype=str),
         flags=_or_empty(result.flags, np.int32), latch=_or_empty(result.latch, float),
         latch_names=np.array(_core.LATCH_NAMES, dtype=str),
-        header=np.array(json.dumps(header)), **contacts)
+        header=np.array(json.dumps(header)), **contacts, **events)
 
 
 def _or_empty(array, dtype):
@@ -117,6 +122,8 @@ def read(path) -> tuple[dict, dict, dict]:
 
 #: The arrays every ballc .npz holds (besides contact_* and latch_names).
 NPZ_ARRAYS = ("header", "t", "y", "state_names", "flags", "latch")
+#: The user events' arrays (files of earlier versions lack them).
+EVENT_ARRAYS = ("event_index", "event_times", "event_states")
 #: The keys of a file's header (files of earlier versions lack "method_switches").
 HEADER_KEYS = ("scene", "provenance", "status", "message", "nfev", "njev", "nlu")
 
@@ -145,7 +152,7 @@ def _read_npz(path):
         header = _header_of(path, str(data["header"]))
         contacts = {k[len("contact_"):]: data[k] for k in data.files
                     if k.startswith("contact_")}
-        arrays = {k: data[k] for k in NPZ_ARRAYS[1:]}
+        arrays = {k: data[k] for k in NPZ_ARRAYS[1:] + EVENT_ARRAYS if k in data.files}
     return header, arrays, contacts
 
 
@@ -172,6 +179,10 @@ def _to_dataset(result):
     for name, values in result.contact_arrays().items():
         dims = ("contact", f"{name}_component") if values.ndim == 2 else ("contact",)
         variables[f"contact_{name}"] = (dims, values)
+    events = result.event_arrays()
+    variables["event_index"] = (("event",), events["index"])
+    variables["event_times"] = (("event",), events["times"], {"units": "s"})
+    variables["event_states"] = (("event", "state"), events["states"])
     coords = {"time": ("time", result.t, {"units": "s"}),
               "state": list(result.state_names), "latch_name": list(_core.LATCH_NAMES)}
     return xr.Dataset(variables, coords=coords, attrs=_header(result))
@@ -189,6 +200,7 @@ def _read_dataset(path):
                   "state_names": ds["state"].values.astype(str),
                   "flags": ds["flags"].values.astype(np.int32) if "flags" in ds else np.zeros(0),
                   "latch": ds["latch"].values.astype(float) if "latch" in ds else np.zeros(0)}
+        arrays.update({name: ds[name].values for name in EVENT_ARRAYS if name in ds})
         contacts = {k[len("contact_"):]: ds[k].values for k in ds.data_vars
                     if k.startswith("contact_")}
         header = dict(ds.attrs)

@@ -89,12 +89,30 @@ def _pyplot():
     return plt
 
 
+#: The normal damping laws' names in figure titles (``Scene.normal_damping``).
+DAMPING_LAW_NAMES = {"hunt_crossley": "Hunt-Crossley", "viscoelastic": "viscoelastic"}
+
+
+def damping_title(scene) -> str:
+    """The normal damping input the scene was given, with its law: c_tau (or its
+    default), the restitution e, or the viscoelastic damping ratio gamma.  A scene gives
+    exactly one of them (``Scene``); the other two are None or derived from it."""
+    law = DAMPING_LAW_NAMES[scene.normal_damping]
+    if scene.restitution is not None:
+        given = f"e = {scene.restitution:g}"
+    elif scene.normal_damping == "viscoelastic":
+        given = f"$\\gamma$ = {scene.damping_ratio:g}"
+    else:
+        given = f"$c_\\tau$ = {scene.c_tau:g}"
+    return f"{given} ({law})"
+
+
 def scene_title(scene) -> str:
-    """One line naming the tangential model and its parameters."""
+    """One line naming the normal damping input (``damping_title``), the friction
+    coefficient and the tangential model."""
     model = (f"mixture {scene.mixture:g}" if scene.tangential_model == "mixture"
              else f"{scene.tangential_model} model")
-    return (f"$c_\\tau$ = {scene.c_tau:g}, $\\mu$ = {scene.friction_coefficient:g}, "
-            f"{model}")
+    return f"{damping_title(scene)}, $\\mu$ = {scene.friction_coefficient:g}, {model}"
 
 
 def shade_contacts(ax, result) -> None:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -10,6 +11,11 @@ from . import _core, layout
 from .orientation import angles_123_from_quaternion
 
 _STATE = layout.INDEX
+#: A contact is under gravity when gravity's impulse over it, g t_c, is more than this
+#: share of its exit normal speed abs(v_n after) (or the ball did not leave): its
+#: rebound ratio is then off the law's e (by about a third of g t_c / abs(v_n after),
+#: measured on the soft and hard default balls), so the contact table says so.
+GRAVITY_IMPULSE_SHARE = 0.1
 #: The unset values of a Contact's vectors (each contact gets its own copy).
 _NAN_3, _NAN_2 = np.full(3, np.nan), np.full(2, np.nan)
 
@@ -48,6 +54,9 @@ class Contact:
         Time with the tangential force below, and at, the Coulomb cap mu F_n (s).
     transitions : list of (float, str)
         Exact Coulomb friction: the start (s) of each "slip" or "stick" phase.
+
+    The properties ``duration`` (s) and ``rebound_ratio`` (-v_n after / v_n before, 1:
+    the scene's restitution e only without gravity) are derived from these.
     """
 
     plane: str                       # "floor" or "ceiling"
@@ -83,11 +92,25 @@ class Contact:
         """t_end - t_start (s)."""
         return self.t_end - self.t_start
 
+    @property
+    def rebound_ratio(self) -> float:
+        """The measured normal rebound ratio -v_n after / v_n before (1), v_n = v . n the
+        centre's velocity along the plane's normal n towards the ball (+z floor, -z
+        ceiling) at ``t_start`` and ``t_end``.  NaN when the contact did not end or did
+        not start approaching the plane.  Without gravity it is the normal law's
+        restitution e (``Scene.restitution``); under gravity it is not
+        (``Result.gravity_affected_contacts``, docs/limits.md)."""
+        normal = 1.0 if self.plane == "floor" else -1.0
+        before = float(self.velocity_before[2]) * normal
+        after = float(self.velocity_after[2]) * normal
+        return -after / before if before < 0 else math.nan
+
     def as_dict(self) -> dict:
         """The contact as one flat row (the contact table's columns, units in
         ``ballc.result.CONTACT_UNITS``)."""
         row = {"plane": self.plane, "t_start": self.t_start, "t_end": self.t_end,
-               "duration": self.duration, "max_penetration": self.max_penetration,
+               "duration": self.duration, "rebound_ratio": self.rebound_ratio,
+               "max_penetration": self.max_penetration,
                "contact_point_x": float(self.contact_point[0]),
                "contact_point_y": float(self.contact_point[1]),
                "peak_normal_force": self.peak_normal_force,
@@ -106,7 +129,8 @@ class Contact:
 
 #: Unit of each column of :meth:`Contact.as_dict` (the contact CSV's header says them).
 CONTACT_UNITS = {
-    "plane": "", "t_start": "s", "t_end": "s", "duration": "s", "max_penetration": "m",
+    "plane": "", "t_start": "s", "t_end": "s", "duration": "s", "rebound_ratio": "1",
+    "max_penetration": "m",
     "contact_point_x": "m", "contact_point_y": "m", "peak_normal_force": "N",
     "energy_lost_normal": "J", "energy_lost_tangential": "J", "time_sticking": "s",
     "time_slipping": "s", "penetration_rate_at_impact": "m/s", "t_rest": "s",
@@ -340,9 +364,35 @@ class Result:
         from .io import save
         save(self, path)
 
+    def gravity_affected_contacts(self) -> list:
+        """Indices (from 0) of the contacts whose rebound gravity changed much: gravity's
+        impulse over the contact, g t_c, exceeds GRAVITY_IMPULSE_SHARE of the exit
+        normal speed; or the ball did not leave -- it came to rest on the plane, or the
+        run ended in a contact over which gravity's impulse already exceeds the impact
+        speed (its weight holds it there).  Their ``rebound_ratio`` is not the scene's
+        restitution e, which is the law's e of an isolated impact without gravity."""
+        g = float(self.scene.gravity)
+        if g <= 0:
+            return []
+        found = []
+        for i, contact in enumerate(self.contacts):
+            normal = 1.0 if contact.plane == "floor" else -1.0
+            if contact.t_rest == contact.t_rest:
+                found.append(i)
+            elif contact.t_end == contact.t_end:
+                exit_speed = abs(float(contact.velocity_after[2]) * normal)
+                if g * contact.duration > GRAVITY_IMPULSE_SHARE * exit_speed:
+                    found.append(i)
+            elif g * (float(self.t[-1]) - contact.t_start) > abs(
+                    float(contact.velocity_before[2]) * normal):
+                found.append(i)
+        return found
+
     def contact_arrays(self) -> dict:
-        """field -> array over the contacts ((k,) or (k, 3)): what files store."""
-        arrays = {}
+        """field -> array over the contacts ((k,) or (k, 3)): what files store, and the
+        derived ``rebound_ratio`` (for readers of the file; load recomputes it)."""
+        arrays = {"rebound_ratio": np.array([c.rebound_ratio for c in self.contacts],
+                                            dtype=float)}
         for name in CONTACT_FIELDS:
             values = [getattr(c, name) for c in self.contacts]
             if name == "plane":
@@ -355,20 +405,49 @@ class Result:
                 arrays[name] = np.array(values, dtype=float)
         return arrays
 
+    def event_arrays(self) -> dict:
+        """The user events' occurrences as files store them, all events in one run of
+        rows (a netCDF file has no list of arrays of different lengths): "index" (m,)
+        which event (int), "times" (m,) when (s), "states" (m, len(state_names)) the
+        states there; :func:`load` splits them back into ``t_events`` and ``y_events``."""
+        n = len(self.state_names)
+        times = [np.asarray(t, dtype=float) for t in self.t_events or []]
+        states = [np.asarray(y, dtype=float).reshape(-1, n) for y in self.y_events or []]
+        index = [np.full(len(t), k, dtype=np.int32) for k, t in enumerate(times)]
+        return {"index": np.concatenate(index or [np.zeros(0, np.int32)]),
+                "times": np.concatenate(times or [np.zeros(0)]),
+                "states": np.concatenate(states or [np.zeros((0, n))])}
+
     def contact_table(self) -> str:
         """The contacts as a fixed-width text table; a second header line gives the units
-        (times in s, penetration in m, centre velocities in m/s)."""
+        (times in s, penetration in m, centre velocities in m/s, the normal rebound ratio
+        1).  Lines under it name the contacts where gravity changed the rebound
+        (``gravity_affected_contacts``), that came to rest, or were continued in closed
+        form."""
         head = (f"{'#':>2} {'plane':7} {'t_start':>8} {'t_end':>8} {'max pen.':>9} "
                 f"{'vx before':>10} {'vx after':>9} {'vy before':>10} {'vy after':>9} "
-                f"{'vz before':>10} {'vz after':>9}")
+                f"{'vz before':>10} {'vz after':>9} {'rebound':>8}")
         units = (f"{'':>2} {'':7} {'[s]':>8} {'[s]':>8} {'[m]':>9} " +
-                 " ".join(f"{'[m/s]':>{width}}" for width in (10, 9, 10, 9, 10, 9)))
+                 " ".join(f"{'[m/s]':>{width}}" for width in (10, 9, 10, 9, 10, 9)) +
+                 f" {'[1]':>8}")
         lines = [head, units, "-" * len(head)]
         for i, c in enumerate(self.contacts, 1):
             vb, va = c.velocity_before, c.velocity_after
             lines.append(f"{i:2d} {c.plane:7} {c.t_start:8.4f} {c.t_end:8.4f} "
                          f"{c.max_penetration:9.4f} {vb[0]:10.3f} {va[0]:9.3f} "
-                         f"{vb[1]:10.3f} {va[1]:9.3f} {vb[2]:10.3f} {va[2]:9.3f}")
+                         f"{vb[1]:10.3f} {va[1]:9.3f} {vb[2]:10.3f} {va[2]:9.3f} "
+                         f"{c.rebound_ratio:8.4f}")
+        if self.contacts:
+            lines.append("rebound: the normal rebound ratio -v_n after / v_n before")
+        affected = self.gravity_affected_contacts()
+        if affected:
+            which = ", ".join(str(i + 1) for i in affected)
+            lines.append(
+                f"contact{'s' if len(affected) > 1 else ''} {which}: gravity acted for much "
+                f"of the contact (g t_c > {GRAVITY_IMPULSE_SHARE:g} |v_n after|, or the ball "
+                f"did not leave), so the rebound ratio is not the scene's restitution "
+                f"e = {self.scene.normal_restitution:.4g}: that is the law's e of an "
+                "isolated impact without gravity (docs/limits.md)")
         lines += [f"contact {i}: at rest from t = {c.t_rest:.6g} s (ballc.resting)"
                   for i, c in enumerate(self.contacts, 1) if c.t_rest == c.t_rest]
         lines += [f"contact {i}: {what} from t = {when:.6g} s, in closed form"
@@ -435,7 +514,20 @@ def load(path) -> Result:
                   contacts=_contacts_from(contacts),
                   state_names=tuple(str(s) for s in arrays["state_names"]),
                   flags=flags if flags.size else None, latch=latch if latch.size else None,
-                  method_switches=_switches_from(header.get("method_switches")))
+                  method_switches=_switches_from(header.get("method_switches")),
+                  **_events_from(header.get("event_count"), arrays))
+
+
+def _events_from(count_text, arrays) -> dict:
+    """A saved run's ``t_events`` and ``y_events`` (:meth:`Result.event_arrays` split
+    per event: an event that never fired gets empty (0,) and (0, n) arrays), or None
+    when the run was given no events or the file was written before they were saved."""
+    count = json.loads(str(count_text)) if count_text is not None else None
+    if count is None:
+        return {"t_events": None, "y_events": None}
+    index = np.asarray(arrays["event_index"])
+    return {"t_events": [arrays["event_times"][index == k] for k in range(count)],
+            "y_events": [arrays["event_states"][index == k] for k in range(count)]}
 
 
 def _switches_from(text) -> list | None:

@@ -81,10 +81,19 @@ class Scene:
         coefficient of restitution of a normal impact for c_tau near 1.  Default 0.9
         (the seed's) unless ``restitution`` is given: a scene gives one or the other.
     restitution : float, optional
-        Coefficient of restitution e of a normal impact (1), in (0, 1], inverted exactly
+        Coefficient of restitution e of the normal law (1), in (0, 1]: the exit / entry
+        normal speed ratio of an isolated normal impact without gravity, inverted exactly
         for the normal damping in use (Hunt-Crossley: chi (1 + e) = ln[(1 + chi)/(1 - chi
         e)], any e > 0, where c_tau only reaches e > 0.4877; viscoelastic: gamma(e) of the
         dimensionless Hertz impact, :mod:`ballc.restitution`).  Default None (c_tau).
+        It is a parameter of the law, not the rebound a run shows: gravity acts during a
+        contact too and lowers a floor rebound (raises a ceiling one) by about a third of
+        g t_c / abs(v_n after) (t_c the contact time) -- on the default soft ball (contacts
+        of ~0.1 s) e = 0.1 rebounds from the seed throw's first impact at 0.082 -- and the
+        dig-in law pushes along the contact point's velocity at impact, normal part
+        included.  Each contact's measured ratio is ``Contact.rebound_ratio``; the
+        contact table names the contacts where gravity's impulse is more than 10 % of
+        the exit speed (``Result.gravity_affected_contacts``).
     normal_damping : str
         "hunt_crossley" (default, the seed's) or "viscoelastic" (the DEM codes' Hertz
         viscous damping c_n = 2 gamma sqrt(m* k_n), clamped so the force is never
