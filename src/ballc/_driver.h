@@ -1,5 +1,5 @@
 /* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1, 2a -- the
- * rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back --, 2b: t_eval
+ * rest checks of ballc.resting, and ballc.orbit's trial in _orbit.c --, 2b: t_eval
  * and dense output, 2c: method "auto" and exact flight, ballc.flight, 3: the compliant
  * law's exact modes, ballc.compliantmodes, and 4: user events).
  *
@@ -92,7 +92,7 @@ typedef struct {                       /* constants of one run, filled by the br
     /* the rest checks (ballc.resting; stage 2a), constants computed by Python */
     int observer_massive;              /* observer_mass > 0 */
     int rolls_allowed;                 /* flight.scene_allows: uniform motion possible */
-    int orbit_applies;                 /* orbit.applies: a check finding nothing falls back */
+    int orbit_applies;                 /* orbit.applies: a check finding nothing tries an orbit */
     double rest_threshold;             /* resting.energy_threshold */
     double rho_eq, z_eq;               /* equilibrium_penetration, radius - rho_eq */
     double rest_weight;                /* total_mass * gravity */

@@ -899,10 +899,10 @@ def _finish(result, options, stiff_at):
 # environment variable BALLC_PYTHON_DRIVER is not set (to anything non-empty) and the
 # integrator seam is not wrapped (_seams_untouched).  The results are bit-identical to
 # the Python loop above (benchmarks/driver_identical.py, tests/test_c_driver.py).
-# Everything else, and a C run that meets what it does not port (a rest check on a
-# Routh sphere where an orbit's trial may start, a kernel failure where Python raises),
-# runs the Python loop from the start.  A rest check that finds rest or uniform motion
-# ends the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
+# Everything else, and a C run that meets what it does not port (a kernel failure
+# where Python raises), runs the Python loop from the start.  A rest check that finds
+# rest, uniform motion or a relative periodic orbit (ballc.orbit, measured in C) ends
+# the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
 
 _C_METHODS = ("radau5", "dop853", "auto")
 #: The C loop's end states (_driver.h: BALLC_END_*; 0 none) by name.
