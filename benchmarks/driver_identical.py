@@ -17,8 +17,9 @@ paths of stage 1 (a start in contact, regularised friction, max_step and first_s
 passing through, the ceiling, a call budget); stage 2a, the rest checks (rest, uniform
 rolling, checks that find neither); 2b, t_eval and dense output; 2c, method "auto" and
 exact flight; 3, the compliant law's modes at 1e-4/1e-6/1e-9; 4, user events (terminal
-and not, callables and LinearEvents); and runs that must fall back (an orbit's trial,
-method "Radau", a LinearEvent of several states in exact flight).
+and not, callables and LinearEvents); ballc.orbit (the seed's wobbling roll, refused
+trials: its C code serves both drivers); and runs that must fall back (method "Radau", a
+LinearEvent of several states in exact flight).
 """
 from __future__ import annotations
 
@@ -215,10 +216,15 @@ def cases(quick=False):
             (f"user: compliant, terminal {method}", dict(tangential_model="compliant"), 5.0,
              dict(method=method, rtol=1e-6, atol=1e-6, events=[twice]), True),
         ]
+    # ballc.orbit: the seed's trials and its wobbling roll (the orbit in C for both)
+    out += [
+        ("orbit: seed 100 s, dense", {}, 100.0, dict(dense_output=True), True),
+        ("orbit: seed 100 s, auto", {}, 100.0, dict(method="auto", rtol=1e-8, atol=1e-8), True),
+        ("orbit: refused trials (spin 30, 120 s)", dict(angular_velocity=(0, 0, 30)), 120.0,
+         dict(method="dop853", rtol=1e-6, atol=1e-6), True),
+    ]
     # must fall back
     out += [
-        ("fallback: an orbit's trial (seed 100 s)", {}, 100.0,
-         dict(method="dop853", rtol=1e-6, atol=1e-6), False),
         ("fallback: scipy Radau", {}, 0.3, dict(method="Radau", rtol=1e-3, atol=1e-3), False),
         ("fallback: a LinearEvent of several states in exact flight", dict(observer_mass=0),
          2.0, dict(method="dop853", rtol=1e-6, atol=1e-6, events=[ballc.events.LinearEvent(

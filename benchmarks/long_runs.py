@@ -6,8 +6,7 @@
 For each t_end: ``ballc.simulate(scene, t_end)`` with the default options (radau5,
 rtol = atol = 1e-10, exact Coulomb friction, max_nfev = 2e7), timed in wall-clock and
 CPU (time.process_time) as users run it (the C loop where it applies; which driver ran
-is a column: a run whose orbit trial could start falls back to the Python driver from
-the start), then timed again with the Python driver (the integrator seam wrapped to
+is a column), then timed again with the Python driver (the integrator seam wrapped to
 count segments; the results must be the same), with its status, the simulated time reached, the integrator
 segments (calls of the driver's integrate_segment, counted by a wrapper), the steps of
 the last segment, the right-hand-side calls, the samples, the contacts, and the median
@@ -26,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import sys
 import time
 from pathlib import Path
@@ -136,7 +136,9 @@ def main(argv=None):
     command = " ".join(sys.argv[1:] if argv is None else argv)
     lines = ["# Long runs", "",
              f"Made by `{('python -m benchmarks.long_runs ' + command).strip()}`.  What the numbers "
-             "mean: docs/limits.md, \"Long runs\".", ""]
+             "mean: docs/limits.md, \"Long runs\".  Load average at the start: "
+             f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs (the wall times grow with it; "
+             "compare the CPU columns).", ""]
     largest = None
     for name in args.scenes:
         scene = SCENES[name]()

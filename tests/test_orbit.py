@@ -68,8 +68,10 @@ def test_other_wobbling_balls_follow_the_integration(scene, t_end):
 
 def test_the_seed_scene_finishes_a_billion_seconds():
     """Issue 21's target: status 0, the end state named, every sample finite, the
-    energy balance closed (no drift warning), the last sample at t_end."""
+    energy balance closed (no drift warning), the last sample at t_end -- on the C loop
+    (its trial and measurement in C, issue 29)."""
     run = ballc.simulate(ballc.Scene(), 1e9)
+    assert run._driver == "c"
     assert run.status == 0 and run.t[-1] == 1e9
     assert "relative periodic orbit" in run.message and "drifted" not in run.message
     assert np.all(np.isfinite(run.y))
@@ -94,16 +96,18 @@ def test_a_power_of_the_motion_is_the_motion_applied_again_and_again():
     y[layout.DEFLECTION["floor"]] = (1e-4, -2e-4)
     repeated = y.copy()
     for k in range(8):
-        np.testing.assert_allclose(motion.power(k).apply(y), repeated, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(motion.apply(y, k), repeated, rtol=0, atol=1e-12)
         repeated = motion.apply(repeated)
+    # and backwards: G^-k undoes G^k
+    np.testing.assert_allclose(motion.apply(motion.apply(y, 5), -5), y, rtol=0, atol=1e-12)
     # over many columns at once, k per column
     ks = np.arange(8)
-    many = motion.power(ks).apply(np.repeat(y[:, None], ks.size, axis=1))
+    many = motion.apply(np.repeat(y[:, None], ks.size, axis=1), ks)
     for k in ks:
-        np.testing.assert_allclose(many[:, k], motion.power(k).apply(y), rtol=0, atol=1e-14)
+        np.testing.assert_allclose(many[:, k], motion.apply(y, k), rtol=0, atol=1e-14)
     # a turn by 0: the shift adds up k times
     straight = orbit.Motion(0.0, (1.5, -0.4), 0.0, axis)
-    np.testing.assert_allclose(straight.power(5).apply(y)[_P][:2], y[_P][:2] + (7.5, -2.0))
+    np.testing.assert_allclose(straight.apply(y, 5)[_P][:2], y[_P][:2] + (7.5, -2.0))
 
 
 def test_the_motion_keeps_the_quaternion_a_rotation_about_the_balls_axis():
@@ -176,19 +180,95 @@ def test_the_sampled_orbit_is_its_dense_output():
     np.testing.assert_allclose(run.sol(run.t[late]), run.y[:, late], rtol=0, atol=1e-12)
 
 
-def test_a_refused_trial_is_not_followed_by_another_at_once(monkeypatch):
+def test_a_refused_trial_is_not_followed_by_another_at_once():
     """A fast-spinning wobbling ball whose wobble still changes refuses trial after trial:
     the next starts only at the next scheduled rest check, not where the last ended (770
-    back-to-back trials made such a run 78 % slower)."""
-    trials = []
-    init = orbit.Trial.__init__
-
-    def recording(self, plane, t_from, t_to, guess):
-        init(self, plane, t_from, t_to, guess)
-        trials.append((t_from, t_to))
-
-    monkeypatch.setattr(orbit.Trial, "__init__", recording)
+    back-to-back trials made such a run 78 % slower).  The C loop logs its trials."""
     run = ballc.simulate(ballc.Scene(angular_velocity=(0, 0, 30)), 120.0)
-    assert run.status == 0 and len(trials) >= 2
-    for (_, end), (start, _) in zip(trials, trials[1:]):
+    trials = run._orbit_trials
+    assert run.status == 0 and run._driver == "c" and len(trials) >= 2
+    assert not any(accepted for *_, accepted in trials)
+    for (_, end, _), (start, _, _) in zip(trials, trials[1:]):
         assert start > end, trials
+
+
+def _synthetic_orbit(scene, period, turn, spin, centre):
+    """y(t) of a made-up relative periodic orbit, exact by construction: the ball's axis
+    a tilts periodically, theta(t) = 0.4 + 0.2 sin(2 pi t / T), while the scene turns
+    about the vertical at ``turn`` rad/s about ``centre`` and the ball spins about a
+    at ``spin`` rad/s; so y(t + T) = G y(t) with phi = turn T, psi = spin T,
+    d = centre - R(phi) centre and the work T times its rate."""
+    axis = orbit.body_axis(scene)
+    q_of = ballc.orientation.quaternion_multiply
+
+    def about(angle, direction):
+        half = 0.5 * np.asarray(angle)[..., None]
+        return np.concatenate([np.cos(half), np.sin(half) * np.asarray(direction)], axis=-1)
+
+    def sol(t):
+        t = np.asarray(t, dtype=float)
+        theta = 0.4 + 0.2 * np.sin(2 * np.pi * t / period)
+        q = q_of(q_of(about(turn * t, (0, 0, 1)), about(theta, (1, 0, 0))),
+                 about(spin * t, axis))
+        c, s = np.cos(turn * t), np.sin(turn * t)
+        y = np.zeros(t.shape + (ballc._core.N_STATES,))
+        y[..., layout.QUATERNION] = q
+        y[..., 4] = centre[0] + 0.7 * c - 0.2 * s
+        y[..., 5] = centre[1] + 0.7 * s + 0.2 * c
+        y[..., 6] = scene.radius - 0.0174
+        w = (0.3 + 0.1 * np.sin(2 * np.pi * t / period), -0.5, 1.1)
+        y[..., 7], y[..., 8], y[..., 9] = c * w[0] - s * w[1], s * w[0] + c * w[1], w[2]
+        y[..., 10], y[..., 11] = -0.8 * s, 0.8 * c
+        y[..., layout.INDEX["dissipated_normal"]] = 1e-3 * t
+        return np.moveaxis(y, -1, 0)
+
+    return sol
+
+
+def test_the_measurement_finds_a_made_up_orbit_exactly():
+    """Criteria 3-5 on a solution known in closed form: the period to the root finder's
+    tolerance, G as constructed, each crossing a root of the tilt's middle level, and the
+    closed form G^k y(c0 + s) equal to the solution itself 5000 periods on."""
+    scene = ballc.Scene()
+    period, turn, spin, centre = 2.0, 0.3, 1.3, np.array([0.4, -0.9])
+    sol = _synthetic_orbit(scene, period, turn, spin, centre)
+    axis = orbit.body_axis(scene)
+    t1 = orbit.TRIAL_PERIODS * period
+    threshold = ballc.resting.energy_threshold(scene, 1e-10, 1e-10)
+    found = orbit.measure(sol, 0.0, t1, axis, period, 1e-10, 1e-10, threshold,
+                          scene.parameter_vector())
+    assert found is not None
+    c0, measured, motion, rate = found
+    assert abs(measured - period) < 1e-12
+    phi = turn * period
+    assert abs(motion.phi - phi) < 1e-12 and abs(motion.psi - spin * period) < 1e-12
+    rotation = np.array([[np.cos(phi), -np.sin(phi)], [np.sin(phi), np.cos(phi)]])
+    np.testing.assert_allclose(motion.d, centre - rotation @ centre, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(motion.dissipated, (1e-3 * period, 0.0), rtol=0, atol=1e-15)
+    assert abs(rate) < 1e-12
+    # c0: the first upward crossing of the middle of the sampled tilt, to rounding
+    grid = np.linspace(0.0, t1, int(orbit.TILT_SAMPLES * t1 / period) + 2)
+    a_z = np.array([orbit.tilt(sol(t), axis) for t in grid])
+    level = 0.5 * (a_z.max() + a_z.min())
+    below = np.flatnonzero((a_z[:-1] < level) & (a_z[1:] >= level))[0]
+    assert grid[below] <= c0 <= grid[below + 1]
+    assert abs(orbit.tilt(sol(c0), axis) - level) < 1e-14
+    far = c0 + 5000 * period + np.array([0.0, 0.3, 1.7])
+    closed = orbit.RelativePeriodicOrbit(t1, 1e5, c0, measured, motion, sol)
+    np.testing.assert_allclose(closed(far), sol(far), rtol=0, atol=1e-8)
+
+
+def test_a_made_up_motion_that_does_not_repeat_is_refused():
+    """Criterion 4: the same made-up motion with its centre drifting (not a turn and a
+    shift of the scene) is no relative periodic orbit."""
+    scene = ballc.Scene()
+    periodic = _synthetic_orbit(scene, 2.0, 0.3, 1.3, np.array([0.4, -0.9]))
+
+    def drifting(t):
+        y = periodic(t)
+        y[4] = y[4] + 1e-6 * np.asarray(t) ** 2
+        return y
+
+    threshold = ballc.resting.energy_threshold(scene, 1e-10, 1e-10)
+    assert orbit.measure(drifting, 0.0, 7.0, orbit.body_axis(scene), 2.0, 1e-10, 1e-10,
+                         threshold, scene.parameter_vector()) is None

@@ -31,7 +31,6 @@
 #define MAX_TRANSITIONS 100000
 #define MAX_STALLED 100
 #define MIN_IMPACT_RATE 1e-9
-#define ORBIT_TRIAL_PERIODS 3.5   /* orbit.TRIAL_PERIODS */
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
@@ -159,6 +158,9 @@ void ballc_drive_free(ballc_drive_output *o)
     free(o->t); free(o->y); free(o->block_count); free(o->block_flags);
     free(o->block_latch); free(o->contacts); free(o->phases);
     free(o->pieces); free(o->dense_t); free(o->dense_c); free(o->dense_kind);
+    ballc_dense_free(&o->orbit_base);
+    free(o->trials);
+    o->trials = NULL;
     free(o->switch_t); free(o->switch_to);
     o->switch_t = NULL; o->switch_to = NULL;
     free(o->user_hit_event); free(o->user_hit_t); free(o->user_hit_y);
@@ -208,6 +210,11 @@ typedef struct {
     /* the bridge's _ball_event cache: the last compliant margins computed */
     double margins_y[N], margins_out[6];
     int margins_plane, margins_solved;
+    /* ballc.orbit: the trial under way (_Run.orbit_trial: its plane, span, period guess
+     * and segments; broken by an event), and whether the last one was just refused */
+    int trial_on, trial_plane, trial_broken, trial_failed;
+    double trial_from, trial_to, trial_guess;
+    ballc_dense trial;
 } run_t;
 
 enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
@@ -1241,9 +1248,113 @@ static int rolls(const run_t *r, const double *y, double t_start, double t,
     return slip_speed <= c->rolls_dv ? BALLC_END_ROLLING : BALLC_END_SLIDING;
 }
 
+/* ---- the periodic end state (ballc.orbit; _orbit.c) ---- */
+
+/* the trial's log: (t_from, t_to, accepted) */
+static int log_trial(run_t *r)
+{
+    ballc_drive_output *o = r->o;
+    if (grow((void **)&o->trials, &o->cap_trials, 3 * (o->n_trials + 1), sizeof(double)))
+        return -2;
+    double *k = o->trials + 3 * o->n_trials++;
+    k[0] = r->trial_from;
+    k[1] = r->trial_to;
+    k[2] = 0.0;
+    return 0;
+}
+
+/* _Run.plan_orbit_trial: at a rest check that found no end state, with no trial under
+ * way, start one (criteria 1-2) when it ends before t_end; the next rest check is then
+ * at the latest at its end.  Not at once after a refused trial.  0, or -2 (memory) */
+static int plan_orbit_trial(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    if (r->trial_on) return 0;
+    if (r->trial_failed) {   /* not at once again: at the next scheduled rest check */
+        r->trial_failed = 0;
+        return 0;
+    }
+    double rate = sqrt(ballc_dot3_fma(r->y + BALLC_STATE_OMEGA_X));
+    if (!(rate > 0)) return 0;
+    double guess = 2 * M_PI / rate;
+    double t_to = r->t + BALLC_ORBIT_TRIAL_PERIODS * guess;
+    if (!(t_to < c->t_end)
+            || !ballc_orbit_equivariant(c->params, r->latch, run_flags(r, 1), r->y,
+                                        c->orbit_axis))
+        return 0;
+    r->trial_on = 1;
+    r->trial_plane = p;
+    r->trial_broken = 0;
+    r->trial_from = r->t;
+    r->trial_to = t_to;
+    r->trial_guess = guess;
+    ballc_dense_clear(&r->trial);
+    r->rest_check[p] = py_min(r->rest_check[p], t_to);
+    return log_trial(r);
+}
+
+/* orbit.Trial.add: the segment [t0, t1] of the trial under way, or (an event ended it,
+ * or it was flown) the trial broken.  0, or -2 (memory) */
+static int trial_add(run_t *r, const radau5_result *res, double t0, double t1, int reached,
+                     int flown)
+{
+    ballc_dense *d = &r->trial;
+    double end = d->n_pieces ? d->t1[d->n_pieces - 1] : r->trial_from;
+    if (r->trial_broken) return 0;
+    if (!reached || flown || t0 != end) {
+        r->trial_broken = 1;
+        return 0;
+    }
+    if (!res->n_dense) return 0;   /* nothing integrated */
+    return ballc_dense_add(d, t0, t1, res->n_dense, res->dense_t, res->dense_c,
+                           res->dense_kind, res->dense_terms, N) ? -2 : 0;
+}
+
+/* _Run.check_orbit: when this check ends the trial under way, the relative periodic
+ * orbit if criteria 3-5 hold (BALLC_END_ROLLING or SLIDING, o->orbit and its base),
+ * else 0 (and the trial is over); before the trial's end, 0 and the next check at the
+ * latest at its end.  -1 when the trial's solution failed, -2 out of memory. */
+static int check_orbit(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    ballc_drive_output *o = r->o;
+    if (!r->trial_on || r->trial_plane != p) return 0;
+    if (r->t < r->trial_to) {
+        r->rest_check[p] = py_min(r->rest_check[p], r->trial_to);
+        return 0;
+    }
+    r->trial_on = 0;
+    r->trial_failed = 1;
+    ballc_dense *d = &r->trial;
+    if (r->trial_broken || !d->n_pieces || d->t1[d->n_pieces - 1] != r->t) return 0;
+    const ballc_piecewise *solution = ballc_dense_view(d);
+    if (!solution) return -2;
+    double atol[N];
+    for (int i = 0; i < N; i++) atol[i] = c->atol;
+    ballc_orbit_tolerances tol = {c->rtol, atol, c->rest_factor, c->rest_threshold,
+                                  c->params};
+    ballc_orbit orbit;
+    int found = ballc_orbit_measure(ballc_piecewise_states, (void *)solution, r->trial_from,
+                                    r->t, c->orbit_axis, r->trial_guess, &tol, &orbit);
+    if (found < 0) return found == -2 ? -2 : -1;
+    if (!found) return 0;
+    r->trial_failed = 0;
+    o->trials[3 * (o->n_trials - 1) + 2] = 1.0;
+    /* sticking (Coulomb's stick, the compliant law's elastic mode) is rolling */
+    double u[2], speed, error, clear;
+    slip(r, p, r->y, u, &speed, &error, &clear);
+    int sticking = r->coulomb[p] == BALLC_MODE_STICK
+                   || (r->coulomb[p] == BALLC_MODE_NONE && r->compliant[p] == COMPLIANT_ELASTIC);
+    o->end_orbit = 1;
+    o->orbit = orbit;
+    if (ballc_dense_span(d, orbit.c0, orbit.c0 + orbit.period, &o->orbit_base)) return -2;
+    return sticking || speed <= c->rest_factor * error ? BALLC_END_ROLLING : BALLC_END_SLIDING;
+}
+
 /* _Run.end_state at a rest check on plane p at (r->t, r->y): BALLC_END_* when the run
- * finishes in closed form from here (r->y the new state), 0 to go on (the next check
- * scheduled), -1 to fall back (an orbit's trial would start, or Python would raise) */
+ * finishes in closed form from here (r->y the new state, or the state of the orbit's
+ * start), 0 to go on (the next check scheduled), -1 to fall back (where Python would
+ * raise), -2 out of memory */
 static int end_state(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
@@ -1272,13 +1383,9 @@ static int end_state(run_t *r, int p)
         return kind;
     }
     if (!c->orbit_applies) return 0;
-    /* _Run.plan_orbit_trial: a trial may start (then orbit.equivariant, not ported,
-     * decides): fall back; with no spin, or a trial that would end after t_end, none */
-    double rate = sqrt(ballc_dot3_fma(r->y + BALLC_STATE_OMEGA_X));
-    if (!(rate > 0)) return 0;
-    double guess = 2 * M_PI / rate;
-    double t_to = r->t + ORBIT_TRIAL_PERIODS * guess;
-    return t_to < c->t_end ? -1 : 0;
+    kind = check_orbit(r, p);
+    if (kind) return kind;
+    return plan_orbit_trial(r, p);
 }
 
 /* pieces.append((t0, t1, sol.interpolant)): the segment's steps kept (stage 2b), or an
@@ -1399,6 +1506,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         int flags = run_flags(r, 1);
+        int trial = r->trial_on;   /* an orbit's trial needs dense output */
         r->seg_flags = flags;
         if (segment_events(r, flags)) { rc = -1; break; }
         r->n_rearmed = 0;
@@ -1465,7 +1573,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.ev_fun = drv_event;
         pr.ev_terminal = r->ev_terminal;
         pr.ev_direction = r->ev_direction;
-        pr.dense_output = c->dense_output;
+        pr.dense_output = c->dense_output || trial;
         pr.controller = c->controller;
         pr.outputs_checked = 1;
         pr.refine_events = 1;
@@ -1568,6 +1676,9 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             radau5_free(&res);
             break;
         }
+        if (trial && trial_add(r, &res, r->t, t_stop, res.status == RADAU5_REACHED, flown)) {
+            radau5_free(&res); rc = -2; break;
+        }
         if (res.status == RADAU5_REACHED) {
             if (c->dense_output && add_piece(r, &res, r->t, t_stop, flown)) {
                 radau5_free(&res); rc = -2; break;
@@ -1583,7 +1694,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 }
                 int p = c->resting_plane;
                 int kind = end_state(r, p);
-                if (kind < 0) { rc = -1; break; }
+                if (kind < 0) { rc = kind; break; }
                 if (kind) {   /* to t_end in closed form: the samples are Python's */
                     o->end_kind = kind;
                     o->end_plane = p;
@@ -1657,6 +1768,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     o->nlu = nlu;
     free(r->rearmed_t);
     free(r->rearmed_latch);
+    ballc_dense_free(&r->trial);
     free(r);
 #ifdef RADAU5_PROFILE
     o->drive_ns = thread_ns() - started;

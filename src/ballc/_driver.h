@@ -1,5 +1,5 @@
 /* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1, 2a -- the
- * rest checks of ballc.resting; an orbit's trial, ballc.orbit, falls back --, 2b: t_eval
+ * rest checks of ballc.resting, and ballc.orbit's trial in _orbit.c --, 2b: t_eval
  * and dense output, 2c: method "auto" and exact flight, ballc.flight, 3: the compliant
  * law's exact modes, ballc.compliantmodes, and 4: user events).
  *
@@ -22,6 +22,7 @@
 #define BALLC_DRIVER_H
 
 #include "ballc_kernels.h"
+#include "_orbit.h"
 
 double ballc_py_hypot(int n, const double *values);
 double ballc_py_ulp(double x);
@@ -91,12 +92,15 @@ typedef struct {                       /* constants of one run, filled by the br
     /* the rest checks (ballc.resting; stage 2a), constants computed by Python */
     int observer_massive;              /* observer_mass > 0 */
     int rolls_allowed;                 /* flight.scene_allows: uniform motion possible */
-    int orbit_applies;                 /* orbit.applies: a check finding nothing falls back */
+    int orbit_applies;                 /* orbit.applies: a check finding nothing tries an orbit */
     double rest_threshold;             /* resting.energy_threshold */
     double rho_eq, z_eq;               /* equilibrium_penetration, radius - rho_eq */
     double rest_weight;                /* total_mass * gravity */
     double observer_weight;            /* observer_mass * gravity */
     double rolls_dv, rolls_level, half_mass;   /* resting.rolls: dv, 1e3 eps g, 0.5 M */
+    /* ballc.orbit, run at the rest checks when orbit_applies (_orbit.c) */
+    double orbit_axis[3];              /* orbit.body_axis */
+    double rest_factor;                /* resting.REST_FACTOR */
 } ballc_drive_config;
 
 /* how a run ended at a rest check (ballc.resting): the state from end_t on is end_y */
@@ -160,6 +164,14 @@ typedef struct {
      * the segments, and in the whole of ballc_drive; zeros otherwise */
     int profiled;
     double integrator_ns, drive_ns;
+    /* ballc.orbit: with end_orbit, the end state (end_kind rolling or sliding) is the
+     * relative periodic orbit ``orbit``, y(t) from orbit_base (its trial's solution over
+     * [c0, c0 + T]); every trial (t_from, t_to, accepted), 3 numbers each in trials */
+    int end_orbit;
+    ballc_orbit orbit;
+    ballc_dense orbit_base;
+    long n_trials, cap_trials;
+    double *trials;
 } ballc_drive_output;
 
 int ballc_drive(const ballc_drive_config *config, const double *y0,

@@ -67,6 +67,8 @@ cdef extern from "_driver.h":
         int observer_massive, rolls_allowed, orbit_applies
         double rest_threshold, rho_eq, z_eq, rest_weight, observer_weight
         double rolls_dv, rolls_level, half_mass
+        double orbit_axis[3]
+        double rest_factor
     ctypedef struct ballc_contact_rec:
         int plane, ended, passed_through, rate_is_kernel_value
         double t_start, t_end
@@ -130,6 +132,11 @@ cdef extern from "_driver.h":
         double end_y[19]
         int profiled
         double integrator_ns, drive_ns
+        int end_orbit
+        ballc_orbit orbit
+        ballc_dense orbit_base
+        long n_trials
+        double *trials
     int ballc_drive(const ballc_drive_config *, const double *, ballc_drive_output *) nogil
     void ballc_drive_free(ballc_drive_output *) nogil
 
@@ -307,6 +314,9 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.rolls_dv = k["rolls_dv"]
     c.rolls_level = k["rolls_level"]
     c.half_mass = k["half_mass"]
+    for j in range(3):
+        c.orbit_axis[j] = k["orbit_axis"][j]
+    c.rest_factor = k["rest_factor"]
     for p in range(2):
         c.contact_bits[p] = k["contact_bits"][p]
         c.slip_bits[p] = k["slip_bits"][p]
@@ -391,7 +401,14 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                        piece.n_steps * (1 + piece.terms) * BALLC_N_STATES * sizeof(double))
                 memcpy(&dkv[0], o.dense_kind + piece.step0, piece.n_steps * sizeof(int))
             pieces.append((piece.t0, piece.t1, dense_t, dense_c, piece.terms, dense_kind))
-        return dict(t=t, rows=rows, counts=counts, block_flags=block_flags, latches=latches,
+        orbit = None   # ballc.orbit's end: (c0, period, G, rate) and its base's pieces
+        if o.end_orbit:
+            orbit = (o.orbit.c0, o.orbit.period, _motion_tuple(&o.orbit.g), o.orbit.rate,
+                     _dense_pieces(&o.orbit_base))
+        return dict(orbit=orbit,
+                    trials=[(o.trials[3 * i], o.trials[3 * i + 1], bool(o.trials[3 * i + 2]))
+                            for i in range(o.n_trials)],
+                    t=t, rows=rows, counts=counts, block_flags=block_flags, latches=latches,
                     contacts=contacts, phases=phases, pieces=pieces,
                     user_hits=(user_event, user_t, user_y),
                     switches=[(o.switch_t[i], _METHOD_NAMES[o.switch_to[i]])
@@ -408,3 +425,29 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                     integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
     finally:
         ballc_drive_free(&o)
+
+
+cdef list _dense_pieces(const ballc_dense *d):
+    """The pieces of a C buffer of interpolants: [(t0, t1, dense_t, dense_c, terms,
+    dense_kind)], as dense.CompiledInterpolant takes them."""
+    cdef list pieces = []
+    cdef Py_ssize_t k
+    cdef long coef = 0, m, width
+    cdef double[:, ::1] dtv, dcv
+    cdef int[::1] dkv
+    for k in range(d.n_pieces):
+        m = d.n_steps[k]
+        width = (1 + d.terms[k]) * d.width
+        dense_t = np.empty((m, 2))
+        dense_c = np.empty((m, width))
+        dense_kind = np.empty(m, dtype=np.intc)
+        if m:
+            dtv = dense_t
+            dcv = dense_c
+            dkv = dense_kind
+            memcpy(&dtv[0, 0], d.steps + 2 * d.step0[k], m * 2 * sizeof(double))
+            memcpy(&dcv[0, 0], d.coef + coef, m * width * sizeof(double))
+            memcpy(&dkv[0], d.kinds + d.step0[k], m * sizeof(int))
+        coef += m * width
+        pieces.append((d.t0[k], d.t1[k], dense_t, dense_c, d.terms[k], dense_kind))
+    return pieces

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _core
+
 
 class CompiledInterpolant:
     """The compiled integrator's dense output of one segment: per step (t_old, t_new),
@@ -29,53 +31,30 @@ class CompiledInterpolant:
     dop853 (7 terms F0..F6, as scipy's ``Dop853DenseOutput``):
     y = y_old + x (F0 + (1 - x) (F1 + x (F2 + (1 - x) (F3 + x (F4 + (1 - x) (F5 + x F6)))))).
     method="auto" (``kinds``: each step's own number of terms): both kinds in one
-    segment, each step evaluated by its own formula.
+    segment, each step evaluated by its own formula.  Evaluated in C (_dense.c, the
+    one evaluation: the C loop's orbit measurement uses it too).
     """
 
     def __init__(self, steps, coefficients, terms=3, kinds=None):
-        self.steps = np.asarray(steps, dtype=float).reshape(-1, 2)
+        self.steps = np.ascontiguousarray(steps, dtype=float).reshape(-1, 2)
         self.terms = int(terms)
         #: per step, its own number of terms: 3 (radau5) or 7 (dop853); with
         #: method="auto" the two alternate, a radau5 step's rows padded with zeros
-        self.kinds = (np.full(len(self.steps), self.terms) if kinds is None
-                      else np.asarray(kinds, dtype=int).reshape(len(self.steps)))
+        self.kinds = (np.full(len(self.steps), self.terms, dtype=np.intc) if kinds is None
+                      else np.ascontiguousarray(kinds, dtype=np.intc).reshape(len(self.steps)))
         width = np.asarray(coefficients).shape[1] if np.ndim(coefficients) == 2 else 0
         self.n = width // (1 + self.terms)
-        c = np.asarray(coefficients, dtype=float).reshape(len(self.steps),
-                                                          (1 + self.terms) * self.n)
-        self.y_old = c[:, :self.n]
-        self.q = c[:, self.n:].reshape(len(self.steps), self.terms, self.n)
+        self.coefficients = np.ascontiguousarray(coefficients, dtype=float).reshape(
+            len(self.steps), (1 + self.terms) * self.n)
         self.t_min = float(self.steps[0, 0]) if len(self.steps) else np.nan
         self.t_max = float(self.steps[-1, 1]) if len(self.steps) else np.nan
 
     def __call__(self, t):
+        """y(t): (n,) for a scalar t, (n, len(t)) for a 1-D array of times."""
         t = np.asarray(t, dtype=float)
-        scalar = t.ndim == 0
-        tt = np.atleast_1d(t)
-        k = np.clip(np.searchsorted(self.steps[:, 1], tt, side="left"), 0, len(self.steps) - 1)
-        t_old, t_new = self.steps[k, 0], self.steps[k, 1]
-        x = ((tt - t_old) / (t_new - t_old))[:, None]
-        kinds = self.kinds[k]
-        if kinds.size == 0 or np.all(kinds == kinds[0]):   # one kind: as before
-            y = self._evaluate(self.q[k], x, int(kinds[0]) if kinds.size else self.terms)
-        else:   # method="auto": each step by its own method's interpolant
-            y = np.empty((tt.size, self.n))
-            for kind in np.unique(kinds):
-                mask = kinds == kind
-                y[mask] = self._evaluate(self.q[k[mask]], x[mask], int(kind))
-        y = y + self.y_old[k]
-        return y[0] if scalar else y.T
-
-    def _evaluate(self, q, x, terms):
-        """The interpolants' terms at x (without y_old): q (m, terms, n), x (m, 1)."""
-        y = np.zeros((x.shape[0], self.n))
-        if terms == 3:                                  # Horner in x
-            for j in range(2, -1, -1):
-                y = (y + q[:, j]) * x
-        else:                                           # scipy's Dop853DenseOutput
-            for i, j in enumerate(range(terms - 1, -1, -1)):
-                y = (y + q[:, j]) * (x if i % 2 == 0 else 1 - x)
-        return y
+        y = _core.dense_states(self.steps, self.coefficients, self.kinds, self.terms, self.n,
+                               np.ascontiguousarray(t.ravel()))
+        return y[:, 0] if t.ndim == 0 else y
 
 
 class PiecewiseSolution:

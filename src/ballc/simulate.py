@@ -477,20 +477,8 @@ class _Run:
         kind = "rolling" if self.mode(plane) in ("stick", "elastic") or (
             speed <= resting.REST_FACTOR * error) else "free_sliding"
         self.enter_motion(plane, kind)
-        what = "rolls" if kind == "rolling" else "slides freely"
-        kinetic = float(_core.energies(np.ascontiguousarray(self.y[None, :]), self.params)[0, 0])
-        neglected = -rate * (t_end - self.t)
-        share = neglected / kinetic if kinetic > 0 else math.inf
-        self.message = (
-            f"{SUCCESS} The ball {what} on the {plane} from t = {self.t:.9g} s with the "
-            f"wobble of its eccentric observer, a relative periodic orbit (ballc.orbit): "
-            f"every {period:.9g} s its state repeats turned by {motion.phi:.6g} rad about "
-            f"the vertical; from there to t_end the state is that orbit, in closed form. "
-            f"The orbit holds the mechanical energy constant; over the trial it changed at "
-            f"{rate:.2g} W (the contact's dissipation, and the integration's error at this "
-            f"tolerance), {-neglected:.2g} J by t_end ({abs(share):.2g} of the kinetic "
-            f"energy)" + (": more than 1 %, so a tighter rtol would resolve it better."
-                          if abs(share) > 0.01 else "."))
+        self.message = _orbit_message(self.params, plane, self.t, self.y, kind, period,
+                                      motion.phi, rate, t_end)
         return orbit.RelativePeriodicOrbit(self.t, t_end, c0, period, motion, interpolant)
 
     def enter_rest(self, plane):
@@ -550,6 +538,26 @@ def _motion_message(scene, plane, t, y, kind):
             f"{resting.equilibrium_penetration(scene):.6g} m); from there "
             f"to t_end the state is that {kind.replace('free_', '')}, in "
             "closed form.")
+
+
+def _orbit_message(params, plane, t, y, kind, period, phi, rate, t_end):
+    """The message of a run that goes on from ``t`` (state ``y``) as a relative periodic
+    orbit of ``period`` (s) turning by ``phi`` (rad) per period, its mechanical energy
+    having changed at ``rate`` (W) over the trial (either driver)."""
+    what = "rolls" if kind == "rolling" else "slides freely"
+    kinetic = float(_core.energies(np.ascontiguousarray(y[None, :]), params)[0, 0])
+    neglected = -rate * (t_end - t)
+    share = neglected / kinetic if kinetic > 0 else math.inf
+    return (
+        f"{SUCCESS} The ball {what} on the {plane} from t = {t:.9g} s with the "
+        f"wobble of its eccentric observer, a relative periodic orbit (ballc.orbit): "
+        f"every {period:.9g} s its state repeats turned by {phi:.6g} rad about "
+        f"the vertical; from there to t_end the state is that orbit, in closed form. "
+        f"The orbit holds the mechanical energy constant; over the trial it changed at "
+        f"{rate:.2g} W (the contact's dissipation, and the integration's error at this "
+        f"tolerance), {-neglected:.2g} J by t_end ({abs(share):.2g} of the kinetic "
+        f"energy)" + (": more than 1 %, so a tighter rtol would resolve it better."
+                      if abs(share) > 0.01 else "."))
 
 
 def _unsettled_message(what, plane, transitions, stalled, t):
@@ -891,10 +899,10 @@ def _finish(result, options, stiff_at):
 # environment variable BALLC_PYTHON_DRIVER is not set (to anything non-empty) and the
 # integrator seam is not wrapped (_seams_untouched).  The results are bit-identical to
 # the Python loop above (benchmarks/driver_identical.py, tests/test_c_driver.py).
-# Everything else, and a C run that meets what it does not port (a rest check on a
-# Routh sphere where an orbit's trial may start, a kernel failure where Python raises),
-# runs the Python loop from the start.  A rest check that finds rest or uniform motion
-# ends the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
+# Everything else, and a C run that meets what it does not port (a kernel failure
+# where Python raises), runs the Python loop from the start.  A rest check that finds
+# rest, uniform motion or a relative periodic orbit (ballc.orbit, measured in C) ends
+# the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
 
 _C_METHODS = ("radau5", "dop853", "auto")
 #: The C loop's end states (_driver.h: BALLC_END_*; 0 none) by name.
@@ -999,6 +1007,7 @@ def _c_config(scene, options, progress, rest):
         contact_time_base=compliantmodes.contact_time_base(scene),
         observer_massive=int(scene.observer_mass > 0),
         rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbit.applies(scene)),
+        orbit_axis=[float(a) for a in orbit.body_axis(scene)], rest_factor=resting.REST_FACTOR,
         **rest_consts,
         params=params, rtol=options.rtol, atol=options.atol, t_end=options.t_end,
         max_step=float(options.max_step), first_step=options.first_step,
@@ -1095,9 +1104,17 @@ def _simulate_c(scene, options, y, config):
                if len(piece) == 3 else CompiledInterpolant(*piece[2:]))
               for piece in out["pieces"]]
     end = _END_KINDS[end_kind]
+    periodic = out["orbit"]   # (c0, period, G, rate, its base's pieces) or None
     if end:   # a rest check found an end state: to t_end in closed form
         when = out["end_t"]
-        times, closed = _closed_form(end, when, out["end_y"], options.t_end)
+        if periodic is None:
+            times, closed = _closed_form(end, when, out["end_y"], options.t_end)
+        else:   # ballc.orbit: G^k of the trial's solution over [c0, c0 + T]
+            c0, period, motion, _, base = periodic
+            base = PiecewiseSolution([(a, b, CompiledInterpolant(*rest)) for a, b, *rest in base])
+            closed = orbit.RelativePeriodicOrbit(when, options.t_end, c0, period,
+                                                 orbit.Motion.from_array(motion), base)
+            times = orbit.sample_times(when, options.t_end, period)
         if options.dense_output:
             pieces.append((when, options.t_end, closed))
         t = np.concatenate([t, times])
@@ -1134,8 +1151,13 @@ def _simulate_c(scene, options, y, config):
         plane = PLANES[out["end_plane"]]
         when = out["end_t"]
         _record_end(contacts[out["open"][out["end_plane"]]], end, when)
-        message = (_rest_message(scene, plane, when) if end == "rest"
-                   else _motion_message(scene, plane, when, out["end_y"], end))
+        if periodic is not None:
+            message = _orbit_message(config["params"], plane, when, out["end_y"], end,
+                                     periodic[1], periodic[2][0], periodic[3], options.t_end)
+        elif end == "rest":
+            message = _rest_message(scene, plane, when)
+        else:
+            message = _motion_message(scene, plane, when, out["end_y"], end)
     if counts[-1]:   # still in contact at the end
         last = states[:, -1]
         for k in out["open"]:
@@ -1168,6 +1190,8 @@ def _simulate_c(scene, options, y, config):
     result._driver = "c"
     result._driver_counts = {key: out[key] for key in (
         "segments", "profiled", "integrator_ns", "drive_ns")}
+    #: ballc.orbit's trials: [(t_from, t_to, accepted)]
+    result._orbit_trials = out["trials"]
     stiff_at = out["stiff_at"]
     return _finish(result, options, None if math.isnan(stiff_at) else stiff_at)
 
