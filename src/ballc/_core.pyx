@@ -393,6 +393,7 @@ def contact_forces_per_sample(const double[:, ::1] states, const double[::1] par
 # ---- the radau5 integrator (imported as ballc._radau5) ----
 
 include "_radau5_bridge.pxi"
+include "_scipy_bridge.pxi"
 include "_driver_bridge.pxi"
 
 

@@ -1,10 +1,8 @@
 /* See _driver.h.  Each step names the Python it reproduces (file:function); the
  * floating-point operations are those of the Python, in its order.  Compiled with the
  * rest of the extension: -std=c99, so no FP contraction (never -ffast-math). */
-#ifdef RADAU5_PROFILE
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
 #include <time.h>
-#endif
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -208,6 +206,11 @@ typedef struct {
     /* the bridge's _ball_event cache: the last compliant margins computed */
     double margins_y[N], margins_out[6];
     int margins_plane, margins_solved;
+    /* issue 29b: the last poll (wall time, s), whether one stopped the run, and the
+     * segment integrator's own interpolant (-1: its dense steps are in the result) */
+    double polled;
+    int interrupted;
+    long seg_interpolant;
 } run_t;
 
 enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
@@ -744,6 +747,39 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     return status;
 }
 
+/* A re-arm at t: (t, the latch before) for the samples' blocks (Samples.add_later);
+ * -1 out of memory */
+static int note_rearm(run_t *r, double t)
+{
+    if (grow((void **)&r->rearmed_t, &r->cap_rearmed, r->n_rearmed + 1, sizeof(double)))
+        return -1;
+    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * NL * sizeof(double));
+    if (!lat) return -1;
+    r->rearmed_latch = lat;
+    r->rearmed_t[r->n_rearmed] = t;
+    memcpy(r->rearmed_latch + r->n_rearmed * NL, r->latch, NL * sizeof(double));
+    r->n_rearmed++;
+    return 0;
+}
+
+/* A user's LinearEvent with ``rearm`` (ballc.events): called back; accepted, the event
+ * goes on as its new row and offset for the rest of the segment, and the run with the
+ * latch returned (the samples from t on carry it) */
+static int user_rearm(run_t *r, int e, double t, const double *y)
+{
+    const ballc_drive_config *c = r->c;
+    double coef[N], offset, latch[NL];
+    int got = c->rearm_fun(c->user_ctx, r->ev_plane[e], t, y, coef, &offset, latch);
+    if (got < 0) r->user_failed = 1;   /* the loop stops: the bridge raises it */
+    if (got != 1 || note_rearm(r, t)) return 0;
+    memcpy(r->ev_coef + (size_t)e * N, coef, sizeof coef);
+    r->ev_offset[e] = offset;
+    r->ev_index[e] = -1;
+    memcpy(r->latch, latch, sizeof latch);
+    r->margins_plane = -1;   /* the margins read the latch */
+    return 1;
+}
+
 /* _Run.rearm_approach's closure */
 static int drv_rearm(void *ctx, int e, double t, const double *y)
 {
@@ -753,24 +789,18 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
         r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + 2 : code - 2;
         return 1;
     }
+    if (r->ev_kind[e] == K_USER) return user_rearm(r, e, t, y);
     int p = r->ev_plane[e];
     long stalled = stalled_at(r, t);
     if (unsettled(r, p, stalled) || r->relatches[p] + 1 > MAX_RELATCH) return 0;
     double u[2], speed, error, clear;
     slip(r, p, y, u, &speed, &error, &clear);
     if (!slips_on_freely(r, p, u, speed, error, clear)) return 0;
-    if (grow((void **)&r->rearmed_t, &r->cap_rearmed, r->n_rearmed + 1, sizeof(double)))
-        return 0;
-    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * NL * sizeof(double));
-    if (!lat) return 0;
-    r->rearmed_latch = lat;
+    if (note_rearm(r, t)) return 0;
     r->stalled = stalled;
     r->last_transition = t;
     r->has_last_transition = 1;
     r->relatches[p] += 1;
-    r->rearmed_t[r->n_rearmed] = t;
-    memcpy(r->rearmed_latch + r->n_rearmed * NL, r->latch, NL * sizeof(double));
-    r->n_rearmed++;
     double d[2] = {u[0] / speed, u[1] / speed};
     double approach = py_min(clear, APPROACH_FRACTION * speed);
     if (set_mode(r, p, BALLC_MODE_SLIP, d, 1, approach)) return 0;
@@ -890,6 +920,7 @@ static int segment_events(run_t *r, int flags)
                           -1, 0, offset, left, c->user_direction[u]);
         r->ev_index[k] = c->user_linear[u] ? c->user_index[u] : -1;
         r->ev_scale[k] = c->user_linear[u] ? c->user_scale[u] : 0.0;
+        r->ev_rearm[k] = c->user_rearm && c->user_linear[u] && c->user_rearm[u];
         if (!c->user_linear[u]) {   /* a callable: evaluated in Python, through the bridge */
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = -2 - u;
@@ -1053,12 +1084,24 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
     int he[2 * MAX_EVENTS], nh = 0;
     for (int e = 0; e < r->n_ev; e++) {   /* FreeFlight.event_polynomial, crossings */
         int k = r->ev_index[e];
-        if (k < 0 || r->ev_nonlinear[e]) return -1;
-        double scale = r->ev_scale[e], y0k = r->y[k];
-        double c0 = scale * y0k + r->ev_offset[e];
-        double c1 = scale * (k >= BALLC_STATE_X && k <= BALLC_STATE_Z ? r->y[k + 6]
-                             : k == BALLC_STATE_VZ ? -g : 0.0);
-        double c2 = k == BALLC_STATE_Z ? -0.5 * scale * g : 0.0;
+        if (r->ev_nonlinear[e]) return -1;
+        double c0, c1, c2;
+        if (k >= 0) {
+            double scale = r->ev_scale[e], y0k = r->y[k];
+            c0 = scale * y0k + r->ev_offset[e];
+            c1 = scale * (k >= BALLC_STATE_X && k <= BALLC_STATE_Z ? r->y[k + 6]
+                          : k == BALLC_STATE_VZ ? -g : 0.0);
+            c2 = k == BALLC_STATE_Z ? -0.5 * scale * g : 0.0;
+        } else {   /* several states (none of the quaternion's): plain C dots */
+            const double *row = r->ev_coef + (size_t)e * N;
+            c0 = 0.0;
+            for (int i = 0; i < N; i++) c0 += row[i] * r->y[i];
+            c0 += r->ev_offset[e];
+            c1 = 0.0;
+            for (int i = 0; i < 3; i++) c1 += row[BALLC_STATE_X + i] * r->y[BALLC_STATE_VX + i];
+            c1 -= row[BALLC_STATE_VZ] * g;
+            c2 = -0.5 * row[BALLC_STATE_Z] * g;
+        }
         double roots[2];
         int n = crossings(c0, c1, c2, r->ev_direction[e], span, roots);
         if (r->ev_terminal[e] > 0 && n > r->ev_terminal[e]) n = r->ev_terminal[e];
@@ -1286,6 +1329,18 @@ static int end_state(run_t *r, int p)
 static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, int flown)
 {
     ballc_drive_output *o = r->o;
+    if (!flown && r->seg_interpolant >= 0) {   /* kept by the integrator (scipy's) */
+        if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1,
+                 sizeof(ballc_piece_rec)))
+            return -1;
+        ballc_piece_rec *k = &o->pieces[o->n_pieces++];
+        memset(k, 0, sizeof *k);
+        k->t0 = t0;
+        k->t1 = t1;
+        k->own = 1;
+        k->interpolant = r->seg_interpolant;
+        return 0;
+    }
     if (flown) {
         if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1,
                  sizeof(ballc_piece_rec)))
@@ -1315,6 +1370,7 @@ static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, i
     k->t0 = t0;
     k->t1 = t1;
     k->flight = 0;
+    k->own = 0;
     k->step0 = o->n_steps;
     k->n_steps = m;
     k->coef0 = o->n_coef;
@@ -1327,6 +1383,58 @@ static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, i
     o->n_steps += m;
     o->n_coef += m * width;
     return 0;
+}
+
+/* ---- the integrator interface (_driver.h) ---- */
+
+int ballc_compiled_integrator(void *ctx, const radau5_problem *problem,
+                              ballc_segment *segment, radau5_result *result)
+{
+    (void)ctx;
+    segment->interpolant = -1;
+    return radau5_solve(problem, result);
+}
+
+double ballc_event_value(const radau5_problem *p, int e, double t, const double *y,
+                         int *status)
+{
+    double g = p->ev_offset[e];
+    *status = 0;
+    if (p->ev_nonlinear != NULL && p->ev_nonlinear[e]) {
+        double v;
+        if (p->ev_fun == NULL) *status = -1;
+        else *status = p->ev_fun(p->ctx, e, t, y, &v);
+        return *status ? NAN : g + v;
+    }
+    const double *c = p->ev_coef + (size_t)e * p->n;
+    for (int i = 0; i < p->n; i++) g += c[i] * y[i];
+    return g;
+}
+
+/* ---- polling: the progress report and Ctrl-C, throttled in wall time ---- */
+
+static double wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Between segments and every RADAU5_POLL_STEPS tries of a compiled step (radau5_problem
+ * .poll): once poll_interval s of wall time have passed since the last, report the time
+ * reached and ask for a pending signal (both the bridge's, with the GIL).  Nonzero: stop
+ * (the bridge raises what it kept: KeyboardInterrupt). */
+static int drv_poll(void *ctx, double t)
+{
+    run_t *r = (run_t *)ctx;
+    const ballc_drive_config *c = r->c;
+    double now = wall_seconds();
+    if (now - r->polled < (c->poll_interval > 0 ? c->poll_interval : 0.1)) return 0;
+    r->polled = now;
+    if ((c->progress && c->progress(c->user_ctx, t))
+            || (c->interrupted && c->interrupted(c->user_ctx)))
+        r->interrupted = 1;
+    return r->interrupted;
 }
 
 /* ---- the loop (simulate.simulate) ---- */
@@ -1358,6 +1466,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     r->rest_check[0] = r->rest_check[1] = INFINITY;
     r->capacity_row[0] = r->capacity_row[1] = -1;
     r->margins_plane = -1;
+    r->polled = wall_seconds();
+    r->seg_interpolant = -1;
     int rc = 0;
     for (int i = 0; i < BALLC_N_PARAMETERS; i++)
         if (!isfinite(c->params[i])) rc = -1;   /* solve_system would raise */
@@ -1386,7 +1496,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         free(times);
     }
     double atol[N];
-    for (int i = 0; i < N; i++) atol[i] = c->atol;
+    for (int i = 0; i < N; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
     double first = c->first_step;
     int has_first = c->has_first_step;
     int implicit = 0;   /* method "auto": the segment starts with radau5 */
@@ -1394,7 +1504,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     int stiff_found = 0;
 
     while (!rc && r->t < c->t_end && r->status == 0) {
-        if (c->interrupted && c->interrupted(c->user_ctx)) {   /* raised by the bridge */
+        if (drv_poll(r, r->t)) {   /* raised by the bridge */
             r->stop_code = BALLC_DRIVE_USER_ERROR;
             break;
         }
@@ -1429,6 +1539,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             int got = flight_segment(r, t_stop, ev, n_eval, &res);
             if (got) { radau5_free(&res); rc = got; break; }
             flown = 1;
+            r->seg_interpolant = -1;
         } else {
         radau5_problem pr;
         memset(&pr, 0, sizeof pr);
@@ -1475,7 +1586,12 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.jacobian_ahead = (flags & c->compliant_any) != 0;
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
-        solved = radau5_solve(&pr, &res);
+        pr.poll = drv_poll;
+        ballc_segment seg = {flags, r->latch, c->params, -1};   /* the integrator interface */
+        memset(&res, 0, sizeof res);
+        solved = (c->integrate ? c->integrate : ballc_compiled_integrator)(
+            c->integrate_ctx, &pr, &seg, &res);
+        r->seg_interpolant = seg.interpolant;
         }
         o->segments++;
         has_first = 0;
@@ -1483,7 +1599,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
 #ifdef RADAU5_PROFILE
         o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
 #endif
-        if (r->user_failed) {   /* solve_system raises the user's exception */
+        if (r->user_failed || r->interrupted || solved == BALLC_INTEGRATOR_RAISED
+                || res.status == RADAU5_INTERRUPTED) {   /* the bridge raises what it kept */
             radau5_free(&res);
             r->stop_code = BALLC_DRIVE_USER_ERROR;
             break;

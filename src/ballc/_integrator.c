@@ -637,7 +637,13 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         goto done;
     }
 
+    long tries = 0;
     for (;;) {
+        if (p->poll != NULL && ++tries % RADAU5_POLL_STEPS == 0 && p->poll(p->ctx, s.t)) {
+            r->status = RADAU5_INTERRUPTED;
+            snprintf(r->message, sizeof r->message, "interrupted at t = %.9g", s.t);
+            break;
+        }
         if (p->max_nfev > 0 && r->nfev >= p->max_nfev) {
             r->status = RADAU5_FAILED;
             snprintf(r->message, sizeof r->message,
