@@ -1125,8 +1125,9 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
         if (r->ev_terminal[e] && seen[e] >= r->ev_terminal[e]) { stop = h; break; }
     }
     double t_end = t1;
-    int kept = 0;
+    int kept = nh;   /* every hit; with a stop, those up to it */
     if (stop >= 0) {
+        kept = 0;
         for (int h = 0; h < nh; h++)   /* hits <= stop (tuples) */
             if (hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])) kept++;
         t_end = py_min(t0 + hs[stop], t1);
@@ -1170,7 +1171,8 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
     if (!res->y_out || !res->hit_event || !res->hit_t || !res->hit_y) return -2;
     for (long i = 0; i < n; i++) flight_at(&f, times[i], res->y_out + (size_t)i * N);
     for (int h = 0, m = 0; h < nh && m < kept; h++) {
-        if (!(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop]))) continue;
+        if (stop >= 0 && !(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])))
+            continue;
         double when = h == stop ? t_end : py_min(t0 + hs[h], t1);
         res->hit_event[m] = he[h];
         res->hit_t[m] = when;
