@@ -5,7 +5,8 @@
  *
  * ballc_drive runs a whole simulation of the subset -- exact Coulomb friction, the
  * compliant law or no friction, user events (callables called back through the
- * bridge), no progress bar, method radau5, dop853 or auto -- and reproduces the Python driver (simulate.py with
+ * bridge), every method through the integrator interface (below), the progress bar and
+ * Ctrl-C polled from C -- and reproduces the Python driver (simulate.py with
  * events.py, stickslip.py, modes.py, samples.py) bit for bit: the same floating-point
  * operations in the same order.  What it does not port ends the run with
  * BALLC_DRIVE_FALLBACK, and simulate() then runs the Python driver from the start.
