@@ -255,6 +255,24 @@ def test_bad_linear_events_and_directions_are_named():
         ballc.simulate(ballc.Scene(), 0.1, events=g)
 
 
+@pytest.mark.parametrize("method", ["radau5", "dop853", "RK45"])
+def test_any_number_of_user_events(method):
+    """60 events (the C loop's arrays were sized for 52): each z = h crossing, every one
+    found where the parabola puts it, the callables' and the LinearEvents' alike."""
+    heights = np.linspace(4.9, 2.0, 60)
+    events = []
+    for k, h in enumerate(heights):
+        if k % 2:
+            events.append(LinearEvent.of_state("z", offset=-h))
+        else:
+            events.append(lambda t, y, h=h: y[Z] - h)
+    result = ballc.simulate(ballc.Scene(), 0.12, method=method, rtol=1e-10, atol=1e-10,
+                            events=events, progress=False)
+    assert result._driver == "c" and len(result.t_events) == 60
+    expected = [[_crossing(5.0, -25.0, h)] for h in heights]
+    np.testing.assert_allclose(np.array(result.t_events), expected, atol=1e-9)
+
+
 @pytest.mark.parametrize("kwargs", [
     dict(method="Radau"), dict(method="LSODA"), dict(atol=np.full(N, 1e-3)),
     dict(events=[LinearEvent(np.eye(N)[Z] + np.eye(N)[X], -1.0)]),

@@ -15,8 +15,7 @@
 #define N BALLC_N_STATES
 #define NL BALLC_N_LATCH
 #define NLP BALLC_N_LATCH_PER_PLANE
-#define MAX_EVENTS 64     /* the driver's (at most 12) and the user's */
-#define MAX_USER_EVENTS (MAX_EVENTS - 12)
+#define DRIVER_EVENTS 12  /* the driver's own events of a segment, at most */
 #define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
 #define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
 
@@ -186,17 +185,19 @@ typedef struct {
     /* this segment's re-arms: (t, latch before) */
     long n_rearmed, cap_rearmed;
     double *rearmed_t, *rearmed_latch;
-    /* the segment's events */
+    /* the segment's events: room for DRIVER_EVENTS + n_user (alloc_events) */
     int n_ev;
-    double ev_coef[MAX_EVENTS * N], ev_offset[MAX_EVENTS];
-    int ev_terminal[MAX_EVENTS], ev_direction[MAX_EVENTS], ev_nonlinear[MAX_EVENTS];
-    int ev_plane_code[MAX_EVENTS], ev_rearm[MAX_EVENTS];
-    int ev_kind[MAX_EVENTS], ev_plane[MAX_EVENTS];
-    int ev_index[MAX_EVENTS];        /* linear in one state: it (exact flight), else -1 */
-    double ev_scale[MAX_EVENTS];     /*   and its coefficient */
+    double *ev_coef, *ev_offset;
+    int *ev_terminal, *ev_direction, *ev_nonlinear;
+    int *ev_plane_code, *ev_rearm;
+    int *ev_kind, *ev_plane;
+    int *ev_index;                   /* linear in one state: it (exact flight), else -1 */
+    double *ev_scale;                /*   and its coefficient */
+    double *flight_s;                /* exact flight's hits (s, event), 2 per event, */
+    int *flight_e, *flight_seen;     /*   and their counts */
     int seg_flags;
     /* the user's events (stage 4): occurrences so far, a callback's error */
-    long user_seen[MAX_USER_EVENTS];
+    long *user_seen;
     int user_failed;
     /* the compliant law's modes (stage 3): per plane */
     int compliant[2], armed[2], capacity_row[2];   /* COMPLIANT_*, bool, -1 or 4/5 */
@@ -1080,8 +1081,8 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
     res->method_end = -1;
     double span = t1 - t0;
     /* the hits (s, event), at most 2 per event, sorted as Python sorts the tuples */
-    double hs[2 * MAX_EVENTS];
-    int he[2 * MAX_EVENTS], nh = 0;
+    double *hs = r->flight_s;
+    int *he = r->flight_e, nh = 0;
     for (int e = 0; e < r->n_ev; e++) {   /* FreeFlight.event_polynomial, crossings */
         int k = r->ev_index[e];
         if (r->ev_nonlinear[e]) return -1;
@@ -1117,8 +1118,8 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
             he[at] = e;
         }
     }
-    int seen[MAX_EVENTS], stop = -1;
-    memset(seen, 0, sizeof seen);
+    int *seen = r->flight_seen, stop = -1;
+    memset(seen, 0, (size_t)r->n_ev * sizeof(int));
     for (int h = 0; h < nh; h++) {
         int e = he[h];
         seen[e]++;
@@ -1441,6 +1442,39 @@ static int drv_poll(void *ctx, double t)
 
 /* ---- the loop (simulate.simulate) ---- */
 
+/* The segment's event arrays, for the driver's events and n_user of the user's; -1 out
+ * of memory (free_events frees what was allocated) */
+static int alloc_events(run_t *r, int n_user)
+{
+    size_t cap = DRIVER_EVENTS + (size_t)(n_user > 0 ? n_user : 0);
+    double *d = malloc(cap * (N + 4) * sizeof(double));
+    int *k = malloc(cap * 11 * sizeof(int));
+    r->user_seen = calloc(n_user > 0 ? (size_t)n_user : 1, sizeof(long));
+    r->ev_coef = d;
+    r->ev_terminal = k;
+    if (!d || !k || !r->user_seen) return -1;
+    r->ev_offset = d + cap * N;
+    r->ev_scale = r->ev_offset + cap;
+    r->flight_s = r->ev_scale + cap;   /* 2 cap */
+    r->ev_direction = k + cap;
+    r->ev_nonlinear = k + 2 * cap;
+    r->ev_plane_code = k + 3 * cap;
+    r->ev_rearm = k + 4 * cap;
+    r->ev_kind = k + 5 * cap;
+    r->ev_plane = k + 6 * cap;
+    r->ev_index = k + 7 * cap;
+    r->flight_seen = k + 8 * cap;
+    r->flight_e = k + 9 * cap;        /* 2 cap */
+    return 0;
+}
+
+static void free_events(run_t *r)
+{
+    free(r->ev_coef);
+    free(r->ev_terminal);
+    free(r->user_seen);
+}
+
 #ifdef RADAU5_PROFILE
 static double thread_ns(void)
 {
@@ -1459,6 +1493,11 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
 #endif
     run_t *r = calloc(1, sizeof(run_t));
     if (!r) return BALLC_DRIVE_NO_MEMORY;
+    if (alloc_events(r, c->n_user)) {
+        free_events(r);
+        free(r);
+        return BALLC_DRIVE_NO_MEMORY;
+    }
     o->open[0] = o->open[1] = -1;
     o->stiff_at = NAN;
     r->c = c;
@@ -1776,6 +1815,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     o->nlu = nlu;
     free(r->rearmed_t);
     free(r->rearmed_latch);
+    free_events(r);
     free(r);
 #ifdef RADAU5_PROFILE
     o->drive_ns = thread_ns() - started;

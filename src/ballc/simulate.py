@@ -943,14 +943,12 @@ _FLAG_BITS = dict(
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
     in the C loop's subset: every method (scipy's through the loop's integrator
-    interface), atol one number or one per state, user events as _c_user_events takes
-    them, t_eval (if given) strictly increasing, slip rows of at most 2 terms (sum() of
+    interface), atol one number or one per state, any user events, t_eval (if given)
+    strictly increasing, slip rows of at most 2 terms (sum() of
     more would be compensated on Python >= 3.12), and the process's hypot and dot as
     the C loop reproduces them (_c_numerics_agree).  (``progress``: the bar is the
     caller's, advanced from C.)"""
     users = _c_user_events(options.events)
-    if users is None:
-        return None
     t_eval = options.t_eval
     if t_eval is not None:   # the C loop takes each segment's points as a range
         t_eval = np.ascontiguousarray(t_eval, dtype=float)
@@ -1022,7 +1020,7 @@ def _c_config(scene, options, progress, rest):
 
 def _c_user_events(events):
     """The user's events as the C loop takes them (UserEvents.for_segment): a dict of
-    arrays, or None when there are more than 52.  A LinearEvent (a subclass too) is
+    arrays.  A LinearEvent (a subclass too) is
     evaluated in C from its coefficients and offset, and its ``rearm``, if any, called
     back; one whose class overrides ``__call__`` (then its own function), and any other
     callable, is called back (CheckedEvent)."""
@@ -1032,8 +1030,6 @@ def _c_user_events(events):
         if not _NO_USER_EVENTS:
             _NO_USER_EVENTS.update(_c_user_events_of([]))
         return _NO_USER_EVENTS
-    if n > 52:
-        return None
     return _c_user_events_of(events)
 
 
