@@ -95,6 +95,19 @@ def test_a_scipy_run_keeps_its_interpolants_and_failures_honest():
     assert 0 < stopped.t[-1] < 1.0 and stopped.nfev <= 600
 
 
+@pytest.mark.parametrize("method", ["Radau", "BDF", "LSODA"])
+def test_c_code_reads_a_scipy_segments_interpolant(method):
+    """The integrator interface's ballc_interpolant_fn (for C code that evaluates a
+    segment's dense output, as an orbit's trial does): scipy's interpolant's values,
+    rows per time, at and between its steps."""
+    result = ballc.simulate(ballc.Scene(), 0.3, method=method, rtol=1e-8, atol=1e-8,
+                            dense_output=True, progress=False)
+    t0, t1, piece = result.sol.pieces[1]   # the first contact's first segment
+    t = np.linspace(t0, t1, 13)
+    rows = _core._scipy_interpolant_rows(piece, t)
+    assert rows.shape == (13, N) and np.array_equal(rows, piece(t).T)
+
+
 @pytest.mark.parametrize("method", ["Radau", "RK23"])
 def test_a_user_event_that_raises_inside_scipy_raises(method):
     def broken(t, y):

@@ -72,6 +72,13 @@ typedef int (*ballc_integrator)(void *ctx, const radau5_problem *problem,
 
 enum { BALLC_INTEGRATOR_RAISED = -100 };
 
+/* An integrator's own interpolant ``id`` (segment->interpolant) at n times t into y (n
+ * rows of N_STATES), with the integrator's ctx: 0, or nonzero when it cannot (an
+ * exception kept for the bridge).  For C code that evaluates a segment's dense output
+ * (ballc.orbit's trial) when the integrator keeps it itself; the compiled integrators'
+ * dense steps are in their result instead. */
+typedef int (*ballc_interpolant_fn)(void *ctx, long id, long n, const double *t, double *y);
+
 /* radau5, dop853 and auto: radau5_solve (ctx unused) */
 int ballc_compiled_integrator(void *ctx, const radau5_problem *problem,
                               ballc_segment *segment, radau5_result *result);
@@ -143,6 +150,7 @@ typedef struct {                       /* constants of one run, filled by the br
     /* issue 29b: the integrator, per-state atol, progress, polling, the user's rearm */
     ballc_integrator integrate;        /* NULL: ballc_compiled_integrator */
     void *integrate_ctx;
+    ballc_interpolant_fn interpolant;  /* its own interpolants (NULL: none) */
     const double *atol_states;         /* N values (NULL: atol for each); atol is then
                                         * their largest (stickslip.error_speed's) */
     /* may be NULL: the simulated time reached, reported at most every poll_interval s of

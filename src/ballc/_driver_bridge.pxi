@@ -70,6 +70,7 @@ cdef extern from "_driver.h":
         int (*integrate)(void *, const radau5_problem *, ballc_segment *,
                          radau5_result *) noexcept nogil
         void *integrate_ctx
+        int (*interpolant)(void *, long, long, const double *, double *) noexcept nogil
         const double *atol_states
         int (*progress)(void *, double) noexcept nogil
         double poll_interval
@@ -318,11 +319,13 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
     c.max_nfev = 0 if k["max_nfev"] is None else k["max_nfev"]
     c.integrate = NULL   # the compiled integrators (radau5_solve)
     c.integrate_ctx = NULL
+    c.interpolant = NULL
     if k["scipy"]:   # one of scipy's methods, called back segment by segment
         scipy_run = _ScipyRun(k["method"], k["scipy_atol"], np.asarray(params), user_ctx[1])
         c.method = -1
         c.integrate = _scipy_integrate
         c.integrate_ctx = <void *>scipy_run
+        c.interpolant = _scipy_interpolant
     else:
         c.method = _method_code(k["method"])
     c.atol_states = NULL

@@ -130,6 +130,41 @@ cdef int _scipy_segment(_ScipyRun run, const radau5_problem *p, ballc_segment *s
             guard.p = NULL
 
 
+cdef int _scipy_interpolant(void *ctx, long id, long n, const double *t,
+                            double *y) noexcept nogil:
+    """ballc_interpolant_fn for scipy's methods (ctx: a _ScipyRun): its kept
+    interpolant ``id`` (an OdeSolution) at n times, rows into y; an exception is kept."""
+    cdef const double[:, ::1] values
+    cdef long i
+    with gil:
+        run = <_ScipyRun>ctx
+        try:
+            times = np.array([t[i] for i in range(n)], dtype=float)
+            values = np.ascontiguousarray(
+                np.asarray(run.interpolants[id](times), dtype=float).reshape(
+                    BALLC_N_STATES, n).T)
+            if n:
+                memcpy(y, &values[0, 0], n * BALLC_N_STATES * sizeof(double))
+            return 0
+        except BaseException as error:
+            run.errors.append(error)
+            return -1
+
+
+def _scipy_interpolant_rows(interpolant, t):
+    """``interpolant`` (a scipy OdeSolution) at the times t as C code reads a scipy
+    run's interpolant (_scipy_interpolant): rows (len(t), N_STATES) (tests)."""
+    cdef const double[::1] tv = np.ascontiguousarray(t, dtype=float)
+    run = _ScipyRun("Radau", 1.0, np.zeros(BALLC_N_PARAMETERS), [])
+    run.interpolants.append(interpolant)
+    out = np.empty((tv.shape[0], BALLC_N_STATES))
+    cdef double[:, ::1] ov = out
+    if _scipy_interpolant(<void *>run, 0, tv.shape[0], &tv[0] if tv.shape[0] else NULL,
+                          &ov[0, 0] if tv.shape[0] else NULL):
+        raise run.errors[0]
+    return out
+
+
 cdef bint _fill_result(sol, int m, radau5_result *res) except -1:
     """solve_ivp's solution as radau5_solve's result (its buffers malloc'd: radau5_free
     frees them); False when out of memory."""
