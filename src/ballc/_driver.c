@@ -1398,22 +1398,6 @@ int ballc_compiled_integrator(void *ctx, const radau5_problem *problem,
     return radau5_solve(problem, result);
 }
 
-double ballc_event_value(const radau5_problem *p, int e, double t, const double *y,
-                         int *status)
-{
-    double g = p->ev_offset[e];
-    *status = 0;
-    if (p->ev_nonlinear != NULL && p->ev_nonlinear[e]) {
-        double v;
-        if (p->ev_fun == NULL) *status = -1;
-        else *status = p->ev_fun(p->ctx, e, t, y, &v);
-        return *status ? NAN : g + v;
-    }
-    const double *c = p->ev_coef + (size_t)e * p->n;
-    for (int i = 0; i < p->n; i++) g += c[i] * y[i];
-    return g;
-}
-
 /* ---- polling: the progress report and Ctrl-C, throttled in wall time ---- */
 
 static double wall_seconds(void)

@@ -59,7 +59,7 @@ enum {
  * its id (>= 0), else -1 and the dense steps are in the result.  It returns
  * RADAU5_DONE, RADAU5_OUT_OF_MEMORY, RADAU5_BAD_PROBLEM, or BALLC_INTEGRATOR_RAISED
  * when it failed with an exception it keeps for the bridge to raise (scipy's methods:
- * the bridge's _scipy_integrate). */
+ * the bridge's _scipy_integrate, which evaluates the events with radau5_event_value). */
 typedef struct {
     int flags;                 /* the segment's ballc_rhs flags */
     const double *latch;       /* the latched values (N_LATCH) at its start */
@@ -83,11 +83,6 @@ typedef int (*ballc_interpolant_fn)(void *ctx, long id, long n, const double *t,
 int ballc_compiled_integrator(void *ctx, const radau5_problem *problem,
                               ballc_segment *segment, radau5_result *result);
 
-/* The value of event e of a segment's problem at (t, y), as the compiled integrators
- * evaluate it: its row dotted with y plus its offset, or ev_fun plus the offset (NaN
- * when that fails); for integrators that locate events themselves. */
-double ballc_event_value(const radau5_problem *problem, int e, double t, const double *y,
-                         int *status);
 
 enum { BALLC_MODE_NONE = 0, BALLC_MODE_SLIP, BALLC_MODE_SLIP_FIXED, BALLC_MODE_STICK };
 

@@ -151,17 +151,25 @@ static int is_nonlinear(const solver_t *s, int e)
     return s->p->ev_nonlinear != NULL && s->p->ev_nonlinear[e];
 }
 
+double radau5_event_value(const radau5_problem *p, int e, double t, const double *y,
+                          int *status)
+{
+    double g = p->ev_offset[e];
+    *status = 0;
+    if (p->ev_nonlinear != NULL && p->ev_nonlinear[e]) {
+        double v;
+        *status = p->ev_fun == NULL ? -1 : p->ev_fun(p->ctx, e, t, y, &v);
+        return *status ? NAN : g + v;
+    }
+    const double *c = p->ev_coef + (size_t)e * p->n;
+    for (int i = 0; i < p->n; i++) g += c[i] * y[i];
+    return g;
+}
+
 static double event_value(const solver_t *s, int e, double t, const double *y)
 {
-    double g = s->p->ev_offset[e];
-    if (is_nonlinear(s, e)) {
-        double v;
-        if (s->p->ev_fun == NULL || s->p->ev_fun(s->p->ctx, e, t, y, &v) != 0) return NAN;
-        return g + v;
-    }
-    const double *c = s->p->ev_coef + (size_t)e * s->n;
-    for (int i = 0; i < s->n; i++) g += c[i] * y[i];
-    return g;
+    int status;
+    return radau5_event_value(s->p, e, t, y, &status);
 }
 
 /* A function of t whose root brentq finds. */

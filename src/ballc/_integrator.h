@@ -216,6 +216,13 @@ typedef struct {
 int radau5_solve(const radau5_problem *problem, radau5_result *result);
 void radau5_free(radau5_result *result);
 
+/* Event e of the problem at (t, y), as the loop evaluates it: its row dotted with y plus
+ * its offset, or ev_fun plus the offset (NaN, and *status nonzero, when that fails);
+ * for integrators that locate the problem's events themselves (scipy's, through the
+ * C loop's integrator interface). */
+double radau5_event_value(const radau5_problem *problem, int e, double t, const double *y,
+                          int *status);
+
 /* radau5_constants (the Radau IIA method's constants, tests only): _radau_iia.h. */
 
 #endif

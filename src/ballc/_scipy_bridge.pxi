@@ -4,7 +4,7 @@
 # ballc.scipy_segment.solve (solve_ivp on the compiled right-hand side, a
 # ``System`` of this module, with its analytic Jacobian for the implicit methods) with
 # the segment's events as _Guard callables over the C loop's own guards
-# (ballc_event_value on the segment's problem, valid while that segment is integrated),
+# (radau5_event_value on the segment's problem, valid while that segment is integrated),
 # and copies its solution into the radau5_result the loop reads.  Its dense output
 # stays a Python object (scipy's OdeSolution), kept here and referenced by the piece's
 # id.  Only converts: the loop (modes, latches, resets, rest checks) stays in C.
@@ -19,8 +19,10 @@ cdef extern from "_driver.h":
         const double *params
         long interpolant
     int BALLC_INTEGRATOR_RAISED
-    double ballc_event_value(const radau5_problem *, int, double, const double *,
-                             int *) nogil
+
+cdef extern from "_integrator.h":
+    double radau5_event_value(const radau5_problem *, int, double, const double *,
+                              int *) nogil
 
 
 class _Kept(Exception):
@@ -30,7 +32,7 @@ class _Kept(Exception):
 
 cdef class _Guard:
     """Event ``e`` of the segment being integrated, as solve_ivp calls an event: g(t, y)
-    with ``terminal`` and ``direction``; its value is the C loop's (ballc_event_value:
+    with ``terminal`` and ``direction``; its value is the C loop's (radau5_event_value:
     the row dotted with y plus the offset, or the system's guard -- stick release, the
     compliant law's margins -- or the user's callable, plus the offset)."""
     cdef const radau5_problem *p
@@ -51,7 +53,7 @@ cdef class _Guard:
             v = np.ascontiguousarray(y, dtype=float)
         if v.shape[0] != BALLC_N_STATES:
             raise ValueError(f"y must have {BALLC_N_STATES} values, got {v.shape[0]}")
-        g = ballc_event_value(self.p, self.e, t, &v[0], &status)
+        g = radau5_event_value(self.p, self.e, t, &v[0], &status)
         if status and self.errors:   # a user's callable raised: stop solve_ivp
             raise _Kept()
         return g
