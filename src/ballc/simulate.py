@@ -660,8 +660,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         Give up (status -1, message, results so far) after this many right-hand-side
         evaluations in all (default 2e7); None: no limit.
     progress : bool, optional
-        Show a tqdm progress bar in simulated time (advanced once per segment).
-        None (default): only when stderr is a terminal.
+        Show a tqdm progress bar in simulated time (refreshed at most every 0.1 s of
+        wall time).  None (default): only when stderr is a terminal.  Whatever the
+        method, Ctrl-C stops a run within about 0.1 s (KeyboardInterrupt).
     exact_flight : bool
         True (default): a free-flight segment is propagated in closed form, not
         integrated, when that is exact -- massless observer (``observer_mass = 0``) and
