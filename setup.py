@@ -21,6 +21,7 @@ core = Extension(
     include_dirs=["generated", "src/ballc"],
     depends=["src/ballc/_radau5_bridge.pxi", "src/ballc/_driver_bridge.pxi",
              "src/ballc/_orbit_bridge.pxi", "src/ballc/_dense.h", "src/ballc/_orbit.h",
+             "src/ballc/_scipy_bridge.pxi",
              "src/ballc/_driver.h", "src/ballc/_system.h", "src/ballc/_lu.h",
              "src/ballc/_integrator.h", "src/ballc/_integrator_private.h",
              "src/ballc/_radau_iia.h", "src/ballc/_dop853.h",

@@ -85,18 +85,6 @@ def test_a_failure_and_the_call_budget_are_bit_identical(monkeypatch):
     _assert_identical(p, _run(monkeypatch, False, scene, 1.2, **kw))
 
 
-@pytest.mark.parametrize("kwargs", [
-    dict(method="Radau"), dict(atol=np.full(_core.N_STATES, 1e-3)),
-    dict(events=[ballc.events.LinearEvent(np.eye(_core.N_STATES)[6]
-                                          + np.eye(_core.N_STATES)[4], -1.0)]),
-], ids=["scipy", "atol per state", "LinearEvent of several states"])
-def test_runs_outside_the_subset_fall_back(monkeypatch, kwargs):
-    kwargs = dict(dict(method="dop853", rtol=1e-3, atol=1e-3), **kwargs)
-    # (a massless observer: exact flight would take the LinearEvent with a BLAS dot)
-    result = _run(monkeypatch, False, ballc.Scene(observer_mass=0), 0.5, **kwargs)
-    assert result._driver == "python"
-
-
 @needs_c_numerics
 def test_an_orbit_runs_in_the_c_loop(monkeypatch):
     """The seed rolls on from 30.9 s: its rest checks find neither rest nor uniform
@@ -336,22 +324,3 @@ def test_a_wrapped_integrator_seam_gets_the_python_driver(monkeypatch):
     result = _run(monkeypatch, False, ballc.Scene(), 0.5, method="dop853", rtol=1e-3,
                   atol=1e-3)
     assert result._driver == "python" and calls
-
-
-def test_ctrl_c_stops_a_long_c_run():
-    """The C loop asks for pending signals before each segment, as the Python driver could
-    be interrupted between segments: a Ctrl-C (SIGINT, raised here 0.2 s into a run of
-    millions of elastic bounces that would take minutes) ends it with KeyboardInterrupt."""
-    import signal
-    import threading
-    scene = ballc.Scene(velocity=(0.0, 0.0, 0.0), observer_mass=0.0, c_tau=1.0,
-                        tangential_model="friction", friction_coefficient=0.0)
-    assert sys.modules["ballc.simulate"]._c_config(
-        scene, ballc.options.check_options(scene, 1e7), False, True) is not None
-    timer = threading.Timer(0.2, signal.raise_signal, (signal.SIGINT,))
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            ballc.simulate(scene, 1e7, progress=False, max_nfev=10**12)
-    finally:
-        timer.cancel()

@@ -394,6 +394,7 @@ def contact_forces_per_sample(const double[:, ::1] states, const double[::1] par
 
 include "_radau5_bridge.pxi"
 include "_orbit_bridge.pxi"
+include "_scipy_bridge.pxi"
 include "_driver_bridge.pxi"
 
 

@@ -1,10 +1,8 @@
 /* See _driver.h.  Each step names the Python it reproduces (file:function); the
  * floating-point operations are those of the Python, in its order.  Compiled with the
  * rest of the extension: -std=c99, so no FP contraction (never -ffast-math). */
-#ifdef RADAU5_PROFILE
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
 #include <time.h>
-#endif
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -17,8 +15,7 @@
 #define N BALLC_N_STATES
 #define NL BALLC_N_LATCH
 #define NLP BALLC_N_LATCH_PER_PLANE
-#define MAX_EVENTS 64     /* the driver's (at most 12) and the user's */
-#define MAX_USER_EVENTS (MAX_EVENTS - 12)
+#define DRIVER_EVENTS 12  /* the driver's own events of a segment, at most */
 #define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
 #define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
 
@@ -190,17 +187,19 @@ typedef struct {
     /* this segment's re-arms: (t, latch before) */
     long n_rearmed, cap_rearmed;
     double *rearmed_t, *rearmed_latch;
-    /* the segment's events */
+    /* the segment's events: room for DRIVER_EVENTS + n_user (alloc_events) */
     int n_ev;
-    double ev_coef[MAX_EVENTS * N], ev_offset[MAX_EVENTS];
-    int ev_terminal[MAX_EVENTS], ev_direction[MAX_EVENTS], ev_nonlinear[MAX_EVENTS];
-    int ev_plane_code[MAX_EVENTS], ev_rearm[MAX_EVENTS];
-    int ev_kind[MAX_EVENTS], ev_plane[MAX_EVENTS];
-    int ev_index[MAX_EVENTS];        /* linear in one state: it (exact flight), else -1 */
-    double ev_scale[MAX_EVENTS];     /*   and its coefficient */
+    double *ev_coef, *ev_offset;
+    int *ev_terminal, *ev_direction, *ev_nonlinear;
+    int *ev_plane_code, *ev_rearm;
+    int *ev_kind, *ev_plane;
+    int *ev_index;                   /* linear in one state: it (exact flight), else -1 */
+    double *ev_scale;                /*   and its coefficient */
+    double *flight_s;                /* exact flight's hits (s, event), 2 per event, */
+    int *flight_e, *flight_seen;     /*   and their counts */
     int seg_flags;
     /* the user's events (stage 4): occurrences so far, a callback's error */
-    long user_seen[MAX_USER_EVENTS];
+    long *user_seen;
     int user_failed;
     /* the compliant law's modes (stage 3): per plane */
     int compliant[2], armed[2], capacity_row[2];   /* COMPLIANT_*, bool, -1 or 4/5 */
@@ -215,6 +214,11 @@ typedef struct {
     int trial_on, trial_plane, trial_broken, trial_failed;
     double trial_from, trial_to, trial_guess;
     ballc_dense trial;
+    /* issue 29b: the last poll (wall time, s), whether one stopped the run, and the
+     * segment integrator's own interpolant (-1: its dense steps are in the result) */
+    double polled;
+    int interrupted;
+    long seg_interpolant;
 } run_t;
 
 enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
@@ -751,6 +755,39 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     return status;
 }
 
+/* A re-arm at t: (t, the latch before) for the samples' blocks (Samples.add_later);
+ * -1 out of memory */
+static int note_rearm(run_t *r, double t)
+{
+    if (grow((void **)&r->rearmed_t, &r->cap_rearmed, r->n_rearmed + 1, sizeof(double)))
+        return -1;
+    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * NL * sizeof(double));
+    if (!lat) return -1;
+    r->rearmed_latch = lat;
+    r->rearmed_t[r->n_rearmed] = t;
+    memcpy(r->rearmed_latch + r->n_rearmed * NL, r->latch, NL * sizeof(double));
+    r->n_rearmed++;
+    return 0;
+}
+
+/* A user's LinearEvent with ``rearm`` (ballc.events): called back; accepted, the event
+ * goes on as its new row and offset for the rest of the segment, and the run with the
+ * latch returned (the samples from t on carry it) */
+static int user_rearm(run_t *r, int e, double t, const double *y)
+{
+    const ballc_drive_config *c = r->c;
+    double coef[N], offset, latch[NL];
+    int got = c->rearm_fun(c->user_ctx, r->ev_plane[e], t, y, coef, &offset, latch);
+    if (got < 0) r->user_failed = 1;   /* the loop stops: the bridge raises it */
+    if (got != 1 || note_rearm(r, t)) return 0;
+    memcpy(r->ev_coef + (size_t)e * N, coef, sizeof coef);
+    r->ev_offset[e] = offset;
+    r->ev_index[e] = -1;
+    memcpy(r->latch, latch, sizeof latch);
+    r->margins_plane = -1;   /* the margins read the latch */
+    return 1;
+}
+
 /* _Run.rearm_approach's closure */
 static int drv_rearm(void *ctx, int e, double t, const double *y)
 {
@@ -760,24 +797,18 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
         r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + 2 : code - 2;
         return 1;
     }
+    if (r->ev_kind[e] == K_USER) return user_rearm(r, e, t, y);
     int p = r->ev_plane[e];
     long stalled = stalled_at(r, t);
     if (unsettled(r, p, stalled) || r->relatches[p] + 1 > MAX_RELATCH) return 0;
     double u[2], speed, error, clear;
     slip(r, p, y, u, &speed, &error, &clear);
     if (!slips_on_freely(r, p, u, speed, error, clear)) return 0;
-    if (grow((void **)&r->rearmed_t, &r->cap_rearmed, r->n_rearmed + 1, sizeof(double)))
-        return 0;
-    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * NL * sizeof(double));
-    if (!lat) return 0;
-    r->rearmed_latch = lat;
+    if (note_rearm(r, t)) return 0;
     r->stalled = stalled;
     r->last_transition = t;
     r->has_last_transition = 1;
     r->relatches[p] += 1;
-    r->rearmed_t[r->n_rearmed] = t;
-    memcpy(r->rearmed_latch + r->n_rearmed * NL, r->latch, NL * sizeof(double));
-    r->n_rearmed++;
     double d[2] = {u[0] / speed, u[1] / speed};
     double approach = py_min(clear, APPROACH_FRACTION * speed);
     if (set_mode(r, p, BALLC_MODE_SLIP, d, 1, approach)) return 0;
@@ -897,6 +928,7 @@ static int segment_events(run_t *r, int flags)
                           -1, 0, offset, left, c->user_direction[u]);
         r->ev_index[k] = c->user_linear[u] ? c->user_index[u] : -1;
         r->ev_scale[k] = c->user_linear[u] ? c->user_scale[u] : 0.0;
+        r->ev_rearm[k] = c->user_rearm && c->user_linear[u] && c->user_rearm[u];
         if (!c->user_linear[u]) {   /* a callable: evaluated in Python, through the bridge */
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = -2 - u;
@@ -1056,16 +1088,28 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
     res->method_end = -1;
     double span = t1 - t0;
     /* the hits (s, event), at most 2 per event, sorted as Python sorts the tuples */
-    double hs[2 * MAX_EVENTS];
-    int he[2 * MAX_EVENTS], nh = 0;
+    double *hs = r->flight_s;
+    int *he = r->flight_e, nh = 0;
     for (int e = 0; e < r->n_ev; e++) {   /* FreeFlight.event_polynomial, crossings */
         int k = r->ev_index[e];
-        if (k < 0 || r->ev_nonlinear[e]) return -1;
-        double scale = r->ev_scale[e], y0k = r->y[k];
-        double c0 = scale * y0k + r->ev_offset[e];
-        double c1 = scale * (k >= BALLC_STATE_X && k <= BALLC_STATE_Z ? r->y[k + 6]
-                             : k == BALLC_STATE_VZ ? -g : 0.0);
-        double c2 = k == BALLC_STATE_Z ? -0.5 * scale * g : 0.0;
+        if (r->ev_nonlinear[e]) return -1;
+        double c0, c1, c2;
+        if (k >= 0) {
+            double scale = r->ev_scale[e], y0k = r->y[k];
+            c0 = scale * y0k + r->ev_offset[e];
+            c1 = scale * (k >= BALLC_STATE_X && k <= BALLC_STATE_Z ? r->y[k + 6]
+                          : k == BALLC_STATE_VZ ? -g : 0.0);
+            c2 = k == BALLC_STATE_Z ? -0.5 * scale * g : 0.0;
+        } else {   /* several states (none of the quaternion's): plain C dots */
+            const double *row = r->ev_coef + (size_t)e * N;
+            c0 = 0.0;
+            for (int i = 0; i < N; i++) c0 += row[i] * r->y[i];
+            c0 += r->ev_offset[e];
+            c1 = 0.0;
+            for (int i = 0; i < 3; i++) c1 += row[BALLC_STATE_X + i] * r->y[BALLC_STATE_VX + i];
+            c1 -= row[BALLC_STATE_VZ] * g;
+            c2 = -0.5 * row[BALLC_STATE_Z] * g;
+        }
         double roots[2];
         int n = crossings(c0, c1, c2, r->ev_direction[e], span, roots);
         if (r->ev_terminal[e] > 0 && n > r->ev_terminal[e]) n = r->ev_terminal[e];
@@ -1081,16 +1125,17 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
             he[at] = e;
         }
     }
-    int seen[MAX_EVENTS], stop = -1;
-    memset(seen, 0, sizeof seen);
+    int *seen = r->flight_seen, stop = -1;
+    memset(seen, 0, (size_t)r->n_ev * sizeof(int));
     for (int h = 0; h < nh; h++) {
         int e = he[h];
         seen[e]++;
         if (r->ev_terminal[e] && seen[e] >= r->ev_terminal[e]) { stop = h; break; }
     }
     double t_end = t1;
-    int kept = 0;
+    int kept = nh;   /* every hit; with a stop, those up to it */
     if (stop >= 0) {
+        kept = 0;
         for (int h = 0; h < nh; h++)   /* hits <= stop (tuples) */
             if (hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])) kept++;
         t_end = py_min(t0 + hs[stop], t1);
@@ -1134,7 +1179,8 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
     if (!res->y_out || !res->hit_event || !res->hit_t || !res->hit_y) return -2;
     for (long i = 0; i < n; i++) flight_at(&f, times[i], res->y_out + (size_t)i * N);
     for (int h = 0, m = 0; h < nh && m < kept; h++) {
-        if (!(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop]))) continue;
+        if (stop >= 0 && !(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])))
+            continue;
         double when = h == stop ? t_end : py_min(t0 + hs[h], t1);
         res->hit_event[m] = he[h];
         res->hit_t[m] = when;
@@ -1393,6 +1439,18 @@ static int end_state(run_t *r, int p)
 static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, int flown)
 {
     ballc_drive_output *o = r->o;
+    if (!flown && r->seg_interpolant >= 0) {   /* kept by the integrator (scipy's) */
+        if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1,
+                 sizeof(ballc_piece_rec)))
+            return -1;
+        ballc_piece_rec *k = &o->pieces[o->n_pieces++];
+        memset(k, 0, sizeof *k);
+        k->t0 = t0;
+        k->t1 = t1;
+        k->own = 1;
+        k->interpolant = r->seg_interpolant;
+        return 0;
+    }
     if (flown) {
         if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1,
                  sizeof(ballc_piece_rec)))
@@ -1422,6 +1480,7 @@ static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, i
     k->t0 = t0;
     k->t1 = t1;
     k->flight = 0;
+    k->own = 0;
     k->step0 = o->n_steps;
     k->n_steps = m;
     k->coef0 = o->n_coef;
@@ -1436,7 +1495,76 @@ static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, i
     return 0;
 }
 
+/* ---- the integrator interface (_driver.h) ---- */
+
+int ballc_compiled_integrator(void *ctx, const radau5_problem *problem,
+                              ballc_segment *segment, radau5_result *result)
+{
+    (void)ctx;
+    segment->interpolant = -1;
+    return radau5_solve(problem, result);
+}
+
+/* ---- polling: the progress report and Ctrl-C, throttled in wall time ---- */
+
+static double wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Between segments and every RADAU5_POLL_STEPS tries of a compiled step (radau5_problem
+ * .poll): once poll_interval s of wall time have passed since the last, report the time
+ * reached and ask for a pending signal (both the bridge's, with the GIL).  Nonzero: stop
+ * (the bridge raises what it kept: KeyboardInterrupt). */
+static int drv_poll(void *ctx, double t)
+{
+    run_t *r = (run_t *)ctx;
+    const ballc_drive_config *c = r->c;
+    double now = wall_seconds();
+    if (now - r->polled < (c->poll_interval > 0 ? c->poll_interval : 0.1)) return 0;
+    r->polled = now;
+    if ((c->progress && c->progress(c->user_ctx, t))
+            || (c->interrupted && c->interrupted(c->user_ctx)))
+        r->interrupted = 1;
+    return r->interrupted;
+}
+
 /* ---- the loop (simulate.simulate) ---- */
+
+/* The segment's event arrays, for the driver's events and n_user of the user's; -1 out
+ * of memory (free_events frees what was allocated) */
+static int alloc_events(run_t *r, int n_user)
+{
+    size_t cap = DRIVER_EVENTS + (size_t)(n_user > 0 ? n_user : 0);
+    double *d = malloc(cap * (N + 4) * sizeof(double));
+    int *k = malloc(cap * 11 * sizeof(int));
+    r->user_seen = calloc(n_user > 0 ? (size_t)n_user : 1, sizeof(long));
+    r->ev_coef = d;
+    r->ev_terminal = k;
+    if (!d || !k || !r->user_seen) return -1;
+    r->ev_offset = d + cap * N;
+    r->ev_scale = r->ev_offset + cap;
+    r->flight_s = r->ev_scale + cap;   /* 2 cap */
+    r->ev_direction = k + cap;
+    r->ev_nonlinear = k + 2 * cap;
+    r->ev_plane_code = k + 3 * cap;
+    r->ev_rearm = k + 4 * cap;
+    r->ev_kind = k + 5 * cap;
+    r->ev_plane = k + 6 * cap;
+    r->ev_index = k + 7 * cap;
+    r->flight_seen = k + 8 * cap;
+    r->flight_e = k + 9 * cap;        /* 2 cap */
+    return 0;
+}
+
+static void free_events(run_t *r)
+{
+    free(r->ev_coef);
+    free(r->ev_terminal);
+    free(r->user_seen);
+}
 
 #ifdef RADAU5_PROFILE
 static double thread_ns(void)
@@ -1456,6 +1584,11 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
 #endif
     run_t *r = calloc(1, sizeof(run_t));
     if (!r) return BALLC_DRIVE_NO_MEMORY;
+    if (alloc_events(r, c->n_user)) {
+        free_events(r);
+        free(r);
+        return BALLC_DRIVE_NO_MEMORY;
+    }
     o->open[0] = o->open[1] = -1;
     o->stiff_at = NAN;
     r->c = c;
@@ -1465,6 +1598,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     r->rest_check[0] = r->rest_check[1] = INFINITY;
     r->capacity_row[0] = r->capacity_row[1] = -1;
     r->margins_plane = -1;
+    r->polled = wall_seconds();
+    r->seg_interpolant = -1;
     int rc = 0;
     for (int i = 0; i < BALLC_N_PARAMETERS; i++)
         if (!isfinite(c->params[i])) rc = -1;   /* solve_system would raise */
@@ -1493,7 +1628,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         free(times);
     }
     double atol[N];
-    for (int i = 0; i < N; i++) atol[i] = c->atol;
+    for (int i = 0; i < N; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
     double first = c->first_step;
     int has_first = c->has_first_step;
     int implicit = 0;   /* method "auto": the segment starts with radau5 */
@@ -1501,7 +1636,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     int stiff_found = 0;
 
     while (!rc && r->t < c->t_end && r->status == 0) {
-        if (c->interrupted && c->interrupted(c->user_ctx)) {   /* raised by the bridge */
+        if (drv_poll(r, r->t)) {   /* raised by the bridge */
             r->stop_code = BALLC_DRIVE_USER_ERROR;
             break;
         }
@@ -1537,6 +1672,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             int got = flight_segment(r, t_stop, ev, n_eval, &res);
             if (got) { radau5_free(&res); rc = got; break; }
             flown = 1;
+            r->seg_interpolant = -1;
         } else {
         radau5_problem pr;
         memset(&pr, 0, sizeof pr);
@@ -1583,7 +1719,12 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.jacobian_ahead = (flags & c->compliant_any) != 0;
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
-        solved = radau5_solve(&pr, &res);
+        pr.poll = drv_poll;
+        ballc_segment seg = {flags, r->latch, c->params, -1};   /* the integrator interface */
+        memset(&res, 0, sizeof res);
+        solved = (c->integrate ? c->integrate : ballc_compiled_integrator)(
+            c->integrate_ctx, &pr, &seg, &res);
+        r->seg_interpolant = seg.interpolant;
         }
         o->segments++;
         has_first = 0;
@@ -1591,7 +1732,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
 #ifdef RADAU5_PROFILE
         o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
 #endif
-        if (r->user_failed) {   /* solve_system raises the user's exception */
+        if (r->user_failed || r->interrupted || solved == BALLC_INTEGRATOR_RAISED
+                || res.status == RADAU5_INTERRUPTED) {   /* the bridge raises what it kept */
             radau5_free(&res);
             r->stop_code = BALLC_DRIVE_USER_ERROR;
             break;
@@ -1769,6 +1911,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     free(r->rearmed_t);
     free(r->rearmed_latch);
     ballc_dense_free(&r->trial);
+    free_events(r);
     free(r);
 #ifdef RADAU5_PROFILE
     o->drive_ns = thread_ns() - started;

@@ -5,7 +5,8 @@
  *
  * ballc_drive runs a whole simulation of the subset -- exact Coulomb friction, the
  * compliant law or no friction, user events (callables called back through the
- * bridge), no progress bar, method radau5, dop853 or auto -- and reproduces the Python driver (simulate.py with
+ * bridge), every method through the integrator interface (below), the progress bar and
+ * Ctrl-C polled from C -- and reproduces the Python driver (simulate.py with
  * events.py, stickslip.py, modes.py, samples.py) bit for bit: the same floating-point
  * operations in the same order.  What it does not port ends the run with
  * BALLC_DRIVE_FALLBACK, and simulate() then runs the Python driver from the start.
@@ -23,6 +24,7 @@
 
 #include "ballc_kernels.h"
 #include "_orbit.h"
+#include "_integrator.h"
 
 double ballc_py_hypot(int n, const double *values);
 double ballc_py_ulp(double x);
@@ -37,8 +39,51 @@ enum {
     BALLC_DRIVE_FALLBACK = 4,    /* not ported here: run the Python driver */
     BALLC_DRIVE_NO_MEMORY = 5,
     BALLC_DRIVE_TERMINATED = 6,  /* a terminal user event (status 1) */
-    BALLC_DRIVE_USER_ERROR = 7   /* a user event raised: the bridge raises it */
+    BALLC_DRIVE_USER_ERROR = 7   /* a user event raised, an integrator raised, or Ctrl-C:
+                                  * the bridge raises the exception it kept */
 };
+
+/* ---- the integrator interface (issue 29) ----
+ *
+ * The loop integrates every segment through one function: ballc_integrator, from the
+ * config (NULL: ballc_compiled_integrator).  ``problem`` is the segment as radau5_solve
+ * takes it -- t0 towards t_bound from y0, the right-hand side (fun, jac and ctx: the
+ * segment's flags and latch), the events (linear rows, or ev_fun for the system's own
+ * and the user's callables; terminal counts, directions, ev_rearm/rearm), rtol, atol
+ * (N values), max_step, first_step, max_nfev, t_eval, dense_output, method,
+ * jacobian_ahead, auto_implicit and poll -- and ``segment`` what an integrator that
+ * does not call back into the problem's fun needs to build its own right-hand side:
+ * the flags and the latch.  The integrator fills ``result`` as radau5_solve does
+ * (samples, event hits, status and message, nfev/njev/nlu, h_next, dense steps; an
+ * integrator without some of them leaves them 0, h_next 0 carries no step, stiff_at
+ * NaN, method_end -1) and may keep its interpolant itself: then segment->interpolant is
+ * its id (>= 0), else -1 and the dense steps are in the result.  It returns
+ * RADAU5_DONE, RADAU5_OUT_OF_MEMORY, RADAU5_BAD_PROBLEM, or BALLC_INTEGRATOR_RAISED
+ * when it failed with an exception it keeps for the bridge to raise (scipy's methods:
+ * the bridge's _scipy_integrate, which evaluates the events with radau5_event_value). */
+typedef struct {
+    int flags;                 /* the segment's ballc_rhs flags */
+    const double *latch;       /* the latched values (N_LATCH) at its start */
+    const double *params;      /* the parameter vector */
+    long interpolant;          /* out: the integrator's own interpolant's id, or -1 */
+} ballc_segment;
+
+typedef int (*ballc_integrator)(void *ctx, const radau5_problem *problem,
+                                ballc_segment *segment, radau5_result *result);
+
+enum { BALLC_INTEGRATOR_RAISED = -100 };
+
+/* An integrator's own interpolant ``id`` (segment->interpolant) at n times t into y (n
+ * rows of N_STATES), with the integrator's ctx: 0, or nonzero when it cannot (an
+ * exception kept for the bridge).  For C code that evaluates a segment's dense output
+ * (ballc.orbit's trial) when the integrator keeps it itself; the compiled integrators'
+ * dense steps are in their result instead. */
+typedef int (*ballc_interpolant_fn)(void *ctx, long id, long n, const double *t, double *y);
+
+/* radau5, dop853 and auto: radau5_solve (ctx unused) */
+int ballc_compiled_integrator(void *ctx, const radau5_problem *problem,
+                              ballc_segment *segment, radau5_result *result);
+
 
 enum { BALLC_MODE_NONE = 0, BALLC_MODE_SLIP, BALLC_MODE_SLIP_FIXED, BALLC_MODE_STICK };
 
@@ -101,6 +146,24 @@ typedef struct {                       /* constants of one run, filled by the br
     /* ballc.orbit, run at the rest checks when orbit_applies (_orbit.c) */
     double orbit_axis[3];              /* orbit.body_axis */
     double rest_factor;                /* resting.REST_FACTOR */
+    /* issue 29b: the integrator, per-state atol, progress, polling, the user's rearm */
+    ballc_integrator integrate;        /* NULL: ballc_compiled_integrator */
+    void *integrate_ctx;
+    ballc_interpolant_fn interpolant;  /* its own interpolants (NULL: none) */
+    const double *atol_states;         /* N values (NULL: atol for each); atol is then
+                                        * their largest (stickslip.error_speed's) */
+    /* may be NULL: the simulated time reached, reported at most every poll_interval s of
+     * wall time (the bridge's: the progress bar), with user_ctx */
+    int (*progress)(void *ctx, double t);   /* nonzero: it raised (kept): stop */
+    double poll_interval;              /* s of wall time between polls: progress and
+                                        * interrupted, between segments and inside the
+                                        * compiled integrators' step loops (<= 0: 0.1) */
+    /* the user's LinearEvents' ``rearm`` (user_rearm[k] nonzero: it has one), called
+     * through rearm_fun with user_ctx: 1 and the event's new row, offset and the latch
+     * the run goes on with written, 0 declined, -1 raised (the exception kept) */
+    const int *user_rearm;
+    int (*rearm_fun)(void *ctx, int k, double t, const double *y, double *coef,
+                     double *offset, double *latch);
 } ballc_drive_config;
 
 /* how a run ended at a rest check (ballc.resting): the state from end_t on is end_y */
@@ -122,6 +185,8 @@ typedef struct {
     int terms;
     int flight;                /* exact flight: FreeFlight(t0, y0, gravity, t_max = t1) */
     double y0[BALLC_N_STATES];
+    int own;                   /* nonzero: the integrator's own interpolant, by its id */
+    long interpolant;
 } ballc_piece_rec;
 
 typedef struct {

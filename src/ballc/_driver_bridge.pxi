@@ -69,6 +69,16 @@ cdef extern from "_driver.h":
         double rolls_dv, rolls_level, half_mass
         double orbit_axis[3]
         double rest_factor
+        int (*integrate)(void *, const radau5_problem *, ballc_segment *,
+                         radau5_result *) noexcept nogil
+        void *integrate_ctx
+        int (*interpolant)(void *, long, long, const double *, double *) noexcept nogil
+        const double *atol_states
+        int (*progress)(void *, double) noexcept nogil
+        double poll_interval
+        const int *user_rearm
+        int (*rearm_fun)(void *, int, double, const double *, double *, double *,
+                         double *) noexcept nogil
     ctypedef struct ballc_contact_rec:
         int plane, ended, passed_through, rate_is_kernel_value
         double t_start, t_end
@@ -91,6 +101,8 @@ cdef extern from "_driver.h":
         int terms
         int flight
         double y0[19]
+        int own
+        long interpolant
     ctypedef struct ballc_drive_output:
         long n
         double *t
@@ -163,6 +175,54 @@ cdef int _drive_interrupted(void *ctx) noexcept nogil:
     return 0
 
 
+cdef int _drive_progress(void *ctx, double t) noexcept nogil:
+    """The progress bar (ctx[3], a tqdm) to the simulated time t; called from C at most
+    every poll_interval s of wall time.  An exception is kept and the run stops."""
+    with gil:
+        try:
+            bar = (<list>ctx)[3]
+            bar.update(t - bar.n)
+        except BaseException as error:
+            (<list>ctx)[1].append(error)
+            return 1
+    return 0
+
+
+cdef int _drive_user_rearm(void *ctx, int k, double t, const double *y, double *coef,
+                           double *offset, double *latch) noexcept nogil:
+    """The ``rearm`` of the user's LinearEvent k (ctx[2][k]) at (t, y), as the radau5
+    bridge's _rearm_event calls it: 0 when it declines (None), 1 with the event's new
+    coefficients, offset and the latch written, -1 when it raised (kept for drive)."""
+    cdef double[::1] yv
+    cdef const double[::1] cv, lv
+    cdef double off
+    with gil:
+        errors = (<list>ctx)[1]
+        if errors:
+            return -1
+        try:
+            state = np.empty(BALLC_N_STATES)
+            yv = state
+            memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+            out = (<list>ctx)[2][k](t, state)
+            if out is None:
+                return 0
+            coefficients, new_offset, new_latch = out
+            cv = _checked_row("rearm coefficients", coefficients, BALLC_N_STATES)
+            lv = _checked_row("rearm latch", new_latch, BALLC_N_LATCH)
+            off = float(new_offset)
+            if not isfinite(off):
+                raise ValueError(f"rearm offset = {new_offset!r} is not allowed: must be "
+                                 "finite")
+            memcpy(coef, &cv[0], BALLC_N_STATES * sizeof(double))
+            memcpy(latch, &lv[0], BALLC_N_LATCH * sizeof(double))
+            offset[0] = off
+            return 1
+        except BaseException as error:
+            errors.append(error)
+            return -1
+
+
 cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
                            double *g) noexcept nogil:
     """The user's callable event k at (t, y), as the radau5 bridge's _user_event calls
@@ -227,8 +287,11 @@ def _hypot_many(const double[:, ::1] v):
     return out
 
 
-def drive(const double[::1] params, const double[::1] y0, dict k):
-    """Run the segment loop in C with the constants ``k`` (simulate._c_config).
+def drive(const double[::1] params, const double[::1] y0, dict k, progress=None):
+    """Run the segment loop in C with the constants ``k`` (simulate._c_config), each
+    segment integrated by ``k["method"]``: a compiled one, or one of scipy's (through
+    _scipy_integrate).  ``progress``: None, or a tqdm bar advanced to the simulated time
+    (at most every ``k["poll_interval"]`` s of wall time, default 0.1).
     Returns None when the run needs the Python driver (nothing of it is kept), else a
     dict of the run's samples, contacts, phases and end."""
     cdef ballc_drive_config c
@@ -244,7 +307,10 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     cdef const double[::1] uoffset = k["user_offset"], uscale = k["user_scale"]
     cdef const int[::1] ulinear = k["user_linear"], uindex = k["user_index"]
     cdef const int[::1] ucount = k["user_count"], udirection = k["user_direction"]
-    cdef list user_ctx = [k["user_events"], []]
+    cdef list user_ctx = [k["user_events"], [], k["user_rearms"], progress]
+    cdef const int[::1] urearm = k["user_rearm"]
+    cdef const double[::1] atol_states = k["atol_states"]   # None: one atol
+    cdef _ScipyRun scipy_run = None
     cdef ballc_piece_rec piece
     cdef double[:, ::1] dtv, dcv
     cdef int[::1] dkv
@@ -258,7 +324,25 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.has_first_step = k["first_step"] is not None
     c.first_step = k["first_step"] if c.has_first_step else 0.0
     c.max_nfev = 0 if k["max_nfev"] is None else k["max_nfev"]
-    c.method = _method_code(k["method"])
+    c.integrate = NULL   # the compiled integrators (radau5_solve)
+    c.integrate_ctx = NULL
+    c.interpolant = NULL
+    if k["scipy"]:   # one of scipy's methods, called back segment by segment
+        scipy_run = _ScipyRun(k["method"], k["scipy_atol"], np.asarray(params), user_ctx[1])
+        c.method = -1
+        c.integrate = _scipy_integrate
+        c.integrate_ctx = <void *>scipy_run
+        c.interpolant = _scipy_interpolant
+    else:
+        c.method = _method_code(k["method"])
+    c.atol_states = NULL
+    if atol_states is not None:
+        c.atol_states = &atol_states[0]
+    c.progress = NULL
+    if progress is not None:
+        c.progress = _drive_progress
+    c.poll_interval = k.get("poll_interval", 0.1)
+    c.rearm_fun = _drive_user_rearm
     c.controller = _controller[0]
     c.observer_bits = k["observer_bits"]
     c.exact = k["exact"]
@@ -284,7 +368,9 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
     c.interrupted = _drive_interrupted
     c.user_coef = c.user_offset = c.user_scale = NULL
     c.user_linear = c.user_index = c.user_count = c.user_direction = NULL
+    c.user_rearm = NULL
     if c.n_user:
+        c.user_rearm = &urearm[0]
         c.user_coef = &ucoef[0, 0]
         c.user_offset = &uoffset[0]
         c.user_scale = &uscale[0]
@@ -384,6 +470,9 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
         pieces = []   # dense output: (t0, t1, dense_t, dense_c, terms, dense_kind), or
         for i in range(o.n_pieces):   # (t0, t1, y0) of an exact flight
             piece = o.pieces[i]
+            if piece.own:   # the integrator's own interpolant (scipy's OdeSolution)
+                pieces.append((piece.t0, piece.t1, scipy_run.interpolants[piece.interpolant]))
+                continue
             if piece.flight:
                 pieces.append((piece.t0, piece.t1,
                                np.array([piece.y0[j] for j in range(BALLC_N_STATES)])))

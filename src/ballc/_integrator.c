@@ -151,17 +151,25 @@ static int is_nonlinear(const solver_t *s, int e)
     return s->p->ev_nonlinear != NULL && s->p->ev_nonlinear[e];
 }
 
+double radau5_event_value(const radau5_problem *p, int e, double t, const double *y,
+                          int *status)
+{
+    double g = p->ev_offset[e];
+    *status = 0;
+    if (p->ev_nonlinear != NULL && p->ev_nonlinear[e]) {
+        double v;
+        *status = p->ev_fun == NULL ? -1 : p->ev_fun(p->ctx, e, t, y, &v);
+        return *status ? NAN : g + v;
+    }
+    const double *c = p->ev_coef + (size_t)e * p->n;
+    for (int i = 0; i < p->n; i++) g += c[i] * y[i];
+    return g;
+}
+
 static double event_value(const solver_t *s, int e, double t, const double *y)
 {
-    double g = s->p->ev_offset[e];
-    if (is_nonlinear(s, e)) {
-        double v;
-        if (s->p->ev_fun == NULL || s->p->ev_fun(s->p->ctx, e, t, y, &v) != 0) return NAN;
-        return g + v;
-    }
-    const double *c = s->p->ev_coef + (size_t)e * s->n;
-    for (int i = 0; i < s->n; i++) g += c[i] * y[i];
-    return g;
+    int status;
+    return radau5_event_value(s->p, e, t, y, &status);
 }
 
 /* A function of t whose root brentq finds. */
@@ -637,7 +645,13 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
         goto done;
     }
 
+    long tries = 0;
     for (;;) {
+        if (p->poll != NULL && ++tries % RADAU5_POLL_STEPS == 0 && p->poll(p->ctx, s.t)) {
+            r->status = RADAU5_INTERRUPTED;
+            snprintf(r->message, sizeof r->message, "interrupted at t = %.9g", s.t);
+            break;
+        }
         if (p->max_nfev > 0 && r->nfev >= p->max_nfev) {
             r->status = RADAU5_FAILED;
             snprintf(r->message, sizeof r->message,

@@ -97,7 +97,14 @@ typedef struct {
                                * step's explicit Euler end (the compliant law's contacts) */
     int auto_implicit;        /* RADAU5_METHOD_AUTO only: nonzero starts with Radau IIA
                                * instead of DOP853 (a segment continuing a stiff one) */
+    /* may be NULL; called with ctx and the time reached every RADAU5_POLL_STEPS tries of a
+     * step (the caller keeps it cheap: a clock test, and now and then a progress report or
+     * a check for Ctrl-C); nonzero stops the integration there with status
+     * RADAU5_INTERRUPTED, keeping what was computed */
+    int (*poll)(void *ctx, double t);
 } radau5_problem;
+
+#define RADAU5_POLL_STEPS 16
 
 /* RADAU5_METHOD_AUTO: LSODA's idea with the two steps.  The call starts with DOP853
  * (unless problem.auto_implicit) and switches to Radau IIA, before the next step, once
@@ -155,7 +162,8 @@ enum {
     RADAU5_CTRL_SCIPY = 0, RADAU5_CTRL_HAIRER = 127
 };
 
-enum { RADAU5_REACHED = 0, RADAU5_EVENT = 1, RADAU5_FAILED = -1 };
+enum { RADAU5_REACHED = 0, RADAU5_EVENT = 1, RADAU5_FAILED = -1,
+       RADAU5_INTERRUPTED = -2 /* problem.poll asked to stop */ };
 /* What radau5_solve returns (result->status says how the integration ended). */
 enum { RADAU5_DONE = 0, RADAU5_OUT_OF_MEMORY = -1, RADAU5_BAD_PROBLEM = -2 };
 
@@ -167,7 +175,8 @@ enum { RADAU5_PROF_FUN = 0, RADAU5_PROF_JAC, RADAU5_PROF_FACTOR, RADAU5_PROF_SOL
        RADAU5_PROF_EVENTS, RADAU5_PROF_TOTAL, RADAU5_PROF_TOTAL_NS, RADAU5_PROF_N };
 
 typedef struct {
-    int status;               /* RADAU5_REACHED, RADAU5_EVENT or RADAU5_FAILED */
+    int status;               /* RADAU5_REACHED, RADAU5_EVENT, RADAU5_FAILED or
+                               * RADAU5_INTERRUPTED */
     char message[240];
     long nfev, njev, nlu, nstep, nreject;
     double h_next;            /* the step size the controller chose for the next step */
@@ -206,6 +215,13 @@ typedef struct {
  * The result always holds what was computed; release it with radau5_free. */
 int radau5_solve(const radau5_problem *problem, radau5_result *result);
 void radau5_free(radau5_result *result);
+
+/* Event e of the problem at (t, y), as the loop evaluates it: its row dotted with y plus
+ * its offset, or ev_fun plus the offset (NaN, and *status nonzero, when that fails);
+ * for integrators that locate the problem's events themselves (scipy's, through the
+ * C loop's integrator interface). */
+double radau5_event_value(const radau5_problem *problem, int e, double t, const double *y,
+                          int *status);
 
 /* radau5_constants (the Radau IIA method's constants, tests only): _radau_iia.h. */
 

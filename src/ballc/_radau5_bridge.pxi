@@ -63,6 +63,7 @@ cdef extern from "_integrator.h":
         int method
         int jacobian_ahead
         int auto_implicit
+        int (*poll)(void *, double) noexcept nogil
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -90,7 +91,8 @@ cdef extern from "_integrator.h":
         int profiled
         double prof[7]
     int radau5_solve(const radau5_problem *, radau5_result *) nogil
-    int RADAU5_DONE, RADAU5_OUT_OF_MEMORY
+    int RADAU5_DONE, RADAU5_OUT_OF_MEMORY, RADAU5_BAD_PROBLEM
+    int RADAU5_REACHED, RADAU5_EVENT, RADAU5_FAILED, RADAU5_INTERRUPTED
     int RADAU5_METHOD_RADAU, RADAU5_METHOD_DOP853, RADAU5_METHOD_AUTO
     void radau5_free(radau5_result *) nogil
 
@@ -630,6 +632,7 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
     p.refine_events = refine_events
     p.ev_rearm = NULL
     p.rearm = NULL
+    p.poll = NULL
     if rearmable:
         ball.rearms = <void *>rearms
         ball.ev_coef_w = &coefv[0, 0]

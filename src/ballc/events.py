@@ -28,11 +28,17 @@ class LinearEvent:
     """An event that is a linear functional of the state: g(y) = coefficients . y + offset.
 
     Callable like a solve_ivp event, ``event(t, y)``, with solve_ivp's ``terminal``
-    and ``direction`` attributes; radau5 reads ``coefficients`` and ``offset`` and
-    evaluates it in C.  Every event of the driver is of this form.  ``rearm`` (None, or
-    a callable (t, y) -> None or (coefficients, offset, latch)): radau5 may re-arm the
-    event where it fires instead of stopping (see ``ballc._radau5.solve_system``);
-    scipy's methods ignore it.
+    and ``direction`` attributes; the C loop reads ``coefficients`` and ``offset`` and
+    evaluates it in C, with every method (a subclass too, unless it overrides
+    ``__call__``: see :func:`is_linear`).  Every event of the driver is of this form.
+    ``rearm`` (None, or a callable (t, y) -> None or (coefficients, offset, latch)):
+    where the terminal event fires, the compiled methods (radau5, dop853, auto) call it
+    at the event's state; None stops there as usual, a triple re-arms it -- the event
+    becomes coefficients . y + offset for the rest of the segment (the next segment
+    starts with the event as given again), the run goes on from that state with
+    ``latch`` (N_LATCH values, which must leave the right-hand side unchanged there;
+    the samples from then on carry it) and the hit is not reported (see
+    ``ballc._radau5.solve_system``).  Exact flight and scipy's methods ignore it.
     """
 
     __slots__ = ("coefficients", "offset", "terminal", "direction", "_index", "_scale",
@@ -96,6 +102,14 @@ class LinearEvent:
                            for i, c in enumerate(self.coefficients) if c)
         return (f"LinearEvent({terms} + {self.offset:g}, terminal={self.terminal}, "
                 f"direction={self.direction})")
+
+
+def is_linear(event) -> bool:
+    """Whether ``event`` is evaluated from its ``coefficients`` and ``offset`` as the
+    linear functional it declares: a :class:`LinearEvent`, or a subclass of it that
+    keeps its ``__call__`` (a subclass that overrides ``__call__`` is a function of its
+    own, called back as any user event)."""
+    return isinstance(event, LinearEvent) and type(event).__call__ is LinearEvent.__call__
 
 
 @functools.lru_cache(maxsize=64)

@@ -48,7 +48,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from . import _core, layout
-from .events import LinearEvent
+from .events import is_linear
 
 _PARAMETER = {name: i for i, name in enumerate(_core.PARAMETER_NAMES)}
 _QUATERNION = layout.QUATERNION
@@ -82,7 +82,7 @@ def applies(system, events) -> bool:
     whose flight is polynomial (not the quaternion)."""
     if system.flags != 0 or not scene_allows(system.params):
         return False
-    return all(type(e) is LinearEvent and polynomial_in_flight(e) for e in events)
+    return all(is_linear(e) and polynomial_in_flight(e) for e in events)
 
 
 def polynomial_in_flight(event) -> bool:

@@ -4,8 +4,8 @@
 C) on the system's C right-hand side and Jacobian, "dop853" ballc's compiled DOP853
 (scipy's DOP853, in the same C loop, with the same events), "auto" the two switching in
 that loop (docs/architecture.md, "The automatic method"); any other is handed to scipy's
-``solve_ivp`` (with the analytic Jacobian when implicit).  scipy has no call budget
-of its own: :func:`_call_budget` gives it one as a terminal event.  With
+``solve_ivp`` by :func:`ballc.scipy_segment.solve` (with the analytic Jacobian when
+implicit, and a call budget).  With
 ``exact_flight``, a free-flight segment that has an exact solution (massless observer,
 isotropic inertia, only linear events: :func:`ballc.flight.applies`) is not integrated
 at all but propagated in closed form by :func:`ballc.flight.propagate`, whatever the
@@ -14,12 +14,11 @@ method.
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from typing import NamedTuple
 
-from . import _core, _radau5, dense, flight
-from .options import COMPILED_METHODS, IMPLICIT_METHODS
+from . import _core, _radau5, dense, flight, scipy_segment
+from .options import COMPILED_METHODS
 
 
 class Segment(NamedTuple):
@@ -69,45 +68,13 @@ def integrate_segment(system, t0, t1, y0, events, *, method, rtol, atol, t_eval,
         return sol
     if isinstance(system, Segment):
         system = _core.System(system.params, system.latch, system.flags)
-    options = {"jac": system.jacobian} if method in IMPLICIT_METHODS else {}
-    if first_step is not None:
-        options["first_step"] = first_step
-    budget = [_call_budget(system, max_nfev)] if max_nfev is not None else []
-    sol = solve_ivp(system, (t0, t1), y0, method=method, rtol=rtol, atol=atol,
-                    t_eval=t_eval, events=list(events) + budget, max_step=max_step,
-                    dense_output=dense_output, **options)
-    # solve_ivp leaves t and y as empty lists when no t_eval point fell in the segment
-    sol.t = np.asarray(sol.t, dtype=float)
-    sol.y = np.asarray(sol.y, dtype=float).reshape(len(y0), sol.t.size)
+    sol = scipy_segment.solve(system, t0, t1, y0, events, method=method, rtol=rtol,
+                              atol=atol, t_eval=t_eval, max_step=max_step,
+                              max_nfev=max_nfev, first_step=first_step,
+                              dense_output=dense_output)
     if dense_output:
         sol.interpolant = sol.sol
-    if budget:
-        if len(sol.t_events[-1]):
-            sol.status = -1
-            sol.message = (f"gave up at t = {sol.t[-1]:.9g} after {sol.nfev} right-hand-side "
-                           "evaluations (max_nfev)")
-        sol.t_events, sol.y_events = sol.t_events[:-1], sol.y_events[:-1]
     return sol
-
-
-def _call_budget(system, max_nfev):
-    """A terminal solve_ivp event that stops the integration gracefully at the end of
-    the first step after which ``system`` has been called ``max_nfev`` more times
-    (solve_ivp has no call budget of its own).  It is +1 before that step's end time
-    and -1 from it on, so the event search puts the root at that step's end."""
-    start, stop = system.nfev, []
-
-    def g(t, y):
-        if not stop and system.nfev - start >= max_nfev:
-            stop.append(t)
-        return -1.0 if stop and t >= stop[0] else 1.0
-    return _event(g, True, -1)
-
-
-def _event(function, terminal, direction):
-    function.terminal = terminal
-    function.direction = direction
-    return function
 
 
 #: Below this absolute tolerance (m, m/s) a contact's state can be tighter than the

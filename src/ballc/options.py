@@ -13,6 +13,7 @@ import numpy as np
 
 from . import _core
 from ._format import plain
+from .events import LinearEvent
 from .scene import Scene, SceneError
 
 SCIPY_METHODS = ("Radau", "BDF", "LSODA", "DOP853", "RK45", "RK23")
@@ -141,10 +142,29 @@ def check_events(events) -> tuple:
                              "be True, False or a whole number k >= 0 (stop at the k-th "
                              "occurrence)") from None
         direction = getattr(event, "direction", 0)
-        if not _is_number_like(direction) or np.ndim(direction) != 0:
+        if not _is_number_like(direction) or np.ndim(direction) != 0 or np.isnan(direction):
             raise SceneError(f"events[{k}].direction = {plain(direction)} is not allowed: must "
                              "be a number (its sign: +1 rising, -1 falling, 0 both)")
+        if isinstance(event, LinearEvent):
+            _check_linear_event(k, event)
     return events
+
+
+def _check_linear_event(k, event):
+    """A LinearEvent's coefficients (N_STATES finite numbers) and offset (finite)."""
+    row = getattr(event, "coefficients", None)
+    n = _core.N_STATES
+    if not (_is_number_like(row) and np.shape(row) == (n,) and np.all(np.isfinite(row))):
+        raise SceneError(f"events[{k}].coefficients = {plain(row)} is not allowed: must be "
+                         f"{n} finite numbers, one per state ({', '.join(_core.STATE_NAMES)})")
+    offset = getattr(event, "offset", None)
+    if not (_is_number_like(offset) and np.ndim(offset) == 0 and np.isfinite(offset)):
+        raise SceneError(f"events[{k}].offset = {plain(offset)} is not allowed: must be a "
+                         "finite number")
+    rearm = getattr(event, "rearm", None)
+    if rearm is not None and not callable(rearm):
+        raise SceneError(f"events[{k}].rearm = {plain(rearm)} is not allowed: must be None or "
+                         "a callable (t, y) -> None or (coefficients, offset, latch)")
 
 
 def check_options(scene, t_end, method="radau5", rtol=1e-10, atol=1e-10, max_step=np.inf,

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 
 import numpy as np
 
@@ -21,10 +20,10 @@ from . import (_core, _radau5, automaton, compliantmodes, events as ev, layout, 
                orbit, outcome, resting, stickslip)
 from ._format import plain
 from .dense import CompiledInterpolant, PiecewiseSolution
-from .events import LinearEvent
 from .flight import FreeFlight, polynomial_in_flight, scene_allows as flight_scene_allows
 from .integrate import Segment, failure_hint, integrate_segment
-from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (METHODS re-exported)
+from .options import (DEFAULT_MAX_NFEV, METHODS, SCIPY_METHODS,  # noqa: F401 (METHODS re-exported)
+                      check_options)
 from .progress import progress_bar
 from .result import Contact, Result
 from .samples import Samples
@@ -669,8 +668,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         Give up (status -1, message, results so far) after this many right-hand-side
         evaluations in all (default 2e7); None: no limit.
     progress : bool, optional
-        Show a tqdm progress bar in simulated time (advanced once per segment).
-        None (default): only when stderr is a terminal.
+        Show a tqdm progress bar in simulated time (refreshed at most every 0.1 s of
+        wall time).  None (default): only when stderr is a terminal.  Whatever the
+        method, Ctrl-C stops a run within about 0.1 s (KeyboardInterrupt).
     exact_flight : bool
         True (default): a free-flight segment is propagated in closed form, not
         integrated, when that is exact -- massless observer (``observer_mass = 0``) and
@@ -710,7 +710,7 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     if not os.environ.get("BALLC_PYTHON_DRIVER") and _seams_untouched():
         config = _c_config(scene, options, progress, rest)
         if config is not None:
-            result = _simulate_c(scene, options, y_start, config)
+            result = _simulate_c(scene, options, y_start, config, progress)
             if result is not None:
                 return result
     run = _Run(scene, options, y_start)
@@ -904,7 +904,6 @@ def _finish(result, options, stiff_at):
 # rest, uniform motion or a relative periodic orbit (ballc.orbit, measured in C) ends
 # the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
 
-_C_METHODS = ("radau5", "dop853", "auto")
 #: The C loop's end states (_driver.h: BALLC_END_*; 0 none) by name.
 _END_KINDS = (None, "rest", "rolling", "free_sliding")
 _SEAMS = (integrate_segment, _radau5.solve_system)
@@ -952,28 +951,24 @@ _FLAG_BITS = dict(
 
 def _c_config(scene, options, progress, rest):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
-    in the C loop's subset: method radau5, dop853 or auto, one float atol, no progress
-    bar, user events as _c_user_events takes them, t_eval (if given) strictly
-    increasing, slip rows of at most 2 terms (sum() of more would be compensated on Python >= 3.12), and the
-    process's hypot and dot as the C loop reproduces them (_c_numerics_agree)."""
-    if options.method not in _C_METHODS or type(options.atol) is not float:
-        return None
+    in the C loop's subset: every method (scipy's through the loop's integrator
+    interface), atol one number or one per state, any user events, t_eval (if given)
+    strictly increasing, slip rows of at most 2 terms (sum() of
+    more would be compensated on Python >= 3.12), and the process's hypot and dot as
+    the C loop reproduces them (_c_numerics_agree).  (``progress``: the bar is the
+    caller's, advanced from C.)"""
     users = _c_user_events(options.events)
-    if users is None:
-        return None
     t_eval = options.t_eval
     if t_eval is not None:   # the C loop takes each segment's points as a range
         t_eval = np.ascontiguousarray(t_eval, dtype=float)
         if t_eval.ndim != 1 or not np.all(np.diff(t_eval) > 0):
             return None
-    if progress or (progress is None and sys.stderr.isatty()):
-        return None
     if not _c_numerics_agree():
         return None
     params = scene.parameter_vector()
     flight_allowed = bool(options.exact_flight and flight_scene_allows(params))
-    if flight_allowed and users["user_flight"] and users["several_states"]:
-        return None   # exact flight would take their value with a BLAS dot (flight.py)
+    atol = options.atol
+    per_state = type(atol) is not float
     terms = [stickslip.slip_terms(params, plane) for plane in PLANES]
     if any(len(row) > 2 for rows in terms for row in rows):
         return None
@@ -1009,7 +1004,10 @@ def _c_config(scene, options, progress, rest):
         rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbit.applies(scene)),
         orbit_axis=[float(a) for a in orbit.body_axis(scene)], rest_factor=resting.REST_FACTOR,
         **rest_consts,
-        params=params, rtol=options.rtol, atol=options.atol, t_end=options.t_end,
+        params=params, rtol=options.rtol, t_end=options.t_end,
+        atol=float(np.max(atol)) if per_state else atol,   # stickslip.error_speed's
+        atol_states=np.ascontiguousarray(atol, dtype=float) if per_state else None,
+        scipy=options.method in SCIPY_METHODS, scipy_atol=atol,
         max_step=float(options.max_step), first_step=options.first_step,
         max_nfev=options.max_nfev, method=options.method, observer_bits=observer,
         contact_bits=[modes.flags(scene, {p: p == plane for p in PLANES}) ^ observer
@@ -1031,18 +1029,17 @@ def _c_config(scene, options, progress, rest):
 
 
 def _c_user_events(events):
-    """The user's events as the C loop takes them (UserEvents.for_segment, the
-    bridge's _event_arrays): a dict of arrays, or None when one is outside the C loop's
-    subset (a LinearEvent subclass, or one with ``rearm``, or something the bridge
-    would refuse; more than 52)."""
+    """The user's events as the C loop takes them (UserEvents.for_segment): a dict of
+    arrays.  A LinearEvent (a subclass too) is
+    evaluated in C from its coefficients and offset, and its ``rearm``, if any, called
+    back; one whose class overrides ``__call__`` (then its own function), and any other
+    callable, is called back (CheckedEvent)."""
     events = list(events or ())
     n = len(events)
     if n == 0:   # the common case: the same (read-only) arrays every run
         if not _NO_USER_EVENTS:
             _NO_USER_EVENTS.update(_c_user_events_of([]))
         return _NO_USER_EVENTS
-    if n > 52:
-        return None
     return _c_user_events_of(events)
 
 
@@ -1055,43 +1052,39 @@ def _c_user_events_of(events):
     coef, offset = np.zeros((n, _core.N_STATES)), np.zeros(n)
     scale, index = np.zeros(n), np.full(n, -1, dtype=np.intc)
     linear, direction = np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc)
-    callables, several, flies = [], False, True
-    for k, event in enumerate(events):
-        try:
-            sign = float(getattr(event, "direction", 0))
-        except (TypeError, ValueError):
-            return None
-        if sign != sign:
-            return None
+    rearm = np.zeros(n, dtype=np.intc)
+    callables, rearms, flies = [], [], True
+    for k, event in enumerate(events):   # (options.check_events checked them)
+        sign = float(getattr(event, "direction", 0))
         direction[k] = (sign > 0) - (sign < 0)
-        if isinstance(event, LinearEvent):
-            if type(event) is not LinearEvent or getattr(event, "rearm", None) is not None:
-                return None
-            row = np.asarray(event.coefficients, dtype=float)
-            if row.shape != (_core.N_STATES,) or not np.all(np.isfinite(row)) \
-                    or not math.isfinite(float(event.offset)):
-                return None
-            linear[k], coef[k], offset[k] = 1, row, float(event.offset)
+        if ev.is_linear(event):
+            linear[k], coef[k], offset[k] = 1, event.coefficients, float(event.offset)
             if event._index is not None:
                 index[k], scale[k] = event._index, event._scale
-            quaternion_free = polynomial_in_flight(event)   # as flight.applies
-            flies = flies and quaternion_free
-            several = several or (quaternion_free and event._index is None)
+            flies = flies and polynomial_in_flight(event)   # as flight.applies
             callables.append(None)
-        elif callable(event):
+            rearms.append(event.rearm)
+            rearm[k] = event.rearm is not None
+        else:
             flies = False
             callables.append(CheckedEvent(event, k, 0, getattr(event, "direction", 0)))
-        else:
-            return None
+            rearms.append(None)
     return dict(user_coef=coef, user_offset=offset, user_scale=scale, user_index=index,
                 user_linear=linear, user_direction=direction,
                 user_count=np.array(users.counts, dtype=np.intc), user_events=callables,
-                user_flight=int(flies), several_states=several)
+                user_rearm=rearm, user_rearms=rearms, user_flight=int(flies))
 
 
-def _simulate_c(scene, options, y, config):
+def _simulate_c(scene, options, y, config, progress):
     """simulate() with the loop in C; None when it needs the Python loop."""
-    out = _core.drive(config["params"], y, config)
+    bar = progress_bar(progress, options.t_end)   # advanced from C, throttled in wall time
+    try:
+        out = _core.drive(config["params"], y, config, bar)
+        if bar is not None and out is not None:   # to where the run ended
+            bar.update((options.t_end if out["status"] == 0 else out["t_run"]) - bar.n)
+    finally:
+        if bar is not None:
+            bar.close()
     if out is None:
         return None
     counts = out["counts"]
@@ -1100,9 +1093,7 @@ def _simulate_c(scene, options, y, config):
     block_flags, latches = out["block_flags"], out["latches"]
     end_kind = out["end_kind"]
     gravity = config["gravity"]
-    pieces = [(piece[0], piece[1], FreeFlight(piece[0], piece[2], gravity, t_max=piece[1])
-               if len(piece) == 3 else CompiledInterpolant(*piece[2:]))
-              for piece in out["pieces"]]
+    pieces = [(piece[0], piece[1], _piece(piece, gravity)) for piece in out["pieces"]]
     end = _END_KINDS[end_kind]
     periodic = out["orbit"]   # (c0, period, G, rate, its base's pieces) or None
     if end:   # a rest check found an end state: to t_end in closed form
@@ -1194,6 +1185,17 @@ def _simulate_c(scene, options, y, config):
     result._orbit_trials = out["trials"]
     stiff_at = out["stiff_at"]
     return _finish(result, options, None if math.isnan(stiff_at) else stiff_at)
+
+
+def _piece(piece, gravity):
+    """One piece of a C run's dense output, from the bridge: (t0, t1, dense_t, dense_c,
+    terms, kinds) the compiled integrators' steps, (t0, t1, y0) an exact flight, (t0,
+    t1, interpolant) an integrator's own (scipy's)."""
+    if len(piece) > 3:
+        return CompiledInterpolant(*piece[2:])
+    if isinstance(piece[2], np.ndarray):
+        return FreeFlight(piece[0], piece[2], gravity, t_max=piece[1])
+    return piece[2]
 
 
 def record_depth(contact, depth, y):
