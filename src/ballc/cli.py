@@ -10,10 +10,16 @@ simulated or written.  An expected error (invalid scene or option, unreadable fi
 output folder that cannot be made) is one line on stderr and exit code 2.  When the
 reader of the output goes away (``ballc run ... | head``) the command ends quietly with
 exit code 141 (128 + SIGPIPE, what a shell reports for a program ended by a broken pipe).
+Ctrl-C (SIGINT) ends a command with one line on stderr and exit code 130 (128 +
+SIGINT): ``ballc sweep`` writes the rows of the runs that had finished; ``ballc run`` and
+``ballc demo`` keep the files written so far, and remove the output folder again if
+they made it and nothing had been written into it (a run interrupted is lost: there is
+no partial Result to write).
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import inspect
 import os
 import sys
@@ -37,6 +43,10 @@ SIMULATE_OPTIONS = SIMULATE_KEYS[1:]
 
 class CommandError(Exception):
     """An expected failure of a command (bad path, output folder): one line, exit 2."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C, with what the command leaves behind (its one line on stderr)."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -157,6 +167,32 @@ def _output_folder(out: Path) -> Path:
     return out
 
 
+@contextlib.contextmanager
+def _output(out: Path):
+    """``_output_folder(out)`` for the body of a command.  If the command fails or is
+    interrupted with nothing written into a folder it made, the folder is removed again
+    (no empty folder is left behind); on Ctrl-C, an :class:`Interrupted` says what is
+    left."""
+    made = not out.exists()
+    out = _output_folder(out)
+    try:
+        yield out
+    except BaseException as error:
+        try:
+            empty = not any(out.iterdir())
+            if made and empty:
+                out.rmdir()
+        except OSError:
+            empty = False
+        if isinstance(error, KeyboardInterrupt):
+            done = str(error) or "interrupted (Ctrl-C)"
+            left = ((f"nothing was written (the folder {out}/ it had made is removed)"
+                     if made else f"nothing was written into {out}/") if empty
+                    else f"the files written so far are in {out}/")
+            raise Interrupted(f"{done}; {left}") from None
+        raise
+
+
 def _simulate_options(scene, t_end, options: dict):
     """(t_end, options for ballc.simulate) checked by ballc.simulate's own validation;
     options not given take simulate's defaults."""
@@ -218,11 +254,12 @@ def _demo(args) -> int:
     scene = Scene()
     t_end, options = _simulate_options(scene, args.t_end, {})
     _check_html(args.html)
-    out = _output_folder(Path(args.out))
-    print(f"ballc demo: the seed scene (c_tau {scene.c_tau}, mu {scene.friction_coefficient}, "
-          f"mixture {scene.mixture}) for {t_end:g} s -> {out}/")
-    result = _simulate_and_write(scene, t_end, options, out, not args.no_animation,
-                                 args.frames, html=args.html)
+    with _output(Path(args.out)) as out:
+        print(f"ballc demo: the seed scene (c_tau {scene.c_tau}, mu "
+              f"{scene.friction_coefficient}, mixture {scene.mixture}) for {t_end:g} s -> "
+              f"{out}/", flush=True)
+        result = _simulate_and_write(scene, t_end, options, out, not args.no_animation,
+                                     args.frames, html=args.html)
     return 0 if result.success else 1
 
 
@@ -237,20 +274,26 @@ def _run(args) -> int:
     options.update({k: v for k, v in overrides.items() if v is not None})
     t_end, options = _simulate_options(scene, t_end, options)
     _check_html(args.html)
-    out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
     described = "".join(f", {k} {v}" for k, v in options.items())
-    print(f"ballc run {path} for {t_end:g} s{described} -> {out}/")
-    result = _simulate_and_write(scene, t_end, options, out, args.animate, args.frames,
-                                 save=True, html=args.html)
+    with _output(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem) as out:
+        print(f"ballc run {path} for {t_end:g} s{described} -> {out}/", flush=True)
+        result = _simulate_and_write(scene, t_end, options, out, args.animate, args.frames,
+                                     save=True, html=args.html)
     return 0 if result.success else 1
 
 
 def _sweep(args) -> int:
-    from .sweep import load_sweep_file, run_sweep_file
+    from .sweep import connect, load_sweep_file, run_sweep_file
     path = _scene_file(args.file)
     load_sweep_file(path)             # all its errors before the output folder is made
-    out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
-    return run_sweep_file(path, out=out, workers=args.workers, scheduler=args.scheduler)
+    # a scheduler that does not answer: said before the output folder is made
+    client = connect(args.scheduler, "--scheduler") if args.scheduler is not None else None
+    try:
+        with _output(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem) as out:
+            return run_sweep_file(path, out=out, workers=args.workers, scheduler=client)
+    finally:
+        if client is not None:
+            client.close()
 
 
 #: Options that take a number: "--rtol -1e-6" is joined into "--rtol=-1e-6", since
@@ -258,6 +301,8 @@ def _sweep(args) -> int:
 NUMBER_OPTIONS = ("--t-end", "--rtol", "--atol", "--frames", "--workers")
 #: Exit code when stdout's reader went away (a broken pipe): 128 + SIGPIPE.
 BROKEN_PIPE = 141
+#: Exit code of a command ended by Ctrl-C: 128 + SIGINT, as a shell reports it.
+INTERRUPTED = 130
 
 
 def _is_number(text: str) -> bool:
@@ -364,6 +409,11 @@ def main(argv=None) -> int:
     except BrokenPipeError:
         _quiet_stdout()
         return BROKEN_PIPE
+    except KeyboardInterrupt as error:
+        # Ctrl-C: one line (what is left is in it, see _output), no traceback
+        sys.stderr.write("\n" if sys.stderr.isatty() else "")   # after a progress bar
+        print(f"ballc {args.command}: {str(error) or 'interrupted (Ctrl-C)'}", file=sys.stderr)
+        return INTERRUPTED
     except (CommandError, SceneError, OSError, ValueError) as error:
         # expected: invalid input or an unusable path.  Anything else is a bug: traceback.
         print(f"ballc {args.command}: error: {_one_line(error)}", file=sys.stderr)
