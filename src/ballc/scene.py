@@ -220,9 +220,12 @@ class Scene:
         _reject_unknown_fields(kwargs)
         return super().__new__(cls)
 
+    #: The fields that are 3-vectors (a tuple of 3 floats each).
+    VECTOR_FIELDS = ("inertia", "observer_position", "position", "velocity", "angles",
+                     "angular_velocity")
+
     def __post_init__(self):
-        for name in ("inertia", "observer_position", "position", "velocity", "angles",
-                     "angular_velocity"):
+        for name in self.VECTOR_FIELDS:
             value = getattr(self, name)
             if value is None:
                 continue
@@ -573,8 +576,7 @@ def _validate(s: Scene) -> None:
         fail("tangential_model", s.tangential_model, f"must be one of {TANGENTIAL_MODELS}{hint}")
     if not s.ceiling_height > 2 * s.radius:
         fail("ceiling_height", s.ceiling_height, f"must be > 2 * radius = {2 * s.radius}")
-    for name in ("inertia", "observer_position", "position", "velocity", "angles",
-                 "angular_velocity"):
+    for name in Scene.VECTOR_FIELDS:
         vector = getattr(s, name)
         for i, v in enumerate(vector):
             if not math.isfinite(v):

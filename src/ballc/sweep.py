@@ -21,12 +21,14 @@ import contextlib
 import inspect
 import itertools
 import math
+import numbers
 import os
 import signal
 import sys
 import threading
 from pathlib import Path
 
+from ._format import plain
 from .outcome import CAME_BACK_AFTER_CONTACTS, summary
 from .scene import Scene, SceneError, read_toml, reject_unknown_keys
 
@@ -96,11 +98,31 @@ def combinations(base_scene: Scene, parameters: dict) -> list:
     for name, grid in zip(names, grids):
         if not grid:
             raise SceneError(f"sweep parameter {name!r} has no values")
+        _check_vector_grid(name, parameters[name], grid)
     cases = []
     for values in itertools.product(*grids):
         changes = dict(zip(names, values))
         cases.append((changes, base_scene.replace(**changes)))   # validates ("did you mean")
     return cases
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _check_vector_grid(name, given, grid) -> None:
+    """A vector field (velocity, angular_velocity, ...) given a flat list of numbers: its
+    values to sweep are each a vector, so say what was understood and how to write it."""
+    if name not in Scene.VECTOR_FIELDS or not all(_is_number(v) for v in grid):
+        return
+    shown = plain(given)
+    raise SceneError(
+        f"sweep parameter {name} = {shown} is not allowed: a parameter's list holds the "
+        f"values to sweep, one run each, so this sweeps {name} over the single numbers "
+        f"{', '.join(plain(v) for v in grid)}, but each value of {name} is a vector of 3 "
+        f"numbers.  To sweep {name} over vectors, list them: {name} = "
+        f"[{shown}, [...], ...]; for this one vector in every run write {name} = "
+        f"[{shown}] (or set it in the base scene)")
 
 
 def check_workers(workers, name="workers"):
