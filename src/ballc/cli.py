@@ -89,10 +89,10 @@ def _workers(text: str) -> int:
 
 
 def write_outputs(result, out: Path, *, animate: bool, frames: int,
-                  html: bool = False) -> list[Path]:
+                  html: bool = False, t_window=None) -> list[Path]:
     """Figures (PNG), contact table (CSV) and optionally the animation (GIF, + MP4 with
     ffmpeg) and the interactive 3-D view (view.html) of ``result`` into ``out``; returns
-    the paths written."""
+    the paths written.  ``t_window``: the figures' time window (ballc.plot)."""
     import matplotlib
     matplotlib.use("Agg")            # files only: never open a window
     import matplotlib.pyplot as plt
@@ -109,7 +109,7 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int,
                ("contacts_top_view.png", result.plot_contacts),
                ("observer.png", result.plot_observer))
     for name, make in figures:
-        fig, _ = make()
+        fig, _ = make(t_window=t_window)
         fig.savefig(out / name, dpi=100)
         plt.close(fig)
         written.append(out / name)
@@ -236,12 +236,14 @@ def _report(result, written, seconds, animate) -> None:
     print(f"[{seconds['simulate']:.2f} s simulation, {seconds['outputs']:.2f} s {outputs}]")
 
 
-def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False, html=False):
+def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False, html=False,
+                        t_window=None):
     from .simulate import simulate
     started = time.perf_counter()
     result = simulate(scene, t_end, **options)
     simulated = time.perf_counter()
-    written = write_outputs(result, out, animate=animate, frames=frames, html=html)
+    written = write_outputs(result, out, animate=animate, frames=frames, html=html,
+                            t_window=t_window)
     if save:
         result.save(out / "result.npz")
         written.append(out / "result.npz")
@@ -250,16 +252,28 @@ def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False,
     return result
 
 
+def _t_window(args, t_end):
+    """--t-window checked against the run's [0, t_end] before anything is simulated."""
+    if args.t_window is None:
+        return None
+    from .plot import check_t_window
+    try:
+        return check_t_window(tuple(args.t_window), 0.0, t_end)
+    except ValueError as error:
+        raise CommandError(f"--t-window: {error}") from None
+
+
 def _demo(args) -> int:
     scene = Scene()
     t_end, options = _simulate_options(scene, args.t_end, {})
+    t_window = _t_window(args, t_end)
     _check_html(args.html)
     with _output(Path(args.out)) as out:
         print(f"ballc demo: the seed scene (c_tau {scene.c_tau}, mu "
               f"{scene.friction_coefficient}, mixture {scene.mixture}) for {t_end:g} s -> "
               f"{out}/", flush=True)
         result = _simulate_and_write(scene, t_end, options, out, not args.no_animation,
-                                     args.frames, html=args.html)
+                                     args.frames, html=args.html, t_window=t_window)
     return 0 if result.success else 1
 
 
@@ -273,12 +287,13 @@ def _run(args) -> int:
     options = {name: settings.get(name) for name in SIMULATE_OPTIONS}
     options.update({k: v for k, v in overrides.items() if v is not None})
     t_end, options = _simulate_options(scene, t_end, options)
+    t_window = _t_window(args, t_end)
     _check_html(args.html)
     described = "".join(f", {k} {v}" for k, v in options.items())
     with _output(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem) as out:
         print(f"ballc run {path} for {t_end:g} s{described} -> {out}/", flush=True)
         result = _simulate_and_write(scene, t_end, options, out, args.animate, args.frames,
-                                     save=True, html=args.html)
+                                     save=True, html=args.html, t_window=t_window)
     return 0 if result.success else 1
 
 
@@ -295,6 +310,13 @@ def _sweep(args) -> int:
         if client is not None:
             client.close()
 
+
+#: --t-window T0 T1: the figures' time window (the same option on run and demo).
+T_WINDOW = ("--t-window",)
+T_WINDOW_OPTIONS = dict(
+    nargs=2, type=float, metavar=("T0", "T1"), default=None,
+    help="draw the figures from T0 to T1 s (default: the whole run, or for a run that "
+         "ends in closed form -- at rest, rolling -- up to its start plus a margin)")
 
 #: Options that take a number: "--rtol -1e-6" is joined into "--rtol=-1e-6", since
 #: argparse takes "-1e-6" for an option (it knows only negative numbers like -1, -0.5).
@@ -362,6 +384,7 @@ def main(argv=None) -> int:
     demo.add_argument("--no-animation", action="store_true", help="skip the GIF/MP4")
     demo.add_argument("--html", action="store_true",
                       help="also write view.html, an interactive 3-D view (needs meshcat)")
+    demo.add_argument(*T_WINDOW, **T_WINDOW_OPTIONS)
     demo.set_defaults(run=_demo)
 
     run = commands.add_parser("run", help="simulate a scene file (TOML)")
@@ -388,6 +411,7 @@ def main(argv=None) -> int:
                      help="also write view.html, an interactive 3-D view (needs meshcat)")
     run.add_argument("--frames", type=_frames, default=DEMO_FRAMES,
                      help=f"animation frames, >= 1 (default {DEMO_FRAMES})")
+    run.add_argument(*T_WINDOW, **T_WINDOW_OPTIONS)
     run.set_defaults(run=_run)
 
     sweep = commands.add_parser("sweep", help="a parameter sweep from a TOML file")
