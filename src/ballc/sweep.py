@@ -495,8 +495,9 @@ def _run_checked_sweep_file(path, spec, out, workers, client) -> int:
                       workers=workers or spec["workers"], client=client, **spec["simulate"])
     except SweepInterrupted as interrupted:
         written = _write_sweep_outputs(interrupted.table, out, names)
-        print(f"wrote {', '.join(str(p) for p in written)}: the {interrupted.finished} "
-              f"of {interrupted.total} runs that finished before the interruption")
+        what = (f"the {interrupted.finished} of {interrupted.total} runs that finished"
+                if interrupted.finished else "no run had finished (the header only)")
+        print(f"wrote {', '.join(str(p) for p in written)}: {what}")
         raise
     written = _write_sweep_outputs(table, out, names)
     verdicts = table["came_back"]
