@@ -163,3 +163,17 @@ def test_a_bad_command_line_time_window_is_one_line_before_anything_runs(tmp_pat
     err = capsys.readouterr().err
     assert code == 2 and shown in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
+
+
+def test_a_window_after_a_run_that_stopped_early_draws_the_whole_run(tmp_path, capsys):
+    """--t-window is checked against [0, t_end] before the run; a run that then stops
+    early (dig-in passes through the floor at 3.4 s) still gets its figures, of the
+    whole run, with a note saying why."""
+    from ballc import cli
+    scene = tmp_path / "s.toml"
+    scene.write_text('tangential_model = "dig-in"\n[simulate]\nt_end = 5.0\n')
+    code = cli.main(["run", str(scene), "--t-window", "4.5", "5", "--out",
+                     str(tmp_path / "out")])
+    assert code == 1                          # the run did not reach t_end
+    assert (tmp_path / "out" / "coordinates.png").is_file()
+    assert "the figures show the whole run" in capsys.readouterr().err

@@ -102,6 +102,11 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int,
 
     if animate:
         frames = check_frames(frames)     # before any file is written
+    if t_window is not None and t_window[0] > result.t[-1]:
+        # checked against [0, t_end] before the run, which then stopped early
+        print(f"note: --t-window starts at {t_window[0]:g} s, after the run stopped at "
+              f"{result.t[-1]:g} s: the figures show the whole run", file=sys.stderr)
+        t_window = None
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     written = []
