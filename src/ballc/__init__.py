@@ -10,10 +10,10 @@ from .result import Contact, Result, load
 from .rigid import RigidImpact, c_tau_for_restitution, hunt_crossley_restitution, rigid_impact
 from .scene import TANGENTIAL_MODELS, Scene, SceneError
 from .simulate import simulate
-from .sweep import sweep
+from .sweep import SweepInterrupted, sweep
 
 __version__ = "0.1.0"
 __all__ = ["Contact", "Impact", "ImpactFit", "PARAMETER_NAMES", "Result", "RigidImpact",
-           "STATE_NAMES", "Scene", "SceneError", "TANGENTIAL_MODELS", "c_tau_for_restitution",
+           "STATE_NAMES", "Scene", "SceneError", "SweepInterrupted", "TANGENTIAL_MODELS", "c_tau_for_restitution",
            "fit_impacts", "hunt_crossley_restitution", "impact", "impact_table", "load",
            "rigid_impact", "simulate", "sweep"]

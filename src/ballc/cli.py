@@ -10,10 +10,16 @@ simulated or written.  An expected error (invalid scene or option, unreadable fi
 output folder that cannot be made) is one line on stderr and exit code 2.  When the
 reader of the output goes away (``ballc run ... | head``) the command ends quietly with
 exit code 141 (128 + SIGPIPE, what a shell reports for a program ended by a broken pipe).
+Ctrl-C (SIGINT) ends a command with one line on stderr and exit code 130 (128 +
+SIGINT): ``ballc sweep`` writes the rows of the runs that had finished; ``ballc run`` and
+``ballc demo`` keep the files written so far, and remove the output folder again if
+they made it and nothing had been written into it (a run interrupted is lost: there is
+no partial Result to write).
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import inspect
 import os
 import sys
@@ -37,6 +43,10 @@ SIMULATE_OPTIONS = SIMULATE_KEYS[1:]
 
 class CommandError(Exception):
     """An expected failure of a command (bad path, output folder): one line, exit 2."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C, with what the command leaves behind (its one line on stderr)."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -79,10 +89,10 @@ def _workers(text: str) -> int:
 
 
 def write_outputs(result, out: Path, *, animate: bool, frames: int,
-                  html: bool = False) -> list[Path]:
+                  html: bool = False, t_window=None) -> list[Path]:
     """Figures (PNG), contact table (CSV) and optionally the animation (GIF, + MP4 with
     ffmpeg) and the interactive 3-D view (view.html) of ``result`` into ``out``; returns
-    the paths written."""
+    the paths written.  ``t_window``: the figures' time window (ballc.plot)."""
     import matplotlib
     matplotlib.use("Agg")            # files only: never open a window
     import matplotlib.pyplot as plt
@@ -92,6 +102,11 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int,
 
     if animate:
         frames = check_frames(frames)     # before any file is written
+    if t_window is not None and t_window[0] > result.t[-1]:
+        # checked against [0, t_end] before the run, which then stopped early
+        print(f"note: --t-window starts at {t_window[0]:g} s, after the run stopped at "
+              f"{result.t[-1]:g} s: the figures show the whole run", file=sys.stderr)
+        t_window = None
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     written = []
@@ -99,7 +114,7 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int,
                ("contacts_top_view.png", result.plot_contacts),
                ("observer.png", result.plot_observer))
     for name, make in figures:
-        fig, _ = make()
+        fig, _ = make(t_window=t_window)
         fig.savefig(out / name, dpi=100)
         plt.close(fig)
         written.append(out / name)
@@ -157,6 +172,32 @@ def _output_folder(out: Path) -> Path:
     return out
 
 
+@contextlib.contextmanager
+def _output(out: Path):
+    """``_output_folder(out)`` for the body of a command.  If the command fails or is
+    interrupted with nothing written into a folder it made, the folder is removed again
+    (no empty folder is left behind); on Ctrl-C, an :class:`Interrupted` says what is
+    left."""
+    made = not out.exists()
+    out = _output_folder(out)
+    try:
+        yield out
+    except BaseException as error:
+        try:
+            empty = not any(out.iterdir())
+            if made and empty:
+                out.rmdir()
+        except OSError:
+            empty = False
+        if isinstance(error, KeyboardInterrupt):
+            done = str(error) or "interrupted (Ctrl-C)"
+            left = ((f"nothing was written (the folder {out}/ it had made is removed)"
+                     if made else f"nothing was written into {out}/") if empty
+                    else f"the files written so far are in {out}/")
+            raise Interrupted(f"{done}; {left}") from None
+        raise
+
+
 def _simulate_options(scene, t_end, options: dict):
     """(t_end, options for ballc.simulate) checked by ballc.simulate's own validation;
     options not given take simulate's defaults."""
@@ -200,12 +241,14 @@ def _report(result, written, seconds, animate) -> None:
     print(f"[{seconds['simulate']:.2f} s simulation, {seconds['outputs']:.2f} s {outputs}]")
 
 
-def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False, html=False):
+def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False, html=False,
+                        t_window=None):
     from .simulate import simulate
     started = time.perf_counter()
     result = simulate(scene, t_end, **options)
     simulated = time.perf_counter()
-    written = write_outputs(result, out, animate=animate, frames=frames, html=html)
+    written = write_outputs(result, out, animate=animate, frames=frames, html=html,
+                            t_window=t_window)
     if save:
         result.save(out / "result.npz")
         written.append(out / "result.npz")
@@ -214,15 +257,28 @@ def _simulate_and_write(scene, t_end, options, out, animate, frames, save=False,
     return result
 
 
+def _t_window(args, t_end):
+    """--t-window checked against the run's [0, t_end] before anything is simulated."""
+    if args.t_window is None:
+        return None
+    from .plot import check_t_window
+    try:
+        return check_t_window(tuple(args.t_window), 0.0, t_end)
+    except ValueError as error:
+        raise CommandError(f"--t-window: {error}") from None
+
+
 def _demo(args) -> int:
     scene = Scene()
     t_end, options = _simulate_options(scene, args.t_end, {})
+    t_window = _t_window(args, t_end)
     _check_html(args.html)
-    out = _output_folder(Path(args.out))
-    print(f"ballc demo: the seed scene (c_tau {scene.c_tau}, mu {scene.friction_coefficient}, "
-          f"mixture {scene.mixture}) for {t_end:g} s -> {out}/")
-    result = _simulate_and_write(scene, t_end, options, out, not args.no_animation,
-                                 args.frames, html=args.html)
+    with _output(Path(args.out)) as out:
+        print(f"ballc demo: the seed scene (c_tau {scene.c_tau}, mu "
+              f"{scene.friction_coefficient}, mixture {scene.mixture}) for {t_end:g} s -> "
+              f"{out}/", flush=True)
+        result = _simulate_and_write(scene, t_end, options, out, not args.no_animation,
+                                     args.frames, html=args.html, t_window=t_window)
     return 0 if result.success else 1
 
 
@@ -236,28 +292,44 @@ def _run(args) -> int:
     options = {name: settings.get(name) for name in SIMULATE_OPTIONS}
     options.update({k: v for k, v in overrides.items() if v is not None})
     t_end, options = _simulate_options(scene, t_end, options)
+    t_window = _t_window(args, t_end)
     _check_html(args.html)
-    out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
     described = "".join(f", {k} {v}" for k, v in options.items())
-    print(f"ballc run {path} for {t_end:g} s{described} -> {out}/")
-    result = _simulate_and_write(scene, t_end, options, out, args.animate, args.frames,
-                                 save=True, html=args.html)
+    with _output(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem) as out:
+        print(f"ballc run {path} for {t_end:g} s{described} -> {out}/", flush=True)
+        result = _simulate_and_write(scene, t_end, options, out, args.animate, args.frames,
+                                     save=True, html=args.html, t_window=t_window)
     return 0 if result.success else 1
 
 
 def _sweep(args) -> int:
-    from .sweep import load_sweep_file, run_sweep_file
+    from .sweep import connect, load_sweep_file, run_sweep_file
     path = _scene_file(args.file)
     load_sweep_file(path)             # all its errors before the output folder is made
-    out = _output_folder(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem)
-    return run_sweep_file(path, out=out, workers=args.workers, scheduler=args.scheduler)
+    # a scheduler that does not answer: said before the output folder is made
+    client = connect(args.scheduler, "--scheduler") if args.scheduler is not None else None
+    try:
+        with _output(Path(args.out) if args.out else Path(OUTPUT_ROOT) / path.stem) as out:
+            return run_sweep_file(path, out=out, workers=args.workers, scheduler=client)
+    finally:
+        if client is not None:
+            client.close()
 
+
+#: --t-window T0 T1: the figures' time window (the same option on run and demo).
+T_WINDOW = ("--t-window",)
+T_WINDOW_OPTIONS = dict(
+    nargs=2, type=float, metavar=("T0", "T1"), default=None,
+    help="draw the figures from T0 to T1 s (default: the whole run, or for a run that "
+         "ends in closed form -- at rest, rolling -- up to its start plus a margin)")
 
 #: Options that take a number: "--rtol -1e-6" is joined into "--rtol=-1e-6", since
 #: argparse takes "-1e-6" for an option (it knows only negative numbers like -1, -0.5).
 NUMBER_OPTIONS = ("--t-end", "--rtol", "--atol", "--frames", "--workers")
 #: Exit code when stdout's reader went away (a broken pipe): 128 + SIGPIPE.
 BROKEN_PIPE = 141
+#: Exit code of a command ended by Ctrl-C: 128 + SIGINT, as a shell reports it.
+INTERRUPTED = 130
 
 
 def _is_number(text: str) -> bool:
@@ -317,6 +389,7 @@ def main(argv=None) -> int:
     demo.add_argument("--no-animation", action="store_true", help="skip the GIF/MP4")
     demo.add_argument("--html", action="store_true",
                       help="also write view.html, an interactive 3-D view (needs meshcat)")
+    demo.add_argument(*T_WINDOW, **T_WINDOW_OPTIONS)
     demo.set_defaults(run=_demo)
 
     run = commands.add_parser("run", help="simulate a scene file (TOML)")
@@ -343,6 +416,7 @@ def main(argv=None) -> int:
                      help="also write view.html, an interactive 3-D view (needs meshcat)")
     run.add_argument("--frames", type=_frames, default=DEMO_FRAMES,
                      help=f"animation frames, >= 1 (default {DEMO_FRAMES})")
+    run.add_argument(*T_WINDOW, **T_WINDOW_OPTIONS)
     run.set_defaults(run=_run)
 
     sweep = commands.add_parser("sweep", help="a parameter sweep from a TOML file")
@@ -364,6 +438,11 @@ def main(argv=None) -> int:
     except BrokenPipeError:
         _quiet_stdout()
         return BROKEN_PIPE
+    except KeyboardInterrupt as error:
+        # Ctrl-C: one line (what is left is in it, see _output), no traceback
+        sys.stderr.write("\n" if sys.stderr.isatty() else "")   # after a progress bar
+        print(f"ballc {args.command}: {str(error) or 'interrupted (Ctrl-C)'}", file=sys.stderr)
+        return INTERRUPTED
     except (CommandError, SceneError, OSError, ValueError) as error:
         # expected: invalid input or an unusable path.  Anything else is a bug: traceback.
         print(f"ballc {args.command}: error: {_one_line(error)}", file=sys.stderr)

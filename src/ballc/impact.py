@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import compliantmodes
+from ._format import plain
 from .result import Result
 from .scene import Scene, SceneError
 from .simulate import simulate
@@ -97,11 +98,13 @@ def _vector(name, value):
             raise TypeError
         v = np.array(value, dtype=float).reshape(-1)
     except (TypeError, ValueError):
-        raise SceneError(f"{name} = {value!r} is not allowed: must be 3 numbers") from None
+        raise SceneError(f"{name} = {plain(value)} is not allowed: must be 3 numbers") \
+            from None
     if v.shape != (3,):
-        raise SceneError(f"{name} = {value!r} is not allowed: must be 3 numbers")
+        raise SceneError(f"{name} = {plain(value)} is not allowed: must be 3 numbers")
     if not np.all(np.isfinite(v)):
-        raise SceneError(f"{name} = {value!r} is not allowed: every component must be finite")
+        raise SceneError(f"{name} = {plain(value)} is not allowed: every component must be "
+                         "finite")
     return v
 
 
@@ -163,13 +166,13 @@ def impact(scene: Scene, velocity, angular_velocity=(0.0, 0.0, 0.0), plane: str 
     except (TypeError, ValueError):
         gap_ok = False
     if not gap_ok:
-        raise SceneError(f"gap = {gap!r} is not allowed: must be a number in (0, 0.5] "
+        raise SceneError(f"gap = {plain(gap)} is not allowed: must be a number in (0, 0.5] "
                          "(radii)")
     n = _normal(plane)
     approach = -float(v @ n)
     if not approach > 0:
-        raise SceneError(f"velocity = {tuple(v)} is not allowed: the ball must move towards "
-                         f"the {plane} (v_z {'< 0' if plane == 'floor' else '> 0'}), "
+        raise SceneError(f"velocity = {plain(tuple(v))} is not allowed: the ball must move "
+                         f"towards the {plane} (v_z {'< 0' if plane == 'floor' else '> 0'}), "
                          f"its normal velocity is {-approach:g} m/s")
     r, g = scene.radius, scene.gravity
     clearance = gap * r
@@ -231,16 +234,16 @@ def impact_table(scene: Scene, angles=(15.0, 30.0, 45.0, 60.0, 75.0), speed: flo
     angles = np.atleast_1d(np.asarray(angles, dtype=float))
     if angles.ndim != 1 or not np.all(np.isfinite(angles)) or np.any(angles < 0) or \
             np.any(angles >= 90):
-        raise SceneError(f"angles = {angles!r} is not allowed: must be degrees in [0, 90)")
+        raise SceneError(f"angles = {plain(angles)} is not allowed: must be degrees in [0, 90)")
     try:
         speed = float(speed)
     except (TypeError, ValueError):
-        raise SceneError(f"speed = {speed!r} is not allowed: must be a number > 0") from None
+        raise SceneError(f"speed = {plain(speed)} is not allowed: must be a number > 0") from None
     if not (math.isfinite(speed) and speed > 0):
-        raise SceneError(f"speed = {speed!r} is not allowed: must be finite and > 0")
+        raise SceneError(f"speed = {plain(speed)} is not allowed: must be finite and > 0")
     spins = np.broadcast_to(np.asarray(spin, dtype=float), angles.shape)
     if not np.all(np.isfinite(spins)):
-        raise SceneError(f"spin = {spin!r} is not allowed: must be finite")
+        raise SceneError(f"spin = {plain(spin)} is not allowed: must be finite")
     down = -1.0 if plane == "floor" else 1.0
     rows = []
     for angle, s in zip(angles, spins):
@@ -286,6 +289,26 @@ FIT_BOUNDS = {
 }
 
 
+def _reject_misspelt_columns(columns) -> None:
+    """A column that is none of the incident or rebound columns but looks like one (ends
+    in "_after", or is close to one's name: "vz_afer", "wx after") would be silently
+    left out of the fit: a SceneError naming it.  Other columns (labels, notes, and a
+    fit's own "<rebound>_fit" predictions) are allowed and ignored."""
+    import difflib
+    known = INCIDENT_COLUMNS + REBOUND_COLUMNS
+    for column in columns:
+        name = str(column)
+        if name in known or name in {f"{c}_fit" for c in REBOUND_COLUMNS}:
+            continue
+        close = difflib.get_close_matches(name, known, n=1, cutoff=0.75)
+        if close or name.endswith("_after"):
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise SceneError(f"data column {name!r} is not allowed: it is none of the "
+                             f"incident columns {', '.join(INCIDENT_COLUMNS)} nor the "
+                             f"rebound columns {', '.join(REBOUND_COLUMNS)}, but looks like "
+                             f"one{hint}, and would be left out of the fit")
+
+
 def _data_frame(data):
     import pandas as pd
     frame = data if isinstance(data, pd.DataFrame) else pd.DataFrame(data)
@@ -293,6 +316,7 @@ def _data_frame(data):
     if missing:
         raise SceneError(f"data is missing the incident column(s) {missing}: needs "
                          f"{list(INCIDENT_COLUMNS)}")
+    _reject_misspelt_columns(frame.columns)
     measured = [c for c in REBOUND_COLUMNS if c in frame.columns]
     if not measured:
         raise SceneError(f"data has no rebound column: needs at least one of "
@@ -358,7 +382,10 @@ def fit_impacts(base_scene: Scene, data, free=("friction_coefficient",
         scene = base_scene.replace(**dict(zip(free, map(float, values))))
         out = np.empty((len(incident), len(REBOUND_COLUMNS)))
         for i, row in enumerate(incident):
-            hit = impact(scene, row[:3], row[3:], plane, **options)
+            try:
+                hit = impact(scene, row[:3], row[3:], plane, **options)
+            except SceneError as error:
+                raise SceneError(f"data row {plain(frame.index[i])}: {error}") from None
             out[i] = np.concatenate([hit.velocity_after, hit.angular_velocity_after])
         return out
 

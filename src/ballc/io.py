@@ -16,6 +16,8 @@ import datetime
 import json
 import platform
 import warnings
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -134,13 +136,19 @@ def _not_a_result(path, why: str) -> ValueError:
                       f"(result.npz) write, with the arrays {', '.join(NPZ_ARRAYS)}")
 
 
+#: What numpy and zipfile raise for a file that is no .npz, or a damaged or truncated
+#: one (zipfile.BadZipFile is none of the others).
+_UNREADABLE = (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error)
+
+
 def _read_npz(path):
     try:
         data = np.load(path, allow_pickle=False)
     except FileNotFoundError:
         raise
-    except (OSError, ValueError, EOFError) as error:    # not a .npz (pickle, text, empty)
-        raise _not_a_result(path, "not an .npz archive") from None
+    except _UNREADABLE as error:    # not a .npz (pickle, text, empty), or truncated
+        raise _not_a_result(path, f"not an .npz archive, or a damaged or truncated one: "
+                            f"{error}") from None
     if not isinstance(data, np.lib.npyio.NpzFile):      # a single .npy array
         raise _not_a_result(path, "it holds one array, not an .npz archive")
     with data:
@@ -149,11 +157,15 @@ def _read_npz(path):
             found = ", ".join(data.files[:8]) + (", ..." if len(data.files) > 8 else "")
             raise _not_a_result(path, f"it has no {', '.join(missing)}; it holds: "
                                 f"{found or 'nothing'}")
-        header = _header_of(path, str(data["header"]))
-        contacts = {k[len("contact_"):]: data[k] for k in data.files
-                    if k.startswith("contact_")}
-        arrays = {k: data[k] for k in NPZ_ARRAYS[1:] + EVENT_ARRAYS if k in data.files}
-    return header, arrays, contacts
+        try:
+            text = str(data["header"])
+            contacts = {k[len("contact_"):]: data[k] for k in data.files
+                        if k.startswith("contact_")}
+            arrays = {k: data[k] for k in NPZ_ARRAYS[1:] + EVENT_ARRAYS if k in data.files}
+        except _UNREADABLE as error:      # an archive member damaged or cut short
+            raise _not_a_result(path, f"a damaged or truncated .npz archive: {error}") \
+                from None
+    return _header_of(path, text), arrays, contacts
 
 
 def _header_of(path, text: str) -> dict:

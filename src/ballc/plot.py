@@ -7,6 +7,12 @@ m/s, energies in J, specific force in g (9.80665 m/s^2).
 Lines drawn from per-sample arrays are decimated for drawing (``_for_drawing``: at most
 ``MAX_POINTS`` points, a min/max envelope per time bucket), so a run of millions of
 samples draws in about a second; the Result's arrays are never changed.
+
+Long runs: a run that ends in closed form (at rest, rolling or sliding uniformly, or in
+a rolling orbit: the last contact's ``t_rest``, ``t_rolling`` or ``t_sliding``) is drawn
+from its start to that closed form's start plus ``CLOSED_FORM_MARGIN`` of it, with the
+start marked and a note "closed form to t_end" (a 1e9-s run is then not one linear
+axis to 1e9 s).  ``t_window=(t0, t1)`` (s) draws any window of the run instead.
 """
 from __future__ import annotations
 
@@ -77,6 +83,101 @@ def _for_drawing(t, *series, max_points: int = MAX_POINTS):
     return (np.asarray(t)[index], *(np.asarray(values)[index] for values in series))
 
 
+#: A run that ends in closed form from t_c on is drawn to (1 + this) t_c, when its end
+#: is later than that (its eventful part, and some of the closed form).
+CLOSED_FORM_MARGIN = 0.25
+#: What each end state's start is called in the note on the figures.
+_CLOSED_FORMS = (("t_rest", "at rest"), ("t_rolling", "rolling"),
+                 ("t_sliding", "sliding"))
+
+
+def closed_form_start(result):
+    """(t_c, what) when the run ends in closed form from t_c (s) on -- the last
+    contact's rest, rolling or sliding time, ``what`` "at rest", "rolling" or "sliding"
+    -- else None."""
+    if not result.contacts:
+        return None
+    last = result.contacts[-1]
+    found = [(getattr(last, name), what) for name, what in _CLOSED_FORMS
+             if np.isfinite(getattr(last, name))]
+    return min(found) if found else None
+
+
+def check_t_window(t_window, t_first: float, t_last: float):
+    """``t_window`` as (t0, t1) floats: two finite times t0 < t1 (s) overlapping the run's
+    [t_first, t_last]; None stays None (the automatic window).  ValueError otherwise."""
+    if t_window is None:
+        return None
+    from ._format import plain
+    try:
+        if isinstance(t_window, (str, bytes)) or len(t_window) != 2 or any(
+                isinstance(v, (str, bytes, bool, np.bool_)) for v in t_window):
+            raise TypeError
+        t0, t1 = (float(v) for v in t_window)
+    except (TypeError, ValueError):
+        t0 = t1 = np.nan
+    if not (np.isfinite(t0) and np.isfinite(t1) and t0 < t1 and t0 <= t_last
+            and t1 >= t_first):
+        raise ValueError(f"t_window = {plain(t_window)} is not allowed: must be two finite "
+                         f"times t0 < t1 (s) overlapping the run, [{t_first:g}, {t_last:g}] "
+                         "s (or None: the whole run, or its eventful part when it ends in "
+                         "closed form)")
+    return (t0, t1)
+
+
+def _window(result, t_window):
+    """(t0, t1, tail) of a figure: ``t_window`` checked, else the whole run, or for a run
+    ending in closed form long after it starts, its start plus CLOSED_FORM_MARGIN;
+    ``tail``: (t_c, what) of the closed form when its start is in the window and t_end
+    beyond it (to mark), else None."""
+    t = result.t
+    window = check_t_window(t_window, float(t[0]), float(t[-1]))
+    closed = closed_form_start(result)
+    if window is None:
+        window = (float(t[0]), float(t[-1]))
+        if closed is not None and closed[0] > t[0]:
+            window = (window[0], min(window[1], (1 + CLOSED_FORM_MARGIN) * closed[0]))
+    t0, t1 = window
+    tail = closed if (closed is not None and t0 <= closed[0] <= t1 and t1 < t[-1]) \
+        else None
+    return t0, t1, tail
+
+
+def _in_window(result, t0: float, t1: float, tail=None):
+    """``result`` itself, or a copy holding the samples in [t0, t1] and one on each side
+    (so lines run to the window's edges) -- but none after t1 when the closed-form
+    ``tail`` starts in the window: its samples are sparse (the next may be 1e5 s on), and
+    a line to one would draw a straight chord over the closed form.  The Result is not
+    changed."""
+    import dataclasses
+    t = result.t
+    first = max(int(np.searchsorted(t, t0, side="left")) - 1, 0)
+    stop = min(int(np.searchsorted(t, t1, side="right")) + (tail is None), t.size)
+    if first == 0 and stop == t.size:
+        return result
+    part = slice(first, stop)
+    return dataclasses.replace(
+        result, t=t[part], y=result.y[:, part],
+        flags=None if result.flags is None else result.flags[part],
+        latch=None if result.latch is None else result.latch[:, part],
+        _energy=None, sol=None)
+
+
+def _mark_tail(axes, tail, t_end, note_on=-1) -> None:
+    """A dashed line at the closed form's start on every axis of ``axes``, and on
+    axes[note_on] the note that the run goes on in closed form to t_end."""
+    if tail is None:
+        return
+    t_c, what = tail
+    for ax in axes:
+        ax.axvline(t_c, color="0.25", ls="--", lw=1.0)
+    # the note in the margin after t_c, where nothing more is drawn
+    ax = axes[note_on]
+    ax.text(t_c, 0.03, f" {what} from\n t = {t_c:.4g} s:\n closed form\n to t_end =\n"
+            f" {t_end:g} s \u2192", transform=ax.get_xaxis_transform(), ha="left",
+            va="bottom", fontsize="small", color="0.25")
+
+
 def _verdict_value(value) -> float:
     """came_back as a cell value: 1 yes, 0 no, 0.5 undetermined (None, NaN, <NA>)."""
     import pandas as pd
@@ -122,50 +223,61 @@ def shade_contacts(ax, result) -> None:
         ax.axvspan(contact.t_start, end, color=PLANE_COLOURS[contact.plane], alpha=0.2, lw=0)
 
 
-def plot_coordinates(result, axes=None, figsize=(10, 8)):
+def plot_coordinates(result, axes=None, figsize=(10, 8), t_window=None):
     """Centre position, centre velocity and angular velocity against time.
 
     Returns (figure, array of 3 axes).  Contacts are shaded (floor brown, ceiling cyan);
     the x, y, z components are solid, dashed and dotted (``COMPONENT_STYLES``).
+    ``t_window=(t0, t1)``: draw that time window (s); default the whole run, or up to
+    the closed-form end state plus a margin (see the module's notes).
     """
     plt = _pyplot()
+    t0, t1, tail = _window(result, t_window)
     if axes is None:
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=figsize, constrained_layout=True)
     else:
         fig = axes[0].figure
-    panels = ((result.position, "centre position (m)", ("x", "y", "z")),
-              (result.velocity, "centre velocity (m/s)", ("$v_x$", "$v_y$", "$v_z$")),
-              (result.angular_velocity, "angular velocity (rad/s)",
+    drawn = _in_window(result, t0, t1, tail)
+    panels = ((drawn.position, "centre position (m)", ("x", "y", "z")),
+              (drawn.velocity, "centre velocity (m/s)", ("$v_x$", "$v_y$", "$v_z$")),
+              (drawn.angular_velocity, "angular velocity (rad/s)",
                ("$\\omega_x$", "$\\omega_y$", "$\\omega_z$")))
     for ax, (values, label, names) in zip(axes, panels):
         for row, name, style in zip(values, names, COMPONENT_STYLES):
-            ax.plot(*_for_drawing(result.t, row), label=name,
+            ax.plot(*_for_drawing(drawn.t, row), label=name,
                     lw=1.5 if style == ":" else 1.2, ls=style)
         shade_contacts(ax, result)
+        ax.set_xlim(t0, t1)
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
         ax.legend(loc="upper right", fontsize="small", ncol=3)
+    _mark_tail(axes, tail, result.t[-1])
     axes[-1].set_xlabel("time (s)")
     axes[0].set_title("Ball centre (shaded: contacts, brown floor, cyan ceiling)\n"
                       + scene_title(result.scene))
     return fig, axes
 
 
-def plot_energy(result, ax=None, figsize=(10, 5)):
-    """Every entry of ``result.energy`` against time (J); "total" thick and last."""
+def plot_energy(result, ax=None, figsize=(10, 5), t_window=None):
+    """Every entry of ``result.energy`` against time (J); "total" thick and last.
+    ``t_window``: as :func:`plot_coordinates`'s."""
     plt = _pyplot()
+    t0, t1, tail = _window(result, t_window)
     fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
                else (ax.figure, ax))
-    energy = result.energy
+    drawn = _in_window(result, t0, t1, tail)
+    energy = drawn.energy
     names = [k for k in ENERGY_ORDER if k in energy]
     names += [k for k in energy if k not in names and k != "total"]
     for name in names:
         style = "--" if name.startswith("dissipated") else ":" if name == "balance" else "-"
-        ax.plot(*_for_drawing(result.t, energy[name]), label=name.replace("_", " "),
+        ax.plot(*_for_drawing(drawn.t, energy[name]), label=name.replace("_", " "),
                 lw=1.2, ls=style)
     if "total" in energy:
-        ax.plot(*_for_drawing(result.t, energy["total"]), label="total", color="k", lw=2)
+        ax.plot(*_for_drawing(drawn.t, energy["total"]), label="total", color="k", lw=2)
     shade_contacts(ax, result)
+    ax.set_xlim(t0, t1)
+    _mark_tail([ax], tail, result.t[-1])
     ax.set_xlabel("time (s)")
     ax.set_ylabel("energy (J)")
     ax.set_title("Energies (shaded: contacts)\n" + scene_title(result.scene))
@@ -188,29 +300,38 @@ def contact_points(result) -> np.ndarray:
     return points
 
 
-def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
+def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5), t_window=None):
     """Top view (x, y): the centre's path and the contact points coloured by time,
-    numbered, with arrows from each to the next (floor o, ceiling ^)."""
+    numbered, with arrows from each to the next (floor o, ceiling ^).
+    ``t_window``: as :func:`plot_coordinates`'s (the path in it, and the contacts that
+    start in it)."""
     plt = _pyplot()
+    t0, t1, tail = _window(result, t_window)
     fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
                else (ax.figure, ax))
-    _, x, y = _for_drawing(result.t, result.position[0], result.position[1])
+    drawn = _in_window(result, t0, t1, tail)
+    inside = (drawn.t >= t0) & (drawn.t <= t1)
+    _, x, y = _for_drawing(drawn.t[inside], drawn.position[0, inside],
+                           drawn.position[1, inside])
     ax.plot(x, y, color="0.6", lw=0.8, label="centre path")
-    ax.plot(*result.position[:2, 0], "kx", ms=8, label="start")
-    points = contact_points(result)
-    times = np.array([c.t_start for c in result.contacts])
+    if t0 <= result.t[0]:
+        ax.plot(*result.position[:2, 0], "kx", ms=8, label="start")
+    shown = [i for i, c in enumerate(result.contacts) if t0 <= c.t_start <= t1]
+    points = contact_points(result)[shown]
+    times = np.array([result.contacts[i].t_start for i in shown])
     if len(points):
-        norm = plt.Normalize(0.0, max(result.t[-1], 1e-12))
+        norm = plt.Normalize(t0, max(t1, t0 + 1e-12))
         cmap = plt.get_cmap("plasma")
         for plane in ("floor", "ceiling"):
-            chosen = [i for i, c in enumerate(result.contacts) if c.plane == plane]
+            chosen = [k for k, i in enumerate(shown) if result.contacts[i].plane == plane]
             if chosen:
                 ax.scatter(points[chosen, 0], points[chosen, 1], c=times[chosen], cmap=cmap,
                            norm=norm, marker=PLANE_MARKERS[plane], s=80, edgecolors="k",
                            zorder=3, label=f"{plane} contact")
-        for i, (x, y, _) in enumerate(points, 1):
-            ax.annotate(str(i), (x, y), textcoords="offset points", xytext=(6, 6),
-                        fontsize=9)
+        view = np.concatenate([np.c_[x, y], points[:, :2]])
+        for i in _labelled(points[:, :2], float(np.ptp(view, axis=0).max())):
+            ax.annotate(str(shown[i] + 1), points[i, :2], textcoords="offset points",
+                        xytext=(6, 6), fontsize=9)
         for (x0, y0, _), (x1, y1, _), t in zip(points[:-1], points[1:], times[1:]):
             ax.annotate("", (x1, y1), (x0, y0), arrowprops=dict(
                 arrowstyle="->", color=cmap(norm(t)), lw=1.5, shrinkA=6, shrinkB=6))
@@ -219,6 +340,10 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
                     label="to the next contact\n(coloured by its time)")
         fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
                      label="contact start time (s)")
+    if tail is not None:
+        ax.text(0.02, 0.02, f"path to t = {t1:.4g} s; {tail[1]} from t = {tail[0]:.4g} s: "
+                f"closed form to t_end = {result.t[-1]:g} s", transform=ax.transAxes,
+                fontsize="small", color="0.25", bbox=dict(facecolor="white", alpha=0.7, lw=0))
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
@@ -227,6 +352,26 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5)):
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize="small")
     return fig, ax
+
+
+#: A contact's number is written next to it unless it would come closer than this
+#: fraction of the top view's span to a number already written (many short hops in one
+#: place -- the last bounces before rolling -- would write their numbers over each
+#: other); the first and the last contact are always numbered.
+LABEL_SPACING = 0.04
+
+
+def _labelled(points, span: float) -> list:
+    """Indices of the ``points`` (k, 2) to number: the last, the first, then each in
+    turn that is at least LABEL_SPACING * span from every one numbered so far."""
+    if not len(points):
+        return []
+    order = [len(points) - 1, 0, *range(1, len(points) - 1)]
+    kept = []
+    for i in dict.fromkeys(order):
+        if all(np.hypot(*(points[i] - points[j])) >= LABEL_SPACING * span for j in kept):
+            kept.append(i)
+    return sorted(kept)
 
 
 #: plot_observer evaluates the specific force (the compiled right-hand side, per
@@ -285,19 +430,21 @@ def _observer_samples(result):
                                _energy=None, sol=None)
 
 
-def plot_observer(result, axes=None, figsize=(10, 7)):
+def plot_observer(result, axes=None, figsize=(10, 7), t_window=None):
     """The observer's specific force (acceleration - gravity) in g: ball-frame
-    components (what an accelerometer inside the ball reads) and inertial ones."""
+    components (what an accelerometer inside the ball reads) and inertial ones.
+    ``t_window``: as :func:`plot_coordinates`'s."""
     plt = _pyplot()
+    t0, t1, tail = _window(result, t_window)
     if axes is None:
         fig, axes = plt.subplots(2, 1, sharex=True, figsize=figsize, constrained_layout=True)
     else:
         fig = axes[0].figure
     from .observer import specific_force, to_ball_frame
-    # The specific force is evaluated once for both frames, at the samples
-    # _observer_samples picks (all of them up to OBSERVER_SAMPLES); each line is then
-    # decimated for drawing by its own min/max envelope.
-    drawn = _observer_samples(result)
+    # The specific force is evaluated once for both frames, at the samples of the
+    # window that _observer_samples picks (all of them up to OBSERVER_SAMPLES); each
+    # line is then decimated for drawing by its own min/max envelope.
+    drawn = _observer_samples(_in_window(result, t0, t1, tail))
     inertial = specific_force(drawn, frame="inertial")
     ball = to_ball_frame(drawn, inertial)
     magnitude = np.linalg.norm(inertial, axis=0)
@@ -306,9 +453,11 @@ def plot_observer(result, axes=None, figsize=(10, 7)):
             ax.plot(*_for_drawing(drawn.t, row), lw=1.0, label=f"{axis}")
         ax.plot(*_for_drawing(drawn.t, magnitude), color="k", lw=0.8, ls="--", label="|f|")
         shade_contacts(ax, result)
+        ax.set_xlim(t0, t1)
         ax.set_ylabel(f"specific force, {frame} (g)")
         ax.grid(alpha=0.3)
         ax.legend(loc="upper right", fontsize="small", ncol=4)
+    _mark_tail(axes, tail, result.t[-1])
     axes[-1].set_xlabel("time (s)")
     alpha, beta, gamma = result.scene.observer_position
     axes[0].set_title(f"What the observer at ({alpha:g}, {beta:g}, {gamma:g}) r feels: "

@@ -25,6 +25,18 @@ FRICTION_REGULARIZATIONS = ("exact", "max", "smooth")
 NORMAL_DAMPINGS = ("hunt_crossley", "viscoelastic")
 #: c_tau when a scene gives neither c_tau nor restitution (the seed's value).
 DEFAULT_C_TAU = 0.9
+#: The rim speed r |omega| must be below this many times the ball's wave speed
+#: c = sqrt(E / rho) (``wave_speed``).  A ball spinning at rim speed r omega is
+#: stretched by its centrifugal force by a strain of order rho omega^2 r^2 / E =
+#: (r omega / c)^2: 100 (10,000 %) at 10 c, where rubber breaks at ~ 7.  Far beyond it
+#: the rigid ball that ballc simulates is no model of any ball (docs/limits.md); and a
+#: spin costs about omega t_end steps, so an absurd one crawled to the call budget.
+#: (The stress matrix spins the default ball, c = 112 m/s, at rim speeds up to 1000 m/s.)
+SPEED_LIMIT = 10.0
+#: The centre's speed |v| must be below the speed of light (m/s): ballc's mechanics is
+#: Newton's.  (A throw far beyond the wave speed is allowed: its impact ends honestly,
+#: the ball passing through the plane.)
+SPEED_OF_LIGHT = 299_792_458.0
 
 #: Scene field -> seed symbol(s).
 SEED_SYMBOLS = {
@@ -217,9 +229,12 @@ class Scene:
         _reject_unknown_fields(kwargs)
         return super().__new__(cls)
 
+    #: The fields that are 3-vectors (a tuple of 3 floats each).
+    VECTOR_FIELDS = ("inertia", "observer_position", "position", "velocity", "angles",
+                     "angular_velocity")
+
     def __post_init__(self):
-        for name in ("inertia", "observer_position", "position", "velocity", "angles",
-                     "angular_velocity"):
+        for name in self.VECTOR_FIELDS:
             value = getattr(self, name)
             if value is None:
                 continue
@@ -514,6 +529,31 @@ def _finite(name, value) -> float:
     return x
 
 
+def wave_speed(scene) -> float:
+    """The ball's (bar) wave speed sqrt(E_b / rho) (m/s), rho = mass / (4/3 pi r^3) its
+    mean density: the speed scale of its elasticity (see SPEED_LIMIT)."""
+    density = float(scene.mass) / (4.0 / 3.0 * math.pi * float(scene.radius) ** 3)
+    return math.sqrt(float(scene.ball_youngs_modulus) / density)
+
+
+def check_speeds(scene, velocity, angular_velocity, names=("velocity", "angular_velocity")):
+    """SceneError unless the centre speed |velocity| is below the speed of light and the
+    rim speed radius |angular_velocity| below SPEED_LIMIT times the ball's wave speed
+    (``names``: what to call the two vectors in the message)."""
+    speed = math.hypot(*velocity)
+    if not speed < SPEED_OF_LIGHT:
+        _fail(names[0], tuple(velocity), f"its speed {speed:.3g} m/s must be below the "
+              f"speed of light, {SPEED_OF_LIGHT:.9g} m/s (ballc's mechanics is Newton's)")
+    limit = SPEED_LIMIT * wave_speed(scene)
+    rim = float(scene.radius) * math.hypot(*angular_velocity)
+    if not rim < limit:
+        _fail(names[1], tuple(angular_velocity), f"its rim speed radius * |omega| = "
+              f"{rim:.3g} m/s must be below {SPEED_LIMIT:g} times the ball's wave speed "
+              f"sqrt(E / rho) = {limit / SPEED_LIMIT:.4g} m/s, i.e. < {limit:.4g} m/s, "
+              f"|omega| < {limit / float(scene.radius):.4g} rad/s (spinning faster, no ball "
+              "stays the rigid body ballc simulates: docs/limits.md)")
+
+
 def _validate(s: Scene) -> None:
     fail, finite = _fail, _finite
 
@@ -545,8 +585,7 @@ def _validate(s: Scene) -> None:
         fail("tangential_model", s.tangential_model, f"must be one of {TANGENTIAL_MODELS}{hint}")
     if not s.ceiling_height > 2 * s.radius:
         fail("ceiling_height", s.ceiling_height, f"must be > 2 * radius = {2 * s.radius}")
-    for name in ("inertia", "observer_position", "position", "velocity", "angles",
-                 "angular_velocity"):
+    for name in Scene.VECTOR_FIELDS:
         vector = getattr(s, name)
         for i, v in enumerate(vector):
             if not math.isfinite(v):
@@ -564,4 +603,5 @@ def _validate(s: Scene) -> None:
     if not 0 < z < s.ceiling_height:
         fail("position", s.position, f"the centre must start between the planes, less than "
              f"one radius deep in either: 0 < z < {s.ceiling_height}")
+    check_speeds(s, s.velocity, s.angular_velocity)
 

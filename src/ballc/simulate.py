@@ -28,7 +28,7 @@ from .progress import progress_bar
 from .result import Contact, Result
 from .samples import Samples
 from .user_events import CheckedEvent, UserEvents
-from .scene import Scene, SceneError
+from .scene import Scene, SceneError, check_speeds
 
 PLANES = layout.PLANES
 _STATE = layout.INDEX
@@ -63,6 +63,10 @@ def check_initial_state(scene, y0):
     if not 0 < y[_STATE["z"]] < scene.ceiling_height:
         raise SceneError(f"y0 is not allowed: z = {plain(y[_STATE['z']])} must be between the "
                          f"planes, 0 < z < {scene.ceiling_height}")
+    check_speeds(scene, y[_STATE["vx"]:_STATE["vz"] + 1],
+                 y[_STATE["omega_x"]:_STATE["omega_z"] + 1],
+                 ("y0's velocity (vx, vy, vz)",
+                  "y0's angular velocity (omega_x, omega_y, omega_z)"))
     return y
 
 

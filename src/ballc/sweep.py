@@ -8,16 +8,27 @@ cores; 1 runs in this process), and on a Dask distributed cluster when given
 ``client=`` (a ``distributed.Client`` or a scheduler address such as
 "tcp://host:8786"; the workers need ballc installed).  The same call either way, and
 the same table: one row per scene, in the order of the combinations.
+
+Ctrl-C (SIGINT, to the whole process group as a terminal sends it, or to this process
+alone) stops a sweep within about a second, however long its runs: the local pool's
+workers ignore SIGINT and are stopped by this process (a worker also ends by itself
+when this process is gone), and :class:`SweepInterrupted` -- a KeyboardInterrupt --
+carries the rows finished so far.
 """
 from __future__ import annotations
 
+import contextlib
 import inspect
 import itertools
 import math
+import numbers
 import os
+import signal
 import sys
+import threading
 from pathlib import Path
 
+from ._format import plain
 from .outcome import CAME_BACK_AFTER_CONTACTS, summary
 from .scene import Scene, SceneError, read_toml, reject_unknown_keys
 
@@ -25,6 +36,17 @@ from .scene import Scene, SceneError, read_toml, reject_unknown_keys
 SUMMARY_COLUMNS = ("contacts", "came_back", "first_reversal_time", "energy_initial",
                    "energy_final", "energy_lost", "energy_lost_fraction", "t_final",
                    "status", "message")
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by Ctrl-C (a KeyboardInterrupt, so a script stops as on any
+    Ctrl-C).  ``table``: the rows of the runs that had finished, in grid order, as
+    :func:`sweep` returns them; ``finished`` of ``total`` runs."""
+
+    def __init__(self, table, finished: int, total: int):
+        super().__init__(f"interrupted (Ctrl-C) after {finished} of {total} runs had "
+                         "finished")
+        self.table, self.finished, self.total = table, finished, total
 
 
 def _run_one(changes: dict, scene: dict, t_end: float, options: dict, outputs: dict) -> dict:
@@ -76,11 +98,31 @@ def combinations(base_scene: Scene, parameters: dict) -> list:
     for name, grid in zip(names, grids):
         if not grid:
             raise SceneError(f"sweep parameter {name!r} has no values")
+        _check_vector_grid(name, parameters[name], grid)
     cases = []
     for values in itertools.product(*grids):
         changes = dict(zip(names, values))
         cases.append((changes, base_scene.replace(**changes)))   # validates ("did you mean")
     return cases
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _check_vector_grid(name, given, grid) -> None:
+    """A vector field (velocity, angular_velocity, ...) given a flat list of numbers: its
+    values to sweep are each a vector, so say what was understood and how to write it."""
+    if name not in Scene.VECTOR_FIELDS or not all(_is_number(v) for v in grid):
+        return
+    shown = plain(given)
+    raise SceneError(
+        f"sweep parameter {name} = {shown} is not allowed: a parameter's list holds the "
+        f"values to sweep, one run each, so this sweeps {name} over the single numbers "
+        f"{', '.join(plain(v) for v in grid)}, but each value of {name} is a vector of 3 "
+        f"numbers.  To sweep {name} over vectors, list them: {name} = "
+        f"[{shown}, [...], ...]; for this one vector in every run write {name} = "
+        f"[{shown}] (or set it in the base scene)")
 
 
 def check_workers(workers, name="workers"):
@@ -152,9 +194,13 @@ def sweep(base_scene: Scene, parameters: dict, t_end: float, *, outputs=None,
         undetermined -- fewer completed contacts than the criterion needs -- or when
         the run raised), first_reversal_time (s), energies (J), t_final (s), status,
         message, and the extra outputs.
-    """
-    import pandas as pd
 
+    Raises
+    ------
+    SweepInterrupted
+        On Ctrl-C (a KeyboardInterrupt): the runs still going are stopped (a run
+        interrupted is lost), and its ``table`` holds the rows of the finished ones.
+    """
     cases = combinations(base_scene, parameters)
     t_end = check_simulate_options(base_scene, t_end, simulate_options)
     workers = check_workers(workers)
@@ -163,13 +209,26 @@ def sweep(base_scene: Scene, parameters: dict, t_end: float, *, outputs=None,
              for changes, scene in cases]
     if progress is None:
         progress = sys.stderr.isatty()
-    if client is not None:
-        rows = _on_dask(client, tasks, progress)
-    elif workers == 1 or len(tasks) == 1:
-        rows = [_run_one(*task) for task in _bar(tasks, progress, len(tasks))]
-    else:
-        rows = _on_local_pool(tasks, workers, progress)
-    table = pd.DataFrame(rows)
+    rows = [None] * len(tasks)       # filled in as the runs finish
+    columns = [*parameters, *SUMMARY_COLUMNS, *named]
+    try:
+        if client is not None:
+            _on_dask(client, tasks, rows, progress)
+        elif workers == 1 or len(tasks) == 1:
+            _in_this_process(tasks, rows, progress)
+        else:
+            _on_local_pool(tasks, workers, rows, progress)
+    except KeyboardInterrupt:
+        finished = [row for row in rows if row is not None]
+        raise SweepInterrupted(_table(finished, columns), len(finished),
+                               len(tasks)) from None
+    return _table(rows, columns)
+
+
+def _table(rows, columns):
+    """The sweep's DataFrame of ``rows`` (dicts), with ``columns`` also when empty."""
+    import pandas as pd
+    table = pd.DataFrame(rows, columns=None if rows else columns)
     # three-valued: True, False, <NA> (undetermined, or the run raised)
     table["came_back"] = table["came_back"].astype("boolean")
     return table
@@ -179,7 +238,21 @@ def _bar(iterable, progress, total):
     if not progress:
         return iterable
     from tqdm import tqdm
-    return tqdm(iterable, total=total, desc="sweep", unit="run")
+    # mininterval 0: every finished run (pool: batch of runs) is shown at once
+    return tqdm(iterable, total=total, desc="sweep", unit="run", mininterval=0)
+
+
+def _in_this_process(tasks, rows, progress):
+    """The runs one after the other in this process (workers = 1)."""
+    bar = _bar(None, progress, len(tasks)) if progress else None
+    try:
+        for i, task in enumerate(tasks):
+            rows[i] = _run_one(*task)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
 
 
 def _run_batch(batch):
@@ -187,45 +260,143 @@ def _run_batch(batch):
     return [_run_one(*task) for task in batch]
 
 
-def _on_local_pool(tasks, workers, progress):
+#: A pool worker checks this often (s) whether the process that started it is still
+#: there, and ends if not (its parent was killed without stopping it).
+PARENT_CHECK_INTERVAL = 0.5
+
+
+def _start_worker():
+    """Initializer of each local pool worker.  SIGINT is ignored: a terminal's Ctrl-C
+    reaches the whole process group, and the parent alone decides -- it stops the
+    workers (a worker that took Ctrl-C for its run's result would go on with the next
+    run).  The parent blocks SIGINT while it starts the workers (``_sigint_held``), so
+    no Ctrl-C reaches a worker before this.  And a thread ends the worker when its
+    parent is gone (killed outright, with no chance to stop it): no orphan runs on."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)       # also drops a pending SIGINT
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    threading.Thread(target=_end_with_parent, args=(os.getppid(),), daemon=True,
+                     name="ballc-sweep-parent-watch").start()
+
+
+def _end_with_parent(parent: int):
+    import time
+    while os.getppid() == parent:
+        time.sleep(PARENT_CHECK_INTERVAL)
+    os._exit(1)
+
+
+@contextlib.contextmanager
+def _sigint_held():
+    """SIGINT blocked in this thread (the workers started in it inherit that until
+    ``_start_worker`` ignores it); a Ctrl-C meanwhile is delivered at the end."""
+    if not hasattr(signal, "pthread_sigmask"):      # (Windows: no process groups)
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def _stop_workers(pool):
+    """Stop a local pool now: no new run starts, the running ones are killed.  (The
+    workers' processes are the executor's ``_processes``, the only handle on them before
+    Python 3.14's ``terminate_workers``; taken before ``shutdown``, which drops them.)"""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    for process in processes:
+        process.join(timeout=5)
+
+
+def _on_local_pool(tasks, workers, rows, progress):
     from concurrent.futures import ProcessPoolExecutor, as_completed
     workers = min(workers or os.cpu_count() or 1, len(tasks))   # None: all cores
     # ~16 batches per worker: a map's runs cost milliseconds each, so submitting them
     # one by one spent as much time in inter-process traffic as in simulating
     size = max(1, math.ceil(len(tasks) / (16 * workers)))
     batches = [(start, tasks[start:start + size]) for start in range(0, len(tasks), size)]
-    rows = [None] * len(tasks)
     bar = _bar(None, progress, len(tasks)) if progress else None
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = {pool.submit(_run_batch, batch): start for start, batch in batches}
-        for future in as_completed(futures):
-            start = futures[future]
-            done = future.result()
-            for offset, row in enumerate(done):
-                rows[start + offset] = row
-            if bar is not None:
-                bar.update(len(done))      # the bar counts runs, not batches
-    if bar is not None:
-        bar.close()
-    return rows
-
-
-def _on_dask(client, tasks, progress):
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_start_worker)
+    futures = {}
     try:
-        from distributed import Client, as_completed
+        with _sigint_held():       # the workers start (are forked) in these submits
+            futures = {pool.submit(_run_batch, batch): start for start, batch in batches}
+        for future in as_completed(futures):
+            _keep(future.result(), futures[future], rows, bar)
+    except BaseException:
+        # Ctrl-C (or any error): stop the workers now, keep what has finished
+        _stop_workers(pool)
+        for future, start in futures.items():
+            if (rows[start] is None and future.done() and not future.cancelled()
+                    and future.exception() is None):
+                _keep(future.result(), start, rows, None)
+        raise
+    else:
+        pool.shutdown()
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _keep(done, start, rows, bar):
+    """A finished batch's rows into their places (grid order), counted on the bar."""
+    for offset, row in enumerate(done):
+        rows[start + offset] = row
+    if bar is not None:
+        bar.update(len(done))      # the bar counts runs, not batches
+
+
+#: Seconds a Dask scheduler address is given to answer (distributed's default: 30).
+CONNECT_TIMEOUT = 5.0
+
+
+def _distributed():
+    try:
+        import distributed
     except ModuleNotFoundError:
         raise ModuleNotFoundError("client= needs Dask distributed: "
                                   "pip install 'ballc[dask]'") from None
+    return distributed
+
+
+def connect(address: str, name: str = "client"):
+    """A ``distributed.Client`` of the Dask scheduler at ``address``; a ValueError naming
+    ``name``, the address and what is allowed when none answers there within
+    CONNECT_TIMEOUT s (checked before anything runs or is written)."""
+    Client = _distributed().Client
+    if not isinstance(address, str) or not address.strip():
+        raise ValueError(f"{name} = {address!r} is not allowed: must be a Dask scheduler's "
+                         "address such as tcp://host:8786 (or, for client=, a "
+                         "distributed.Client)")
+    try:
+        return Client(address, timeout=CONNECT_TIMEOUT)
+    except Exception as error:      # a bad address, nothing there, something else there
+        reason = " ".join(str(error).split()) or type(error).__name__
+        raise ValueError(f"{name} = {address!r} is not allowed: no Dask scheduler answered "
+                         f"there within {CONNECT_TIMEOUT:g} s ({reason}); must be the "
+                         "address of a running scheduler, such as tcp://host:8786") from None
+
+
+def _on_dask(client, tasks, rows, progress):
+    as_completed = _distributed().as_completed
     own = isinstance(client, str)
     if own:
-        client = Client(client)
+        client = connect(client)
+    futures = []
     try:
         futures = [client.submit(_run_one, *task, pure=False) for task in tasks]
         index = {future.key: i for i, future in enumerate(futures)}
-        rows = [None] * len(tasks)
         for future in _bar(as_completed(futures), progress, len(tasks)):
             rows[index[future.key]] = future.result()
-        return rows
+    except BaseException:          # Ctrl-C (or any error): no run left on the cluster
+        if futures:
+            client.cancel(futures)
+        raise
     finally:
         if own:
             client.close()
@@ -294,9 +465,20 @@ def _checked_sweep_file(path, data) -> dict:
 
 def run_sweep_file(path, *, out=None, workers=None, scheduler=None) -> int:
     """``ballc sweep``: run a sweep file, write sweep.csv (+ a heat map for 2 parameters).
-    The file is checked completely before the output folder is made."""
+    The file and the scheduler (an address is connected to) are checked before the
+    output folder is made.  On Ctrl-C the rows of the finished runs are written, and
+    the SweepInterrupted raised again."""
     spec = load_sweep_file(path)
     workers = check_workers(workers, "--workers")
+    client = connect(scheduler, "--scheduler") if isinstance(scheduler, str) else scheduler
+    try:
+        return _run_checked_sweep_file(path, spec, out, workers, client)
+    finally:
+        if client is not scheduler:
+            client.close()
+
+
+def _run_checked_sweep_file(path, spec, out, workers, client) -> int:
     out = Path(out) if out else Path(Path(path).stem)
     out.mkdir(parents=True, exist_ok=True)
     names = list(spec["parameters"])
@@ -304,21 +486,20 @@ def run_sweep_file(path, *, out=None, workers=None, scheduler=None) -> int:
     for values in spec["parameters"].values():
         count *= len(_values(values))
     processes = min(workers or spec["workers"] or os.cpu_count() or 1, count)
-    where = f"Dask scheduler {scheduler}" if scheduler else \
+    where = f"Dask scheduler {client.scheduler.address}" if client is not None else \
         f"{processes} local process{'es' if processes > 1 else ''}"
     print(f"ballc sweep {path}: {count} run{'s' if count > 1 else ''} of {spec['t_end']:g} s "
-          f"over {', '.join(names)} on {where} -> {out}/")
-    table = sweep(spec["base_scene"], spec["parameters"], spec["t_end"],
-                  workers=workers or spec["workers"], client=scheduler, **spec["simulate"])
-    table.to_csv(out / "sweep.csv", index=False)
-    written = [out / "sweep.csv"]
-    if len(names) == 2:
-        import matplotlib
-        matplotlib.use("Agg")
-        from .plot import plot_sweep_map
-        fig, _ = plot_sweep_map(table, x=names[1], y=names[0])
-        fig.savefig(out / "came_back.png", dpi=100)
-        written.append(out / "came_back.png")
+          f"over {', '.join(names)} on {where} -> {out}/", flush=True)
+    try:
+        table = sweep(spec["base_scene"], spec["parameters"], spec["t_end"],
+                      workers=workers or spec["workers"], client=client, **spec["simulate"])
+    except SweepInterrupted as interrupted:
+        written = _write_sweep_outputs(interrupted.table, out, names)
+        what = (f"the {interrupted.finished} of {interrupted.total} runs that finished"
+                if interrupted.finished else "no run had finished (the header only)")
+        print(f"wrote {', '.join(str(p) for p in written)}: {what}")
+        raise
+    written = _write_sweep_outputs(table, out, names)
     verdicts = table["came_back"]
     print(f"{int(verdicts.eq(True).sum())} of {len(table)} scenes came back, "
           f"{int(verdicts.eq(False).sum())} did not, {int(verdicts.isna().sum())} "
@@ -326,3 +507,20 @@ def run_sweep_file(path, *, out=None, workers=None, scheduler=None) -> int:
           f"{int((table['status'] != 0).sum())} did not reach t_end")
     print("wrote " + ", ".join(str(p) for p in written))
     return 0
+
+
+def _write_sweep_outputs(table, out, names) -> list:
+    """sweep.csv and, for two parameters (and some rows), the heat map came_back.png."""
+    table.to_csv(out / "sweep.csv", index=False)
+    written = [out / "sweep.csv"]
+    if len(names) == 2 and len(table):
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from .plot import plot_sweep_map
+        fig, _ = plot_sweep_map(table, x=names[1], y=names[0])
+        fig.savefig(out / "came_back.png", dpi=100)
+        plt.close(fig)
+        written.append(out / "came_back.png")
+    return written
