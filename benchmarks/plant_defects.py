@@ -96,6 +96,18 @@ DEFECTS = [
     Defect("start-in-contact latch without the observer mass", "src/ballc/modes.py",
            "rho ** 2.5 / (scene.mass + scene.observer_mass)\n",
            "rho ** 2.5 / scene.mass\n", regenerate=False),
+    # the two above in the C loop, which the default runs take (issue 29)
+    Defect("C loop: per-contact energy split swapped (normal <-> tangential)",
+           "src/ballc/_driver.c",
+           "    rec->lost[0] = r->y[BALLC_STATE_DISSIPATED_NORMAL] - r->dissipated_at_start[p][0];\n"
+           "    rec->lost[1] = r->y[BALLC_STATE_DISSIPATED_TANGENTIAL] - "
+           "r->dissipated_at_start[p][1];\n",
+           "    rec->lost[1] = r->y[BALLC_STATE_DISSIPATED_NORMAL] - r->dissipated_at_start[p][0];\n"
+           "    rec->lost[0] = r->y[BALLC_STATE_DISSIPATED_TANGENTIAL] - "
+           "r->dissipated_at_start[p][1];\n", regenerate=False),
+    Defect("C loop: start-in-contact latch without the observer mass", "src/ballc/_driver.c",
+           "pow(rho, 2.5) / c->total_mass;\n",
+           "pow(rho, 2.5) / c->params[BALLC_PARAMETER_MASS];\n", regenerate=False),
     Defect("impact's tangential restitution e_t sign flipped", "src/ballc/impact.py",
            "    e_t = -float(ua @ ub) / slip2 if ",
            "    e_t = float(ua @ ub) / slip2 if ", regenerate=False),
