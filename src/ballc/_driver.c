@@ -228,6 +228,8 @@ typedef char k_codes_are_segment_ends[((int)K_ENTER == (int)BALLC_SEG_ENTER
                                        && (int)K_CAPACITY == (int)BALLC_SEG_CAPACITY
                                        && (int)K_USER == (int)BALLC_SEG_USER) ? 1 : -1];
 
+typedef char integrator_prof_fits[RADAU5_PROF_N == 7 ? 1 : -1];
+
 const char *const ballc_plane_mode_names[BALLC_N_PLANE_MODES] = {
     "flight", "contact", "slip", "slip_fixed", "stick", "elastic", "sliding", "resting",
     "rolling", "free_sliding", "passed_through"};
@@ -1568,6 +1570,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         implicit = 0;
 #ifdef RADAU5_PROFILE
         o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
+        for (int i = 0; i < RADAU5_PROF_N; i++) o->integrator_prof[i] += res.prof[i];
 #endif
         if (r->user_failed) {   /* solve_system raises the user's exception */
             radau5_free(&res);
@@ -1581,6 +1584,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         r->seg.nfev = res.nfev;
         r->seg.njev = res.njev;
         r->seg.nlu = res.nlu;
+        r->seg.nstep = res.nstep;
+        r->seg.nreject = res.nreject;
         r->seg.method_end = flown ? -1 : res.method_end;
         r->seg.switches = (int)res.n_switches;
         if (!stiff_found && isfinite(res.stiff_at)) {

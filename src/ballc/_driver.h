@@ -156,6 +156,7 @@ extern const char *const ballc_segment_end_names[BALLC_N_SEGMENT_ENDS];
 typedef struct {
     double t_start, t_end;      /* s; a failure: the last time reached */
     long nfev, njev, nlu;       /* of this segment (0 for an exact flight) */
+    long nstep, nreject;        /* its accepted and rejected steps */
     int method, method_end;     /* the integrator it started / ended with: RADAU5_METHOD_*
                                  * (auto: radau5 or dop853), -1 an exact flight */
     int switches;               /* method "auto": switches inside the segment */
@@ -213,6 +214,10 @@ typedef struct {
     double integrator_ns, drive_ns;
     long n_log, cap_log;                /* the segment log (result.segments) */
     ballc_segment_rec *log;
+    /* a -DRADAU5_PROFILE build: radau5_result's prof (RADAU5_PROF_N = 7: ticks inside the
+     * RHS, Jacobian, factorisations, solves, events, in all, and ns in all) summed over
+     * the segments; zeros otherwise */
+    double integrator_prof[7];
 } ballc_drive_output;
 
 int ballc_drive(const ballc_drive_config *config, const double *y0,

@@ -94,7 +94,7 @@ cdef extern from "_driver.h":
     const char *ballc_segment_end_names[]
     ctypedef struct ballc_segment_rec:
         double t_start, t_end
-        long nfev, njev, nlu
+        long nfev, njev, nlu, nstep, nreject
         int method, method_end, switches, end, plane, rearms
         signed char before[2]
         signed char after[2]
@@ -142,6 +142,7 @@ cdef extern from "_driver.h":
         double integrator_ns, drive_ns
         long n_log
         ballc_segment_rec *log
+        double integrator_prof[7]
     int ballc_drive(const ballc_drive_config *, const double *, ballc_drive_output *) nogil
     void ballc_drive_free(ballc_drive_output *) nogil
 
@@ -165,14 +166,15 @@ cdef object _segment_record():
     cdef ballc_segment_rec g
     cdef char *at = <char *>&g
     offsets = [<char *>&g.t_start - at, <char *>&g.t_end - at, <char *>&g.nfev - at,
-               <char *>&g.njev - at, <char *>&g.nlu - at, <char *>&g.method - at,
+               <char *>&g.njev - at, <char *>&g.nlu - at, <char *>&g.nstep - at,
+               <char *>&g.nreject - at, <char *>&g.method - at,
                <char *>&g.method_end - at, <char *>&g.switches - at, <char *>&g.end - at,
                <char *>&g.plane - at, <char *>&g.rearms - at, <char *>&g.before[0] - at,
                <char *>&g.after[0] - at, <char *>&g.rearm_kind - at,
                <char *>&g.rearm_plane - at, <char *>&g.rearm_before - at,
                <char *>&g.rearm_after - at]
     fields = [("t_start", "f8"), ("t_end", "f8"), ("nfev", "l"), ("njev", "l"), ("nlu", "l"),
-              ("method", "intc"), ("method_end", "intc"), ("switches", "intc"),
+              ("nstep", "l"), ("nreject", "l"), ("method", "intc"), ("method_end", "intc"), ("switches", "intc"),
               ("end", "intc"), ("plane", "intc"), ("rearms", "intc"),
               ("before", ("i1", (2,))), ("after", ("i1", (2,))), ("rearm_kind", "i1"),
               ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1")]
@@ -452,6 +454,9 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                     segments=o.segments, end_kind=o.end_kind, end_plane=o.end_plane,
                     end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(BALLC_N_STATES)]),
                     profiled=bool(o.profiled), segment_log=segments,
+                    integrator_prof=dict(zip(("fun", "jac", "factor", "solve", "events",
+                                              "total", "total_ns"),
+                                             [o.integrator_prof[j] for j in range(7)])),
                     integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
     finally:
         ballc_drive_free(&o)

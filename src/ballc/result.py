@@ -421,6 +421,8 @@ SEGMENT_FIELDS = {
     "nfev": ("", "right-hand-side calls of the segment"),
     "njev": ("", "Jacobian evaluations of the segment"),
     "nlu": ("", "LU decompositions of the segment"),
+    "nstep": ("", "accepted steps of the segment (0 for an exact flight)"),
+    "nreject": ("", "rejected steps of the segment"),
     "end": ("", "why it ended: the event kind that ended it (enter, leave, through, "
             "approach, stop, clear, release, arm, yield, restick, capacity; user: a "
             "terminal user event), or t_end, step bound (a compliant contact's first "
@@ -451,11 +453,13 @@ def segment_table(raw: bytes) -> np.ndarray:
     ends = np.array(_core.SEGMENT_ENDS + ("",))
     table = np.empty(log.size, dtype=[
         ("t_start", "f8"), ("t_end", "f8"), ("method", "U8"), ("method_end", "U8"),
-        ("switches", "i4"), ("nfev", "i8"), ("njev", "i8"), ("nlu", "i8"), ("end", "U13"),
+        ("switches", "i4"), ("nfev", "i8"), ("njev", "i8"), ("nlu", "i8"), ("nstep", "i8"),
+        ("nreject", "i8"), ("end", "U13"),
         ("plane", "U7"), ("before", "U14", (2,)), ("after", "U14", (2,)), ("rearms", "i4"),
         ("rearm_kind", "U8"), ("rearm_plane", "U7"), ("rearm_before", "U14"),
         ("rearm_after", "U14")])
-    for name in ("t_start", "t_end", "switches", "nfev", "njev", "nlu", "rearms"):
+    for name in ("t_start", "t_end", "switches", "nfev", "njev", "nlu", "nstep", "nreject",
+                 "rearms"):
         table[name] = log[name]
     table["method"] = method_names[log["method"] + 1]
     table["method_end"] = method_names[log["method_end"] + 1]

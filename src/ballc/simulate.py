@@ -1168,7 +1168,7 @@ def _simulate_c(scene, options, y, config):
                     _segment_log=out["segment_log"])
     result._driver = "c"
     result._driver_counts = {key: out[key] for key in (
-        "segments", "profiled", "integrator_ns", "drive_ns")}
+        "segments", "profiled", "integrator_ns", "drive_ns", "integrator_prof")}
     stiff_at = out["stiff_at"]
     return _finish(result, options, None if math.isnan(stiff_at) else stiff_at)
 
