@@ -73,7 +73,8 @@ def measure(t_end, tol, repeat, method="radau5"):
                       nreject=int(segments["nreject"].sum()), cpu=cpu,
                       profiled=bool(counts["profiled"]), drive_ns=counts["drive_ns"],
                       nfev=result.nfev, njev=result.njev, nlu=result.nlu,
-                      **counts["integrator_prof"])
+                      **(counts["integrator_prof"] or dict.fromkeys(PARTS + ("total", "total_ns"),
+                                                                    0.0)))
         key = totals["total_ns"] if totals["profiled"] else totals["cpu"]
         if best is None or key < best[0]:
             best = (key, totals)

@@ -456,7 +456,8 @@ def drive(const double[::1] params, const double[::1] y0, dict k):
                     profiled=bool(o.profiled), segment_log=segments,
                     integrator_prof=dict(zip(("fun", "jac", "factor", "solve", "events",
                                               "total", "total_ns"),
-                                             [o.integrator_prof[j] for j in range(7)])),
+                                             [o.integrator_prof[j] for j in range(7)]))
+                    if o.profiled else None,
                     integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
     finally:
         ballc_drive_free(&o)
