@@ -9,9 +9,14 @@ commit and this tree.  Each round starts one child process per build, in alterna
 order, and each child times ``ballc.simulate(ballc.Scene(), t_end, rtol=tol, atol=tol)``
 (``time.process_time``, best of 3 inside the child) and splits that time into
 
-* ``solver``: inside ``ballc._radau5.solve_system`` (the C integration and its bridge),
+* ``solver``: inside ``ballc._core.drive``, the segment loop in C with the integrators
+  and its bridge (a build without the C loop: inside ``ballc._radau5.solve_system``),
 * ``post``: ``outcome.summarize_contact_forces`` and ``outcome.balance_warning``,
-* ``driver``: the rest (the segment loop in Python).
+* ``driver``: the rest (Python around the C loop; without it, the segment loop in Python).
+
+Accepted steps come from the C loop's segment log (``result.segments``; a build with the
+C loop but no log prints -1: wrapping solve_system there would make it take the Python
+driver).
 
 The printed figure per build is the best over rounds (a loaded machine only adds time),
 so two builds are compared on the same machine state as far as interleaving allows.
@@ -45,14 +50,18 @@ def timed(function, key):
             acc[key] += time.process_time() - started
     return wrapper
 
-original = _radau5.solve_system
-def solve_system(*args, **kwargs):
-    started = time.process_time()
-    sol = original(*args, **kwargs)
-    acc["solver"] += time.process_time() - started
-    acc["nstep"] += sol.nstep
-    return sol
-_radau5.solve_system = solve_system
+from ballc import _core
+if hasattr(_core, "drive"):   # the C loop: its one call
+    _core.drive = timed(_core.drive, "solver")
+else:
+    original = _radau5.solve_system
+    def solve_system(*args, **kwargs):
+        started = time.process_time()
+        sol = original(*args, **kwargs)
+        acc["solver"] += time.process_time() - started
+        acc["nstep"] += sol.nstep
+        return sol
+    _radau5.solve_system = solve_system
 outcome.summarize_contact_forces = timed(outcome.summarize_contact_forces, "post")
 outcome.balance_warning = timed(outcome.balance_warning, "post")
 out = {"__file__": ballc.__file__}
@@ -63,6 +72,11 @@ for tol in tols:
         started = time.process_time()
         result = ballc.simulate(ballc.Scene(), t_end, rtol=tol, atol=tol)
         total = time.process_time() - started
+        log = getattr(result, "segments", None)
+        if log is not None:
+            acc["nstep"] = int(log["nstep"].sum())
+        elif hasattr(_core, "drive"):
+            acc["nstep"] = -1
         if best is None or total < best["total"]:
             best = dict(total=total, solver=acc["solver"], post=acc["post"],
                         nstep=acc["nstep"], nfev=int(result.nfev),

@@ -1,4 +1,4 @@
-"""How much of a run is the Python driver, for two builds measured in one run.
+"""How much of a run is Python around the C loop, for two builds measured in one run.
 
     python -m benchmarks.driver_share BEFORE_SRC AFTER_SRC [--rounds 5] [--runs 100]
 
@@ -6,17 +6,17 @@ BEFORE_SRC and AFTER_SRC are ``src`` directories of two checkouts with their ext
 built in place (``python setup.py build_ext --inplace``), as for
 ``benchmarks.bit_identical``.  Each round starts one child process per build, in
 alternating order; a child imports ballc from its ``src`` (and checks that it did), wraps
-``simulate``'s one seam to the integrators (``ballc.integrate.integrate_segment``, as
-the driver module imported it) in a timer, and times ``--runs`` runs of each case with
-``time.perf_counter``, after a warm-up.  Per build and case the round with the least
-total time is kept.
+simulate's one call into the segment loop in C (``ballc._core.drive``) in a timer, and
+times ``--runs`` runs of each case with ``time.perf_counter``, after a warm-up.  Per build
+and case the round with the least total time is kept.  (A build whose run does not take
+the C loop spends all of it in Python.)
 
-Columns: the run's time (ms), the time inside integrate_segment (the compiled integrator
-plus its Cython bridge: argument checks, result arrays), the rest ("driver": the segment
-loop, the mode decisions, the segment events, the samples and the post-processing, all
-Python), the driver's share of the run, the segments per run and the driver per segment
-(µs).  Issue 22's target for the segment loop in C is a driver share <= 10 % at rtol 1e-3
-and a 1.2-s throw in <= 0.5 ms of CPU with dop853.
+Columns: the run's time (ms), the time inside ``_core.drive`` (the C loop with the
+integrators, and its Cython bridge: the constants in, the run's buffers out), the rest
+("Python": validation, the C loop's constants, the Result and its post-processing), the
+Python share of the run, the segments per run (the segment log's, ``result.segments``)
+and the Python per segment (µs).  Issue 29's target: a 1.2-s map throw with dop853 at
+rtol 1e-3 in <= 0.3 ms of CPU.
 
 Cases: the comeback map's throw (``ballc.Scene()``, 1.2 s, rtol = atol = 1e-3) with dop853
 and radau5, and benchmarks.compliant_cost's "ratio 2/7, mu 1" compliant scene (5 s) with
@@ -49,8 +49,7 @@ src = Path(sys.argv[1]).resolve()
 sys.path.insert(0, str(src))
 import ballc
 assert Path(ballc.__file__).resolve().parent == src / "ballc", (ballc.__file__, str(src))
-driver = sys.modules["ballc.simulate"]
-seam = driver.integrate_segment
+seam = getattr(ballc._core, "drive", None)
 inside = [0.0, 0]
 
 def timed(*args, **kwargs):
@@ -59,9 +58,16 @@ def timed(*args, **kwargs):
         return seam(*args, **kwargs)
     finally:
         inside[0] += time.perf_counter() - started
-        inside[1] += 1
 
-driver.integrate_segment = timed
+def segments_of(result):
+    log = getattr(result, "segments", None)
+    if log is not None:
+        return len(log)
+    counts = getattr(result, "_driver_counts", None)
+    return counts["segments"] if counts else float("nan")
+
+if seam is not None:
+    ballc._core.drive = timed
 spec = json.loads(sys.argv[2])
 out = {}
 for name, (scene_kw, t_end, kw) in spec["cases"].items():
@@ -74,7 +80,7 @@ for name, (scene_kw, t_end, kw) in spec["cases"].items():
         result = ballc.simulate(scene, t_end, progress=False, **kw)
     total = time.perf_counter() - started
     out[name] = dict(total=total / spec["runs"], inside=inside[0] / spec["runs"],
-                     segments=inside[1] / spec["runs"], nfev=int(result.nfev),
+                     segments=segments_of(result), nfev=int(result.nfev),
                      status=int(result.status))
 print(json.dumps(out))
 """
@@ -106,8 +112,8 @@ def main(argv=None) -> int:
                     best[(build, name)] = row
         print(f"  round {k + 1}/{args.rounds} done", file=sys.stderr)
     print(f"before: {builds['before']}\nafter:  {builds['after']}\n")
-    print("| case | build | run ms | integrator + bridge ms | driver ms | driver share | "
-          "segments | driver µs/segment | RHS calls | status |")
+    print("| case | build | run ms | C loop + bridge ms | Python ms | Python share | "
+          "segments | Python µs/segment | RHS calls | status |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for name in CASES:
         for build in builds:

@@ -4,11 +4,13 @@ would pay for an explicit method.
 Part 1: an observer-free isotropic scene (the seed scene with observer_mass = 0; its
 default inertia is a solid sphere's, isotropic): simulate with exact_flight on and off
 at several tolerances, CPU time (best of N, process time, same process), right-hand-side
-calls, and with the exact path off the share of radau5's steps, calls and CPU that the
-flight segments take.
+calls, and with the exact path off the share of radau5's steps and calls that the flight
+segments take (the C loop's segment log, ``result.segments``).
 
 Part 2: the seed scene (observer present, so no exact flight): its flight segments are
-recorded from a run, then replayed from the same start states with radau5 and with
+read from a run (its segment log, samples and dense output, as benchmarks.peers
+records segments), then replayed from the same start states, with the contact starts'
+events (ballc.events.penetration past its threshold), with radau5 and with
 scipy's DOP853 over a range of tolerances; the error is the end state (at the contact
 start event) against a reference (radau5 at rtol = atol = 1e-13, checked against DOP853
 at 1e-13).  Work is counted in right-hand-side calls and steps, radau5's Jacobians and
@@ -20,7 +22,6 @@ its cost in C is estimated as calls x the C right-hand side's cost).
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 
 import numpy as np
@@ -28,39 +29,41 @@ from scipy.integrate import solve_ivp
 
 import ballc
 from ballc import _core, _radau5
+from ballc import events as ev
 
-SIM = sys.modules["ballc.simulate"]
 TOLERANCES = (1e-3, 1e-6, 1e-8, 1e-10)
 REPLAY_TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
 
 
-class Recorder:
-    """Wraps the driver's integrate_segment: per call, whether it was a flight segment,
-    its steps, RHS calls and CPU time, and its inputs."""
-
-    def __init__(self):
-        self.calls = []
-        self.inner = SIM.integrate_segment
-
-    def __call__(self, system, t0, t1, y0, events, **options):
-        start = time.process_time()
-        sol = self.inner(system, t0, t1, y0, events, **options)
-        cpu = time.process_time() - start
-        self.calls.append(dict(flight=system.flags & ~_core.FLAGS["observer"] == 0,
-                               nstep=getattr(sol, "nstep", 0), nfev=sol.nfev, cpu=cpu,
-                               exact=getattr(sol, "exact_flight", False),
-                               inputs=(np.array(system.params), np.array(system.latch),
-                                       int(system.flags), t0, t1, np.array(y0), list(events)),
-                               t_end=float(sol.t[-1]) if sol.t.size else t0,
-                               status=sol.status))
-        return sol
-
-    def __enter__(self):
-        SIM.integrate_segment = self
-        return self
-
-    def __exit__(self, *exc):
-        SIM.integrate_segment = self.inner
+def flight_segments(result, scene, t_end):
+    """The flight segments of ``result`` (a run of the C loop to ``t_end`` with dense
+    output) that ended in a contact start: [dict(inputs=(params, latch, flags, t0, t1,
+    y0, events), nstep, nfev)], from its segment log, as the loop integrated them: from
+    t0 towards t1 = t_end (a flight has no rest check to stop at) with the contact
+    starts' events past their thresholds (events.contact_threshold); y0 is the
+    segment's piece of result.sol at t0 (its first step's start state, exactly), the
+    latch and flags its samples'."""
+    log = result.segments
+    if log is None:
+        raise SystemExit("the run did not take the C loop: it has no segment log")
+    params = scene.parameter_vector()
+    found = []
+    for row, (_, _, interpolant) in zip(log, result.sol.pieces):
+        if list(row["before"]) != ["flight", "flight"] or row["end"] != "enter":
+            continue
+        t0 = float(row["t_start"])
+        first = np.flatnonzero(result.t > t0)[0]
+        y0 = np.asarray(interpolant(t0), dtype=float)
+        events = []
+        for plane in ("floor", "ceiling"):
+            rho = ev.penetration(plane, scene)
+            threshold = ev.contact_threshold(scene, plane, float(rho(t0, y0)), True)
+            events.append(ev.LinearEvent(rho.coefficients, rho.offset - threshold,
+                                         terminal=True, direction=1))
+        found.append(dict(inputs=(params, np.array(result.latch[:, first]),
+                                  int(result.flags[first]), t0, t_end, y0, events),
+                          nstep=int(row["nstep"]), nfev=int(row["nfev"])))
+    return found
 
 
 def best_cpu(function, repeat):
@@ -82,18 +85,15 @@ def part1(t_end, repeat):
                 scene, t_end, rtol=rtol, atol=rtol, exact_flight=exact, progress=False),
                 repeat)
             run[exact] = (cpu, result)
-        with Recorder() as record:
-            ballc.simulate(scene, t_end, rtol=rtol, atol=rtol, exact_flight=False,
-                           progress=False)
-        flight = [c for c in record.calls if c["flight"]]
         on, off = run[True][1], run[False][1]
-        share = lambda key: sum(c[key] for c in flight) / max(sum(c[key] for c in record.calls), 1e-300)  # noqa: E731
+        log = off.segments
+        flight = log[(log["before"] == "flight").all(axis=1)]
+        share = lambda key: flight[key].sum() / max(log[key].sum(), 1e-300)  # noqa: E731
         rows.append(dict(
             rtol=rtol, cpu_on=run[True][0], cpu_off=run[False][0], nfev_on=on.nfev,
             nfev_off=off.nfev, contacts_on=len(on.contacts), contacts_off=len(off.contacts),
             came_back_on=ballc.outcome.came_back(on), came_back_off=ballc.outcome.came_back(off),
             flight_segments=len(flight), step_share=share("nstep"), nfev_share=share("nfev"),
-            cpu_share=share("cpu"),
             state_difference=float(np.abs(on.y[:13, -1] - off.y[:13, -1]).max())))
     return scene, rows
 
@@ -134,11 +134,8 @@ def rhs_cost(params, flags, y0, repeat=200_000):
 
 def part2(t_end, repeat):
     scene = ballc.Scene()    # the seed scene: observer of 1e-4 kg
-    with Recorder() as record:
-        result = ballc.simulate(scene, t_end, progress=False)
-    flights = [c for c in record.calls if c["flight"] and c["status"] == 1]
-    total_cpu = sum(c["cpu"] for c in record.calls)
-    flight_cpu = sum(c["cpu"] for c in flights)
+    result = ballc.simulate(scene, t_end, progress=False, dense_output=True)
+    flights = flight_segments(result, scene, t_end)
     references = [replay(c["inputs"], "radau5", 1e-13, 1e-13) for c in flights]
     cross = [replay(c["inputs"], "DOP853", 1e-13, 1e-13) for c in flights]
     reference_spread = max(float(np.abs(a["y"][:13] - b["y"][:13]).max())
@@ -160,12 +157,11 @@ def part2(t_end, repeat):
             rows.append(dict(method=method, tol=tol, error=error, t_error=t_error, **totals))
     cost, called = rhs_cost(scene.parameter_vector(), flights[0]["inputs"][2],
                             flights[0]["inputs"][5])
-    return dict(scene=scene, contacts=len(result.contacts), segments=len(record.calls),
-                flights=len(flights), total_cpu=total_cpu, flight_cpu=flight_cpu,
-                flight_steps=sum(c["nstep"] for c in flights),
-                total_steps=sum(c["nstep"] for c in record.calls),
-                flight_nfev=sum(c["nfev"] for c in flights),
-                total_nfev=sum(c["nfev"] for c in record.calls),
+    log = result.segments
+    return dict(scene=scene, contacts=len(result.contacts), segments=len(log),
+                flights=len(flights), flight_steps=sum(c["nstep"] for c in flights),
+                total_steps=int(log["nstep"].sum()),
+                flight_nfev=sum(c["nfev"] for c in flights), total_nfev=int(log["nfev"].sum()),
                 reference_spread=reference_spread, rows=rows, rhs_cost=cost,
                 rhs_call=called)
 
@@ -179,23 +175,22 @@ def main(argv=None):
     print(f"Part 1: Scene(observer_mass=0) (inertia {scene.inertia[0]:g} kg m^2 each), "
           f"t_end = {args.t_end:g} s, radau5, CPU best of {args.repeat}\n")
     print("| rtol = atol | CPU on (ms) | CPU off (ms) | speed-up | RHS calls on | RHS calls "
-          "off | contacts on/off | came back on/off | flight share of steps / calls / CPU "
-          "(off) | max end-state difference |")
+          "off | contacts on/off | came back on/off | flight share of steps / calls (off) "
+          "| max end-state difference |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         print(f"| {r['rtol']:.0e} | {1e3 * r['cpu_on']:.1f} | {1e3 * r['cpu_off']:.1f} | "
               f"{r['cpu_off'] / r['cpu_on']:.2f} | {r['nfev_on']} | {r['nfev_off']} | "
               f"{r['contacts_on']}/{r['contacts_off']} | {r['came_back_on']}/"
               f"{r['came_back_off']} | {100 * r['step_share']:.1f} % / "
-              f"{100 * r['nfev_share']:.1f} % / {100 * r['cpu_share']:.1f} % | "
+              f"{100 * r['nfev_share']:.1f} % | "
               f"{r['state_difference']:.1e} |")
     p2 = part2(args.t_end, args.repeat)
     print(f"\nPart 2: the seed scene (observer 1e-4 kg), t_end = {args.t_end:g} s, rtol = "
           f"atol = 1e-10: {p2['contacts']} contacts, {p2['segments']} segments, "
           f"{p2['flights']} flight segments ending in a contact start; flight takes "
           f"{p2['flight_steps']} of {p2['total_steps']} steps, {p2['flight_nfev']} of "
-          f"{p2['total_nfev']} RHS calls, {1e3 * p2['flight_cpu']:.2f} of "
-          f"{1e3 * p2['total_cpu']:.2f} ms CPU of the segments.")
+          f"{p2['total_nfev']} RHS calls.")
     print(f"Replayed flight segments; reference radau5 at 1e-13 (DOP853 at 1e-13 differs "
           f"from it by {p2['reference_spread']:.1e}); one RHS call through _core.System (flight, "
           f"observer; its Python-call overhead subtracted, its output array not: an upper "

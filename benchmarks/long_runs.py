@@ -6,10 +6,11 @@
 For each t_end: ``ballc.simulate(scene, t_end)`` with the default options (radau5,
 rtol = atol = 1e-10, exact Coulomb friction, max_nfev = 2e7), timed in wall-clock and
 CPU (time.process_time) as users run it (the C loop where it applies; which driver ran
-is a column), then timed again with the Python driver (the integrator seam wrapped to
-count segments; the results must be the same), with its status, the simulated time reached, the integrator
-segments (calls of the driver's integrate_segment, counted by a wrapper), the steps of
-the last segment, the right-hand-side calls, the samples, the contacts, and the median
+is a column), then timed again with the Python driver (the integrator seam wrapped; the
+results must be the same), with its status, the simulated time reached, the integrator
+segments and the steps of the last one (the C loop's segment log, ``result.segments``;
+for a run that fell back, the wrapper's count of the driver's integrate_segment calls),
+the right-hand-side calls, the samples, the contacts, and the median
 step after the last contact started.  For the largest run, the figures
 (``result.plot()``, ``plot_energy()``, ``plot_observer()``, ``plot_contacts()``, matplotlib
 Agg, not saved) and the animation (GIF) are timed too.  ``--scene drop``: a vertical
@@ -86,6 +87,9 @@ def run(scene, t_end, method, rest):
         python_cpu = time.process_time() - python_cpu
     if not (np.array_equal(plain.t, result.t) and np.array_equal(plain.y, result.y)):
         raise SystemExit(f"t_end {t_end}: the two drivers differ")
+    log = getattr(plain, "segments", None)
+    if log is not None:   # the C loop's own account
+        segments.count, segments.last_steps = len(log), int(log["nstep"][-1])
     last = result.contacts[-1].t_start if result.contacts else 0.0
     late = np.diff(result.t[result.t >= last])
     return dict(t_end=t_end, status=result.status, reached=float(result.t[-1]), wall=wall,

@@ -4,7 +4,9 @@
 
 Times ``ballc.simulate(ballc.Scene(), 5.0, rtol=1e-10, atol=1e-10)`` in this process
 (best of ``--repeat``, time.process_time around the call) and prints the counts
-(nfev, njev, nlu, and nstep / nreject summed over the segments).  Run it once
+(nfev, njev, nlu, and nstep / nreject summed over the segments of the C loop's
+segment log, ``result.segments``; a build without one: over the Python driver's calls of
+``_radau5.solve_system``, wrapped).  Run it once
 against a build that factors radau5's Newton matrices with LAPACK (before
 src/ballc/_lu.c) and once against a build that uses _lu.c, and compare: the script
 itself does not care which build it imports, it prints the path.
@@ -21,8 +23,8 @@ from ballc import _radau5
 
 
 def _counting(solve_system, totals):
-    """Wrap _radau5.solve_system to sum nstep / nreject over segments (simulate does not
-    report them)."""
+    """Wrap _radau5.solve_system to sum nstep / nreject over segments (a build without
+    the segment log; the wrapper makes simulate take the Python driver)."""
     def wrapped(*args, **kwargs):
         sol = solve_system(*args, **kwargs)
         totals["nstep"] += sol.nstep
@@ -41,13 +43,18 @@ def main(argv=None):
     def run():
         return ballc.simulate(ballc.Scene(), args.t_end, rtol=args.tol, atol=args.tol)
 
-    totals = {"nstep": 0, "nreject": 0}
-    original = _radau5.solve_system
-    _radau5.solve_system = _counting(original, totals)
-    try:
-        result = run()   # counts (and warm-up)
-    finally:
-        _radau5.solve_system = original
+    result = run()   # counts (and warm-up)
+    log = getattr(result, "segments", None)
+    if log is not None:
+        totals = {"nstep": int(log["nstep"].sum()), "nreject": int(log["nreject"].sum())}
+    else:
+        totals = {"nstep": 0, "nreject": 0}
+        original = _radau5.solve_system
+        _radau5.solve_system = _counting(original, totals)
+        try:
+            run()
+        finally:
+            _radau5.solve_system = original
     cpu = []
     for _ in range(args.repeat):
         started = time.process_time()

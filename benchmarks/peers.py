@@ -8,8 +8,9 @@ Method.  A reference run of the seed scene, ``ballc.simulate(ballc.Scene(), 5.0,
 rtol=1e-12, atol=1e-12)`` (default friction law, "exact"), is recorded segment by
 segment: start time and state, end time and state (the state at the event that ended
 the segment, as the driver received it, or at t_end), and the segment's parameters,
-latched values and flags.  The recording wraps ``integrate_segment`` as the driver
-calls it and changes nothing it returns.  Then every contender integrates EVERY
+latched values and flags.  The recording reads the C loop's segment log
+(``result.segments``) with the run's samples and dense output, which change nothing of
+the run.  Then every contender integrates EVERY
 segment from the reference's start state to the reference's end time, on the same
 compiled right-hand side and analytic Jacobian (``ballc._core.System(params, latch,
 flags)``), at rtol = atol = tol; no events, no output but the end state:
@@ -57,7 +58,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib
 import json
 import os
 import platform
@@ -132,62 +132,54 @@ class Segment:
 
 
 def record_segments(scene=None, t_end=T_END, rtol=REFERENCE_TOL, atol=REFERENCE_TOL):
-    """(result, segments): a ballc.simulate run and its smooth segments, recorded by
-    wrapping the driver's one call to an integrator (``integrate_segment``, as
-    ``ballc.simulate`` imported it); what it returns is passed on unchanged.
+    """(result, segments): a ballc.simulate run and its smooth segments, as the C loop's
+    segment log (``result.segments``) and the run's samples and dense output give them
+    (dense output changes nothing of the run: tests/test_peers_bench.py).
 
-    A driver segment in which radau5 re-armed an event (ballc.events.LinearEvent's
-    ``rearm``: a slip's approach re-latched without ending the segment) is recorded as
-    one piece per latch: it is split at each re-arming, whose time, state and new latch
-    the recording's wrapper of ``rearm`` keeps, so that every piece integrates one
-    fixed right-hand side (a replay without events would otherwise run on with the
-    first latch, whose slip orientation flips where u . d < 0).  The segment's RHS
-    calls are counted on its first piece."""
+    A segment's start state is its piece of ``result.sol`` at its start (each
+    integrator's interpolant gives its first step's start state there, exactly), its end
+    state the run's last sample in it (the state at the event that ended it, before the
+    driver handled it, or at t_end), its flags and latch those of its samples.  A
+    segment in which radau5 re-armed an event (a slip's approach re-latched without
+    ending the segment) is recorded as one piece per latch, split where the latch of its
+    samples changes: the samples up to a re-arming carry the latch before it, and the
+    last of them is the step's end at the event, the state the re-arming took; so every
+    piece integrates one fixed right-hand side (a replay without events would otherwise
+    run on with the first latch, whose slip orientation flips where u . d < 0).  The
+    segment's RHS calls are counted on its first piece.  A segment of zero length (an
+    event at its very start) has no samples and nothing to replay: its states and latch
+    are NaN and its flags -1."""
     scene = ballc.Scene() if scene is None else scene
-    driver = importlib.import_module("ballc.simulate")
-    original = driver.integrate_segment
+    result = ballc.simulate(scene, t_end, rtol=rtol, atol=atol, dense_output=True)
+    log = result.segments
+    if log is None:
+        raise RuntimeError("the run did not take the C loop: it has no segment log")
+    params = scene.parameter_vector()
+    pieces = result.sol.pieces
+    assert len(pieces) == len(log), (len(pieces), len(log))
     segments = []
-
-    def recording(system, t0, t1, y0, events, **options):
-        latch = np.array(system.latch, dtype=float)
-        rearmed = []   # (t, state, latch after) of each re-arming, in order
-        for event in events:
-            if getattr(event, "rearm", None) is not None:
-                event.rearm = _recorded_rearm(event.rearm, rearmed)
-        sol = original(system, t0, t1, y0, events, **options)
-        if sol.status == 1:   # as the driver does: the earliest terminal event
-            fired = [i for i, e in enumerate(events)
-                     if getattr(e, "terminal", False) and len(sol.t_events[i])]
-            index = min(fired, key=lambda i: sol.t_events[i][-1])
-            t_end_, y_end = float(sol.t_events[index][-1]), np.array(sol.y_events[index][-1])
-        elif sol.status == 0:
-            t_end_, y_end = float(sol.t[-1]), np.array(sol.y[:, -1])
-        else:
-            t_end_, y_end = None, None
-        if t_end_ is not None:
-            starts = [(float(t0), np.array(y0, dtype=float), latch)] + rearmed
-            ends = [(t, y) for t, y, _ in rearmed] + [(t_end_, y_end)]
-            for k, ((ta, ya, la), (tb, yb)) in enumerate(zip(starts, ends)):
-                segments.append(Segment(ta, ya, tb, yb, system.params, la, int(system.flags),
-                                        int(sol.nfev) if k == 0 else 0))
-        return sol
-
-    driver.integrate_segment = recording
-    try:
-        result = ballc.simulate(scene, t_end, rtol=rtol, atol=atol)
-    finally:
-        driver.integrate_segment = original
+    for row, (a, b, interpolant) in zip(log, pieces):
+        t0, t1, nfev = float(row["t_start"]), float(row["t_end"]), int(row["nfev"])
+        assert (a, b) == (t0, t1), ((a, b), (t0, t1))
+        inside = np.flatnonzero((result.t > t0) & (result.t <= t1))
+        if not inside.size:
+            nothing = np.full(_core.N_STATES, np.nan)
+            segments.append(Segment(t0, nothing, t1, nothing, params,
+                                    np.full(_core.N_LATCH, np.nan), -1, nfev))
+            continue
+        assert result.t[inside[-1]] == t1
+        flags = int(result.flags[inside[0]])
+        latch = result.latch[:, inside]
+        cuts = [k for k in range(1, inside.size)
+                if not np.array_equal(latch[:, k], latch[:, k - 1])]
+        starts = [(t0, np.asarray(interpolant(t0), dtype=float), latch[:, 0])] + [
+            (float(result.t[inside[k - 1]]), result.y[:, inside[k - 1]], latch[:, k])
+            for k in cuts]
+        ends = [(t, y) for t, y, _ in starts[1:]] + [(t1, result.y[:, inside[-1]])]
+        for k, ((ta, ya, la), (tb, yb)) in enumerate(zip(starts, ends)):
+            segments.append(Segment(ta, np.array(ya), tb, np.array(yb), params,
+                                    np.array(la), flags, nfev if k == 0 else 0))
     return result, segments
-
-
-def _recorded_rearm(rearm, rearmed):
-    """``rearm`` that also keeps (t, state, new latch) of each re-arming it makes."""
-    def recorded(t, y):
-        out = rearm(t, y)
-        if out is not None:
-            rearmed.append((float(t), np.array(y, dtype=float), np.array(out[2], dtype=float)))
-        return out
-    return recorded
 
 
 #: A segment whose exact-Coulomb slip starts this close to zero slip (m/s) is

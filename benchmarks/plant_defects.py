@@ -96,6 +96,34 @@ DEFECTS = [
     Defect("start-in-contact latch without the observer mass", "src/ballc/modes.py",
            "rho ** 2.5 / (scene.mass + scene.observer_mass)\n",
            "rho ** 2.5 / scene.mass\n", regenerate=False),
+    # the two above in the C loop, which the default runs take (issue 29)
+    Defect("C loop: per-contact energy split swapped (normal <-> tangential)",
+           "src/ballc/_driver.c",
+           "    rec->lost[0] = r->y[BALLC_STATE_DISSIPATED_NORMAL] - r->dissipated_at_start[p][0];\n"
+           "    rec->lost[1] = r->y[BALLC_STATE_DISSIPATED_TANGENTIAL] - "
+           "r->dissipated_at_start[p][1];\n",
+           "    rec->lost[1] = r->y[BALLC_STATE_DISSIPATED_NORMAL] - r->dissipated_at_start[p][0];\n"
+           "    rec->lost[0] = r->y[BALLC_STATE_DISSIPATED_TANGENTIAL] - "
+           "r->dissipated_at_start[p][1];\n", regenerate=False),
+    Defect("C loop: start-in-contact latch without the observer mass", "src/ballc/_driver.c",
+           "pow(rho, 2.5) / c->total_mass;\n",
+           "pow(rho, 2.5) / c->params[BALLC_PARAMETER_MASS];\n", regenerate=False),
+    # the C loop's copies of defects planted above in Python that only the Python
+    # driver runs (each caught without a comparison of the drivers: the test named)
+    Defect("C loop: dig-in direction latched reversed", "src/ballc/_driver.c",  # test_physics
+           "direction[i] = v[i] / speed;", "direction[i] = -v[i] / speed;", regenerate=False),
+    Defect("C loop: slip from rest starts along +lambda (settle)", "src/ballc/_driver.c",
+           "double d[2] = {-out[0] / size, -out[1] / size};",   # test_stickslip
+           "double d[2] = {out[0] / size, out[1] / size};", regenerate=False),
+    Defect("C loop: compliant modes, a yield never slides", "src/ballc/_driver.c",
+           "    if (m[1] >= 0) {\n", "    if (m[1] >= 1e300) {\n",   # test_compliant_modes
+           regenerate=False),
+    Defect("C loop: compliant elastic mode, the viscous capacity's kink not guarded",
+           "src/ballc/_driver.c", "if (elastic && c->damping_positive) {",
+           "if (elastic && 0) {", regenerate=False),   # test_compliant_modes
+    Defect("C loop: compliant modes, a sliding start's slip direction loses the sign of u_y",
+           "src/ballc/_driver.c", "    along[1] = length * u[1] / speed;",   # test_impact
+           "    along[1] = length * fabs(u[1]) / speed;", regenerate=False),
     Defect("impact's tangential restitution e_t sign flipped", "src/ballc/impact.py",
            "    e_t = -float(ua @ ub) / slip2 if ",
            "    e_t = float(ua @ ub) / slip2 if ", regenerate=False),

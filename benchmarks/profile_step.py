@@ -20,9 +20,10 @@ Printed per tolerance: accepted steps, RHS / Jacobian / LU calls per step, and C
 per accepted step inside ``radau5_solve`` (thread CPU time of the instrumented run;
 its timers add ~10 ns per timed call) split in proportion to the time-stamp-counter
 ticks of each part (on a loaded machine a preemption falls on a part in proportion
-to its length, so the shares stay fair); then the solver time per step of the same
-run seen from Python (``time.process_time`` around each ``solve_system`` call, so it
-includes the bridge's per-segment cost).  Best of ``--repeat`` runs.
+to its length, so the shares stay fair), summed over the segments by the C loop
+(``result._driver_counts``); then the CPU of the whole C loop (``ballc_drive``) and of
+the simulate call (``time.process_time``, the Python layer included) per step.  The
+steps are the segment log's (``result.segments``).  Best of ``--repeat`` runs.
 """
 from __future__ import annotations
 
@@ -54,33 +55,26 @@ def build_profiled(where: Path, quiet: bool = False) -> Path:
 
 
 def measure(t_end, tol, repeat, method="radau5"):
+    """The run's counts (its segment log's steps, the result's calls), and with a
+    profiled build the C loop's integrator counters (``_driver_counts``); CPU of the
+    simulate call.  Best of ``repeat``."""
     import ballc
-    from ballc import _radau5
 
-    original = _radau5.solve_system
     best = None
     for _ in range(repeat):
-        totals = dict(nstep=0, nreject=0, cpu=0.0, profiled=False, **{k: 0.0 for k in PARTS},
-                      total=0.0, total_ns=0.0)
-
-        def wrapped(*args, **kwargs):
-            started = time.process_time()
-            sol = original(*args, **kwargs)
-            totals["cpu"] += time.process_time() - started
-            totals["nstep"] += sol.nstep
-            totals["nreject"] += sol.nreject
-            if "profile" in sol:
-                totals["profiled"] = True
-                for key, value in sol.profile.items():
-                    totals[key] += value
-            return sol
-
-        _radau5.solve_system = wrapped
-        try:
-            result = ballc.simulate(ballc.Scene(), t_end, method=method, rtol=tol, atol=tol)
-        finally:
-            _radau5.solve_system = original
-        totals.update(nfev=result.nfev, njev=result.njev, nlu=result.nlu)
+        started = time.process_time()
+        result = ballc.simulate(ballc.Scene(), t_end, method=method, rtol=tol, atol=tol)
+        cpu = time.process_time() - started
+        segments = result.segments
+        if segments is None:
+            raise SystemExit("the run did not take the C loop: no segment log")
+        counts = result._driver_counts
+        totals = dict(nstep=int(segments["nstep"].sum()),
+                      nreject=int(segments["nreject"].sum()), cpu=cpu,
+                      profiled=bool(counts["profiled"]), drive_ns=counts["drive_ns"],
+                      nfev=result.nfev, njev=result.njev, nlu=result.nlu,
+                      **(counts["integrator_prof"] or dict.fromkeys(PARTS + ("total", "total_ns"),
+                                                                    0.0)))
         key = totals["total_ns"] if totals["profiled"] else totals["cpu"]
         if best is None or key < best[0]:
             best = (key, totals)
@@ -94,7 +88,7 @@ def report(t_end, tols, repeat, method="radau5"):
           f"best of {repeat}")
     header = (f"{'tol':>7s} {'steps':>6s} {'rej':>5s} {'RHS/st':>6s} {'Jac/st':>6s} {'LU/st':>6s} "
               f"{'us/step':>7s} " + " ".join(f"{LABELS[k]:>8s}" for k in PARTS)
-              + f" {'rest':>8s} {'bridge':>8s}")
+              + f" {'rest':>8s} {'C loop':>8s} {'run':>8s}")
     print(header)
     for tol in tols:
         m = measure(t_end, tol, repeat, method)
@@ -108,13 +102,16 @@ def report(t_end, tols, repeat, method="radau5"):
             rest = total - sum(parts.values())
             line += f"{total:7.2f} " + " ".join(
                 f"{parts[k]:4.2f} {100 * parts[k] / total:2.0f}%" for k in PARTS)
-            line += f" {rest:4.2f} {100 * rest / total:2.0f}%"
+            line += f" {rest:4.2f} {100 * rest / total:2.0f}% {m['drive_ns'] / 1e3 / n:8.2f}"
         else:
-            line += f"{'-':>7s} " + " ".join(f"{'-':>8s}" for _ in PARTS) + f" {'-':>8s}"
+            line += f"{'-':>7s} " + " ".join(f"{'-':>8s}" for _ in PARTS) + (
+                f" {'-':>8s} {'-':>8s}")
         line += f" {1e6 * m['cpu'] / n:8.2f}"
         print(line, flush=True)
-    print("us/step and the split: CPU inside radau5_solve (timers compiled in); 'bridge': "
-          "process time of the solve_system calls / accepted steps (bridge included)")
+    print("us/step and the split: CPU inside radau5_solve (timers compiled in), summed over "
+          "the segments; 'C loop': CPU of the whole segment loop in C (ballc_drive) / "
+          "accepted steps; 'run': process time of the simulate call / accepted steps "
+          "(the Python layer included)")
 
 
 def main(argv=None):

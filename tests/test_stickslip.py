@@ -398,9 +398,15 @@ def test_a_ten_micron_steel_ball_settles_to_rolling():
 
 
 def _segments_of(monkeypatch, *args, restart=False, **kwargs):
-    """(result, number of integrator calls) of ballc.simulate(*args, **kwargs);
-    ``restart``: without re-arming (every approach ends its segment, as for scipy's
-    methods)."""
+    """(result, number of segments integrated) of ballc.simulate(*args, **kwargs): the
+    C loop's, from its segment log.  ``restart``: without re-arming (every approach
+    ends its segment, as for scipy's methods), a switch only the Python driver has:
+    that run counts its integrator calls (until scipy's methods run in the C loop, or
+    the Python driver goes: issue 29)."""
+    if not restart:
+        result = ballc.simulate(*args, **kwargs)
+        assert result.segments is not None   # the C loop ran it
+        return result, len(result.segments)
     driver = importlib.import_module("ballc.simulate")
     calls = []
     original = driver.integrate_segment
@@ -409,12 +415,9 @@ def _segments_of(monkeypatch, *args, restart=False, **kwargs):
         calls.append(1)
         return original(*a, **k)
     with monkeypatch.context() as patch:
-        # the Python driver: its hooks are what this counts and patches (the C loop,
-        # bit-identical to it, is checked by tests/test_c_driver.py)
         patch.setenv("BALLC_PYTHON_DRIVER", "1")
         patch.setattr(driver, "integrate_segment", counting)
-        if restart:
-            patch.setattr(driver._Run, "rearm_approach", lambda self, plane: None)
+        patch.setattr(driver._Run, "rearm_approach", lambda self, plane: None)
         result = ballc.simulate(*args, **kwargs)
     return result, len(calls)
 
@@ -433,6 +436,9 @@ def test_re_arming_an_approach_changes_the_path_not_the_result(monkeypatch):
     assert ours.status == theirs.status == 0
     assert len(ours.contacts) == len(theirs.contacts) == 3
     assert calls < restarts
+    rearmed = ours.segments[ours.segments["rearms"] > 0]   # where, in the C loop's log
+    assert len(rearmed) and set(rearmed["rearm_kind"]) == {"approach"}
+    assert set(rearmed["rearm_before"]) == set(rearmed["rearm_after"]) == {"slip"}
     for a, b in zip(ours.contacts, theirs.contacts):
         assert [p for _, p in a.transitions] == [p for _, p in b.transitions]
         np.testing.assert_allclose(a.velocity_after, b.velocity_after, rtol=0, atol=20 * tol)
@@ -544,7 +550,31 @@ def test_stick_releases_where_the_coulomb_cone_says(s_star):
     assert slip[after][-1] < -1e-3
 
 
-def test_a_slip_from_rest_leaves_along_minus_lambda_and_friction_dissipates(monkeypatch):
+def _settles(result, plane):
+    """[(mode, slip direction, v_z)] of each settle on ``plane`` the C loop's segment log
+    reports: a stop whose slip was left within the integration error ends in stick or
+    in a slip from rest (slip_fixed), and one beyond it slips on (slip).  The direction
+    is the one latched for the next segment (its samples' latch; None for stick; NaN
+    when the run stopped there), v_z the state's at the stop (the segment's last
+    sample)."""
+    segments = result.segments
+    k = layout.PLANES.index(plane)
+    columns = [_core.LATCH_NAMES.index(f"{plane}_slip_direction_{axis}") for axis in "xy"]
+    found = []
+    for row in segments[(segments["end"] == "stop") & (segments["plane"] == plane)]:
+        mode = str(row["after"][k])
+        if mode == "slip":
+            continue
+        at = np.flatnonzero(result.t == row["t_end"])[-1]
+        direction = None
+        if mode == "slip_fixed":
+            direction = result.latch[columns, at + 1] if at + 1 < result.t.size else (
+                np.full(2, np.nan))
+        found.append((mode, direction, float(result.velocity[2, at])))
+    return found
+
+
+def test_a_slip_from_rest_leaves_along_minus_lambda_and_friction_dissipates():
     """Oracle: closed forms of the same scene with c_tau = 1 (chi = 0: N = (1 - m) F_H,
     F_d = m F_H, both proportional to F_H, and the normal force conservative: v_z goes
     from -w0 to +w0).  mu = 0.3 < m b / (1 - m) = 0.71: the cone cannot hold the
@@ -567,18 +597,9 @@ def test_a_slip_from_rest_leaves_along_minus_lambda_and_friction_dissipates(monk
     assert A > B                                   # outside the cone: no stick
     r_before = -(A + B) / ((1 - m) + m * a)
     r_after = -(A - B) / ((1 - m) + m * a)
-    settles = []
-    original = stickslip.settle
-
-    def recording(scene, params, latch, flags, plane, y):
-        found = original(scene, params, latch, flags, plane, y)
-        settles.append((found[0], None if found[1] is None else np.array(found[1]),
-                        float(y[layout.INDEX["vz"]])))
-        return found
-    monkeypatch.setattr(stickslip, "settle", recording)
-    monkeypatch.setenv("BALLC_PYTHON_DRIVER", "1")   # records the Python driver's settles
     scene = _mixture_throw(mu, m, 1.0, u0, w0)
     result = ballc.simulate(scene, 0.15, rtol=1e-10, atol=1e-10, max_nfev=100_000)
+    settles = _settles(result, "floor")
 
     # the path: one settle, a slip from rest along -lambda / |lambda| = -e_x
     assert len(settles) >= 1

@@ -180,7 +180,8 @@ def test_invalid_simulate_option_is_rejected_before_integration(kwargs, name, va
     def must_not_integrate(*args, **kw):
         raise AssertionError("integrated despite invalid input")
 
-    monkeypatch.setattr(driver, "integrate_segment", must_not_integrate)
+    monkeypatch.setattr(ballc._core, "drive", must_not_integrate)   # the C loop
+    monkeypatch.setattr(driver, "integrate_segment", must_not_integrate)   # the Python loop
     with pytest.raises(SceneError) as info:
         ballc.simulate(ballc.Scene(), **kwargs)
     message = str(info.value)

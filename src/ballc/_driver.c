@@ -160,6 +160,8 @@ void ballc_drive_free(ballc_drive_output *o)
     o->trials = NULL;
     free(o->switch_t); free(o->switch_to);
     o->switch_t = NULL; o->switch_to = NULL;
+    free(o->log);
+    o->log = NULL;
     free(o->user_hit_event); free(o->user_hit_t); free(o->user_hit_y);
     o->user_hit_event = NULL; o->user_hit_t = o->user_hit_y = NULL;
     o->pieces = NULL; o->dense_t = o->dense_c = NULL; o->dense_kind = NULL;
@@ -219,6 +221,7 @@ typedef struct {
     double polled;
     int interrupted;
     long seg_interpolant;
+    ballc_segment_rec seg;      /* the segment under way's log record */
 } run_t;
 
 enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
@@ -227,6 +230,84 @@ enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
 
 enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE,
        K_ARM, K_YIELD, K_RESTICK, K_CAPACITY, K_USER };   /* from K_APPROACH on: CARRY_STEP */
+
+/* ---- the segment log (_driver.h: ballc_segment_rec) ---- */
+
+/* the event kinds are the first segment ends, in the same order */
+typedef char k_codes_are_segment_ends[((int)K_ENTER == (int)BALLC_SEG_ENTER
+                                       && (int)K_DEEPEST == (int)BALLC_SEG_DEEPEST
+                                       && (int)K_CAPACITY == (int)BALLC_SEG_CAPACITY
+                                       && (int)K_USER == (int)BALLC_SEG_USER) ? 1 : -1];
+
+typedef char integrator_prof_fits[RADAU5_PROF_N == 7 ? 1 : -1];
+
+const char *const ballc_plane_mode_names[BALLC_N_PLANE_MODES] = {
+    "flight", "contact", "slip", "slip_fixed", "stick", "elastic", "sliding", "resting",
+    "rolling", "free_sliding", "passed_through"};
+
+const char *const ballc_segment_end_names[BALLC_N_SEGMENT_ENDS] = {
+    "enter", "leave", "through", "deepest", "approach", "stop", "clear", "release", "arm",
+    "yield", "restick", "capacity", "user", "t_end", "rest check", "uniform check",
+    "orbit check", "step bound", "failed"};
+
+/* _Run.mode: plane p's mode now (BALLC_PLANE_*) */
+static int plane_mode(const run_t *r, int p)
+{
+    if (!r->in_contact[p])
+        return r->stop_code == BALLC_DRIVE_THROUGH && r->stop_plane == p
+            ? BALLC_PLANE_PASSED_THROUGH : BALLC_PLANE_FLIGHT;
+    if (r->o->end_kind != BALLC_END_NONE && r->o->end_plane == p)
+        return r->o->end_kind == BALLC_END_REST ? BALLC_PLANE_RESTING
+            : r->o->end_kind == BALLC_END_ROLLING ? BALLC_PLANE_ROLLING
+            : BALLC_PLANE_FREE_SLIDING;
+    switch (r->coulomb[p]) {
+    case BALLC_MODE_SLIP: return BALLC_PLANE_SLIP;
+    case BALLC_MODE_SLIP_FIXED: return BALLC_PLANE_SLIP_FIXED;
+    case BALLC_MODE_STICK: return BALLC_PLANE_STICK;
+    default: break;
+    }
+    if (r->compliant[p] == COMPLIANT_ELASTIC) return BALLC_PLANE_ELASTIC;
+    if (r->compliant[p] == COMPLIANT_SLIDING) return BALLC_PLANE_SLIDING;
+    return BALLC_PLANE_CONTACT;
+}
+
+/* A segment starts at r->t in the present modes. */
+static void log_open(run_t *r)
+{
+    ballc_segment_rec *g = &r->seg;
+    memset(g, 0, sizeof *g);
+    g->t_start = r->t;
+    g->plane = -1;
+    g->rearm_kind = g->rearm_plane = g->rearm_before = g->rearm_after = -1;
+    for (int p = 0; p < 2; p++) g->before[p] = (signed char)plane_mode(r, p);
+}
+
+/* An event of plane p re-armed inside the segment, leaving it in mode ``before``. */
+static void log_rearm(run_t *r, int kind, int p, int before)
+{
+    ballc_segment_rec *g = &r->seg;
+    g->rearms++;
+    g->rearm_kind = (signed char)kind;
+    g->rearm_plane = (signed char)p;
+    g->rearm_before = (signed char)before;
+    g->rearm_after = (signed char)plane_mode(r, p);
+}
+
+/* The segment ended at t_end, by ``end`` (BALLC_SEG_*) of ``plane``, and its end has
+ * been handled: append its record.  -1: out of memory. */
+static int log_close(run_t *r, int end, int plane, double t_end)
+{
+    ballc_drive_output *o = r->o;
+    if (grow((void **)&o->log, &o->cap_log, o->n_log + 1, sizeof(ballc_segment_rec)))
+        return -1;
+    ballc_segment_rec *g = &r->seg;
+    g->end = end;
+    g->plane = plane;
+    g->t_end = t_end;
+    for (int p = 0; p < 2; p++) g->after[p] = (signed char)plane_mode(r, p);
+    o->log[o->n_log++] = *g;
+    return 0;
+}
 
 /* _Run.flags */
 static int run_flags(const run_t *r, int with_coulomb)
@@ -793,12 +874,13 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
 {
     run_t *r = (run_t *)ctx;
     int code = r->ev_plane_code[e];
+    int p = r->ev_plane[e];
     if (code >= CAPACITY_FIRST) {   /* the bridge's _ball_rearm: a capacity guard toggles */
         r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + 2 : code - 2;
+        log_rearm(r, K_CAPACITY, p, plane_mode(r, p));
         return 1;
     }
     if (r->ev_kind[e] == K_USER) return user_rearm(r, e, t, y);
-    int p = r->ev_plane[e];
     long stalled = stalled_at(r, t);
     if (unsettled(r, p, stalled) || r->relatches[p] + 1 > MAX_RELATCH) return 0;
     double u[2], speed, error, clear;
@@ -811,7 +893,9 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
     r->relatches[p] += 1;
     double d[2] = {u[0] / speed, u[1] / speed};
     double approach = py_min(clear, APPROACH_FRACTION * speed);
+    int before = plane_mode(r, p);
     if (set_mode(r, p, BALLC_MODE_SLIP, d, 1, approach)) return 0;
+    log_rearm(r, K_APPROACH, p, before);
     stop_coefficients(r, p, d, r->ev_coef + (size_t)e * N);
     r->ev_offset[e] = -approach;
     r->margins_plane = -1;   /* the margins read the latch */
@@ -1371,6 +1455,7 @@ static int check_orbit(run_t *r, int p)
     }
     r->trial_on = 0;
     r->trial_failed = 1;
+    r->seg.end = BALLC_SEG_ORBIT_CHECK;   /* the log: the trial ended at this check */
     ballc_dense *d = &r->trial;
     if (r->trial_broken || !d->n_pieces || d->t1[d->n_pieces - 1] != r->t) return 0;
     const ballc_piecewise *solution = ballc_dense_view(d);
@@ -1407,6 +1492,7 @@ static int end_state(run_t *r, int p)
     const ballc_contact_rec *k = &r->o->contacts[r->o->open[p]];
     int rest = at_rest(r, r->y, k->t_start, r->t);
     if (rest < 0) return -1;
+    r->seg.end = rest ? BALLC_SEG_REST_CHECK : BALLC_SEG_UNIFORM_CHECK;   /* the log */
     if (rest) {   /* resting.rest_state */
         double new_y[N];
         memcpy(new_y, r->y, sizeof new_y);
@@ -1657,6 +1743,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         for (int i = 0; i < NL; i++)
             if (!isfinite(r->latch[i])) rc = -1;
         if (rc) break;
+        log_open(r);
         radau5_result res;
         int solved = RADAU5_DONE, flown = 0;
         if (c->exact_flight && flags == 0 && c->user_flight) {   /* flight.applies */
@@ -1727,10 +1814,13 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         r->seg_interpolant = seg.interpolant;
         }
         o->segments++;
+        r->seg.method = flown ? -1 : c->method != RADAU5_METHOD_AUTO ? c->method
+                        : implicit ? RADAU5_METHOD_RADAU : RADAU5_METHOD_DOP853;
         has_first = 0;
         implicit = 0;
 #ifdef RADAU5_PROFILE
         o->integrator_ns += res.prof[RADAU5_PROF_TOTAL_NS];
+        for (int i = 0; i < RADAU5_PROF_N; i++) o->integrator_prof[i] += res.prof[i];
 #endif
         if (r->user_failed || r->interrupted || solved == BALLC_INTEGRATOR_RAISED
                 || res.status == RADAU5_INTERRUPTED) {   /* the bridge raises what it kept */
@@ -1742,6 +1832,13 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         nfev += res.nfev;
         njev += res.njev;
         nlu += res.nlu;
+        r->seg.nfev = res.nfev;
+        r->seg.njev = res.njev;
+        r->seg.nlu = res.nlu;
+        r->seg.nstep = res.nstep;
+        r->seg.nreject = res.nreject;
+        r->seg.method_end = flown ? -1 : res.method_end;
+        r->seg.switches = (int)res.n_switches;
         if (!stiff_found && isfinite(res.stiff_at)) {
             o->stiff_at = res.stiff_at;
             stiff_found = 1;
@@ -1816,6 +1913,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             o->message[sizeof o->message - 1] = 0;
             o->fail_end = res.n_out ? res.t_out[res.n_out - 1] : r->t;
             radau5_free(&res);
+            if (log_close(r, BALLC_SEG_FAILED, -1, o->fail_end)) rc = -2;
             break;
         }
         if (trial && trial_add(r, &res, r->t, t_stop, res.status == RADAU5_REACHED, flown)) {
@@ -1832,6 +1930,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 radau5_free(&res);
                 if (t_stop != t_check) {   /* only a step bound ended: a fresh step */
                     implicit = ended_implicit;
+                    if (log_close(r, BALLC_SEG_STEP_BOUND, -1, r->t)) { rc = -2; break; }
                     continue;
                 }
                 int p = c->resting_plane;
@@ -1842,12 +1941,15 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                     o->end_plane = p;
                     o->end_t = r->t;
                     memcpy(o->end_y, r->y, sizeof r->y);
+                    if (log_close(r, r->seg.end, p, r->t)) rc = -2;
                     break;
                 }
                 implicit = ended_implicit;   /* auto keeps the method it ended with */
+                if (log_close(r, r->seg.end, p, r->t)) { rc = -2; break; }
                 continue;   /* the next segment starts with its own first step */
             }
             radau5_free(&res);
+            if (log_close(r, BALLC_SEG_T_END, -1, r->t)) rc = -2;
             break;
         }
         if (fired < 0) { radau5_free(&res); rc = -1; break; }
@@ -1864,6 +1966,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         if (kind == K_USER) {   /* a terminal user event: the run stops, status 1 */
             r->status = 1;
             r->stop_code = BALLC_DRIVE_TERMINATED;
+            if (log_close(r, BALLC_SEG_USER, p, r->t)) rc = -2;
             break;
         }
         if (kind == K_CAPACITY)   /* its row may have toggled inside the segment */
@@ -1889,6 +1992,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         default: handled = coulomb_event(r, kind, p); break;
         }
         if (handled) { rc = -1; break; }
+        if (log_close(r, kind, p, r->t)) { rc = -2; break; }
         if (kind >= K_APPROACH && h_next > 0) {   /* CARRY_STEP */
             first = py_min(h_next, run_max_step(r));
             has_first = 1;

@@ -30,6 +30,10 @@ double ballc_py_hypot(int n, const double *values);
 double ballc_py_ulp(double x);
 double ballc_dot3_fma(const double *v);
 
+/* ballc_drive_config.method of a run with one of scipy's methods (its integrator is the
+ * bridge's callback), and the segment log's method of its segments */
+enum { BALLC_METHOD_SCIPY = -2 };
+
 /* stop codes */
 enum {
     BALLC_DRIVE_OK = 0,          /* reached t_end (status 0) */
@@ -189,6 +193,58 @@ typedef struct {
     long interpolant;
 } ballc_piece_rec;
 
+/* The segment log (result.segments): one record per segment integrated (or flown), in
+ * order, appended where the segment ends -- after the handler of the event that ended
+ * it, or the check or bound that did.  Always kept: a few stores per segment. */
+
+/* A plane's mode (ballc.automaton.MODES, in its order: ballc_plane_mode_names) */
+enum {
+    BALLC_PLANE_FLIGHT = 0, BALLC_PLANE_CONTACT, BALLC_PLANE_SLIP, BALLC_PLANE_SLIP_FIXED,
+    BALLC_PLANE_STICK, BALLC_PLANE_ELASTIC, BALLC_PLANE_SLIDING, BALLC_PLANE_RESTING,
+    BALLC_PLANE_ROLLING, BALLC_PLANE_FREE_SLIDING, BALLC_PLANE_PASSED_THROUGH,
+    BALLC_N_PLANE_MODES
+};
+
+/* Why a segment ended (ballc_segment_end_names): first the event kinds of the automaton
+ * (its terminal events: enter .. capacity, and a terminal user event), then the ends
+ * that are no event.  A scheduled rest check runs its checks in turn -- rest, uniform
+ * motion, an orbit's trial ending now -- each when the one before found nothing: the
+ * end names the last that ran (so "uniform check" says the rest check found no rest). */
+enum {
+    BALLC_SEG_ENTER = 0, BALLC_SEG_LEAVE, BALLC_SEG_THROUGH, BALLC_SEG_DEEPEST,
+    BALLC_SEG_APPROACH, BALLC_SEG_STOP, BALLC_SEG_CLEAR, BALLC_SEG_RELEASE, BALLC_SEG_ARM,
+    BALLC_SEG_YIELD, BALLC_SEG_RESTICK, BALLC_SEG_CAPACITY, BALLC_SEG_USER,
+    BALLC_SEG_T_END,            /* reached t_end */
+    BALLC_SEG_REST_CHECK,       /* a rest check that found rest */
+    BALLC_SEG_UNIFORM_CHECK,    /* ... no rest; uniform rolling / sliding, or nothing */
+    BALLC_SEG_ORBIT_CHECK,      /* ... neither; an orbit's trial ended here */
+    BALLC_SEG_STEP_BOUND,       /* a compliant contact's step bound ended */
+    BALLC_SEG_FAILED,           /* the integrator failed (status -1) */
+    BALLC_N_SEGMENT_ENDS
+};
+
+extern const char *const ballc_plane_mode_names[BALLC_N_PLANE_MODES];
+extern const char *const ballc_segment_end_names[BALLC_N_SEGMENT_ENDS];
+
+typedef struct {
+    double t_start, t_end;      /* s; a failure: the last time reached */
+    long nfev, njev, nlu;       /* of this segment (0 for an exact flight) */
+    long nstep, nreject;        /* its accepted and rejected steps */
+    int method, method_end;     /* the integrator it started / ended with: RADAU5_METHOD_*
+                                 * (auto: radau5 or dop853), -1 an exact flight */
+    int switches;               /* method "auto": switches inside the segment */
+    int end;                    /* BALLC_SEG_* */
+    int plane;                  /* the event's plane (0 floor, 1 ceiling), a user event's
+                                 * index, or -1 (no event) */
+    int rearms;                 /* events re-armed inside the segment (a free slip's
+                                 * approach re-latched, the capacity guard toggled) */
+    signed char before[2], after[2];   /* BALLC_PLANE_* of each plane during the segment
+                                        * and after its end was handled */
+    signed char rearm_kind, rearm_plane;    /* the last re-arm: BALLC_SEG_APPROACH or
+                                             * _CAPACITY and its plane; -1 none */
+    signed char rearm_before, rearm_after;  /* the plane's mode before / after it */
+} ballc_segment_rec;
+
 typedef struct {
     long n, cap;                        /* samples: t (n), y (n x N_STATES) */
     double *t, *y;
@@ -237,6 +293,12 @@ typedef struct {
     ballc_dense orbit_base;
     long n_trials, cap_trials;
     double *trials;
+    long n_log, cap_log;                /* the segment log (result.segments) */
+    ballc_segment_rec *log;
+    /* a -DRADAU5_PROFILE build: radau5_result's prof (RADAU5_PROF_N = 7: ticks inside the
+     * RHS, Jacobian, factorisations, solves, events, in all, and ns in all) summed over
+     * the segments; zeros otherwise */
+    double integrator_prof[7];
 } ballc_drive_output;
 
 int ballc_drive(const ballc_drive_config *config, const double *y0,

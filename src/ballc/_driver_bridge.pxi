@@ -103,6 +103,16 @@ cdef extern from "_driver.h":
         double y0[19]
         int own
         long interpolant
+    enum: BALLC_N_PLANE_MODES, BALLC_N_SEGMENT_ENDS
+    const char *ballc_plane_mode_names[]
+    const char *ballc_segment_end_names[]
+    ctypedef struct ballc_segment_rec:
+        double t_start, t_end
+        long nfev, njev, nlu, nstep, nreject
+        int method, method_end, switches, end, plane, rearms
+        signed char before[2]
+        signed char after[2]
+        signed char rearm_kind, rearm_plane, rearm_before, rearm_after
     ctypedef struct ballc_drive_output:
         long n
         double *t
@@ -149,6 +159,9 @@ cdef extern from "_driver.h":
         ballc_dense orbit_base
         long n_trials
         double *trials
+        long n_log
+        ballc_segment_rec *log
+        double integrator_prof[7]
     int ballc_drive(const ballc_drive_config *, const double *, ballc_drive_output *) nogil
     void ballc_drive_free(ballc_drive_output *) nogil
 
@@ -156,6 +169,41 @@ cdef extern from "_driver.h":
 DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH, DRIVE_TERMINATED = (
     BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
     BALLC_DRIVE_TERMINATED)
+
+
+#: The names of the segment log's codes (_driver.c): a plane's mode (ballc.automaton.MODES),
+#: why a segment ended (the automaton's event kinds, then t_end, the checks, ...), and the
+#: integrator (-1: an exact flight, -2: one of scipy's methods, the run's).
+PLANE_MODES = tuple(ballc_plane_mode_names[i].decode() for i in range(BALLC_N_PLANE_MODES))
+SEGMENT_ENDS = tuple(ballc_segment_end_names[i].decode()
+                     for i in range(BALLC_N_SEGMENT_ENDS))
+SEGMENT_METHODS = {BALLC_METHOD_SCIPY: "scipy", -1: "flight", RADAU5_METHOD_RADAU: "radau5",
+                   RADAU5_METHOD_DOP853: "dop853"}
+
+
+cdef object _segment_record():
+    """The numpy dtype of _driver.h's ballc_segment_rec, at the offsets C gives it."""
+    cdef ballc_segment_rec g
+    cdef char *at = <char *>&g
+    offsets = [<char *>&g.t_start - at, <char *>&g.t_end - at, <char *>&g.nfev - at,
+               <char *>&g.njev - at, <char *>&g.nlu - at, <char *>&g.nstep - at,
+               <char *>&g.nreject - at, <char *>&g.method - at,
+               <char *>&g.method_end - at, <char *>&g.switches - at, <char *>&g.end - at,
+               <char *>&g.plane - at, <char *>&g.rearms - at, <char *>&g.before[0] - at,
+               <char *>&g.after[0] - at, <char *>&g.rearm_kind - at,
+               <char *>&g.rearm_plane - at, <char *>&g.rearm_before - at,
+               <char *>&g.rearm_after - at]
+    fields = [("t_start", "f8"), ("t_end", "f8"), ("nfev", "l"), ("njev", "l"), ("nlu", "l"),
+              ("nstep", "l"), ("nreject", "l"), ("method", "intc"), ("method_end", "intc"), ("switches", "intc"),
+              ("end", "intc"), ("plane", "intc"), ("rearms", "intc"),
+              ("before", ("i1", (2,))), ("after", ("i1", (2,))), ("rearm_kind", "i1"),
+              ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1")]
+    return np.dtype(dict(names=[f[0] for f in fields], formats=[f[1] for f in fields],
+                         offsets=offsets, itemsize=sizeof(ballc_segment_rec)))
+
+
+#: ballc_segment_rec as a numpy record (drive's "segment_log": bytes of these)
+SEGMENT_RECORD = _segment_record()
 
 
 cdef int _check_signals() except -1:
@@ -329,7 +377,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
     c.interpolant = NULL
     if k["scipy"]:   # one of scipy's methods, called back segment by segment
         scipy_run = _ScipyRun(k["method"], k["scipy_atol"], np.asarray(params), user_ctx[1])
-        c.method = -1
+        c.method = BALLC_METHOD_SCIPY
         c.integrate = _scipy_integrate
         c.integrate_ctx = <void *>scipy_run
         c.interpolant = _scipy_interpolant
@@ -467,6 +515,8 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
                 lost=(rec.lost[0], rec.lost[1])))
         phases = [(o.phases[i].contact, o.phases[i].t, o.phases[i].phase)
                   for i in range(o.n_phases)]
+        # the segment log, the bytes C wrote (SEGMENT_RECORD each): read when asked for
+        segments = (<char *>o.log)[:o.n_log * sizeof(ballc_segment_rec)] if o.n_log else b""
         pieces = []   # dense output: (t0, t1, dense_t, dense_c, terms, dense_kind), or
         for i in range(o.n_pieces):   # (t0, t1, y0) of an exact flight
             piece = o.pieces[i]
@@ -510,7 +560,11 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
                     nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
                     segments=o.segments, end_kind=o.end_kind, end_plane=o.end_plane,
                     end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(BALLC_N_STATES)]),
-                    profiled=bool(o.profiled),
+                    profiled=bool(o.profiled), segment_log=segments,
+                    integrator_prof=dict(zip(("fun", "jac", "factor", "solve", "events",
+                                              "total", "total_ns"),
+                                             [o.integrator_prof[j] for j in range(7)]))
+                    if o.profiled else None,
                     integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
     finally:
         ballc_drive_free(&o)

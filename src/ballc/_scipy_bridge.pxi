@@ -13,6 +13,9 @@ from libc.stdlib cimport malloc
 from libc.string cimport memset, strncpy
 
 cdef extern from "_driver.h":
+    enum: BALLC_METHOD_SCIPY
+
+cdef extern from "_driver.h":
     ctypedef struct ballc_segment:
         int flags
         const double *latch
@@ -89,7 +92,7 @@ cdef int _scipy_segment(_ScipyRun run, const radau5_problem *p, ballc_segment *s
     cdef list guards = []
     memset(res, 0, sizeof(radau5_result))
     res.stiff_at = NAN
-    res.method_end = -1
+    res.method_end = BALLC_METHOD_SCIPY
     res.status = RADAU5_FAILED
     seg.interpolant = -1
     try:

@@ -180,6 +180,10 @@ class Result:
         Right-hand-side flags of the segment that computed each sample (int).
     latch : ndarray, shape (N_LATCH, n)
         The latched contact values of that segment (SI units).
+    segments : ndarray or None
+        The segment log: one row per smooth segment the run integrated, in order (see
+        :data:`SEGMENT_FIELDS`); None for a run of the Python driver or one read from a
+        file.
     """
 
     t: np.ndarray
@@ -206,6 +210,19 @@ class Result:
     #: with ``method="auto"``: [(t, method)], each switch of the integrator (s, and
     #: "radau5" or "dop853": the method switched to), in time order; else None
     method_switches: list | None = field(default=None, repr=False)
+    #: the C loop's segment log, the bytes it wrote (ballc._core.SEGMENT_RECORD each);
+    #: read it as ``segments``
+    _segment_log: bytes | None = field(default=None, repr=False)
+
+    @property
+    def segments(self) -> np.ndarray | None:
+        """The segment log (a read-only numpy structured array, one row per segment,
+        fields and units in :data:`SEGMENT_FIELDS`), or None for a run of the Python
+        driver or one read from a file.  Built on first access."""
+        found = self.__dict__.get("_segments")
+        if found is None and self._segment_log is not None:
+            found = self.__dict__["_segments"] = segment_table(self._segment_log)
+        return found
 
     @property
     def success(self) -> bool:
@@ -468,6 +485,75 @@ ODE_RESULT_KEYS = ("t", "y", "sol", "t_events", "y_events", "nfev", "njev", "nlu
 
 #: Contact fields, in the order files store them.
 CONTACT_FIELDS = [f.name for f in fields(Contact)]
+
+
+#: The columns of ``Result.segments``: name -> (unit, meaning).  The modes are
+#: ballc.automaton.MODES, the event kinds its TRANSITIONS' events; a plane's column pair
+#: (shape (2,)) is (floor, ceiling).
+SEGMENT_FIELDS = {
+    "t_start": ("s", "when the segment started"),
+    "t_end": ("s", "when it ended (a failed one: the last time it reached)"),
+    "method": ("", "the integrator it started with: radau5, dop853 (method auto: the one "
+               "in use), or flight (exact free flight, ballc.flight)"),
+    "method_end": ("", "the integrator of its last step (method auto may switch)"),
+    "switches": ("", "method auto: its switches inside the segment"),
+    "nfev": ("", "right-hand-side calls of the segment"),
+    "njev": ("", "Jacobian evaluations of the segment"),
+    "nlu": ("", "LU decompositions of the segment"),
+    "nstep": ("", "accepted steps of the segment (0 for an exact flight)"),
+    "nreject": ("", "rejected steps of the segment"),
+    "end": ("", "why it ended: the event kind that ended it (enter, leave, through, "
+            "approach, stop, clear, release, arm, yield, restick, capacity; user: a "
+            "terminal user event), or t_end, step bound (a compliant contact's first "
+            "steps end), failed (the integrator), or a scheduled rest check named by the "
+            "last of its checks that ran, each running when the one before found "
+            "nothing: rest check, uniform check, orbit check"),
+    "plane": ("", "the plane of that event or check (floor, ceiling), else ''"),
+    "before": ("", "each plane's mode during the segment (floor, ceiling)"),
+    "after": ("", "each plane's mode once its end was handled (floor, ceiling)"),
+    "rearms": ("", "events re-armed inside the segment without ending it (a free slip's "
+               "approach re-latched, the compliant capacity guard turned)"),
+    "rearm_kind": ("", "the last of those: its event kind (approach, capacity), or ''"),
+    "rearm_plane": ("", "... its plane, or ''"),
+    "rearm_before": ("", "... that plane's mode before it, or ''"),
+    "rearm_after": ("", "... and after it, or ''"),
+}
+
+
+def segment_table(raw: bytes) -> np.ndarray:
+    """The readable segment table (``Result.segments``) of the C loop's log ``raw``
+    (records ballc._core.SEGMENT_RECORD, of codes), with names for its codes
+    (_core.PLANE_MODES, SEGMENT_ENDS, SEGMENT_METHODS; layout.PLANES); read-only."""
+    log = np.frombuffer(raw, dtype=_core.SEGMENT_RECORD)
+    modes = np.array(_core.PLANE_MODES + ("",))        # code -1: ''
+    planes = np.array(layout.PLANES + ("",))
+    methods = _core.SEGMENT_METHODS
+    low = min(methods)
+    method_names = np.array([methods.get(k, str(k)) for k in range(low, max(methods) + 1)])
+    ends = np.array(_core.SEGMENT_ENDS + ("",))
+    table = np.empty(log.size, dtype=[
+        ("t_start", "f8"), ("t_end", "f8"), ("method", "U6"), ("method_end", "U6"),
+        ("switches", "i4"), ("nfev", "i8"), ("njev", "i8"), ("nlu", "i8"), ("nstep", "i8"),
+        ("nreject", "i8"), ("end", "U13"),
+        ("plane", "U7"), ("before", "U14", (2,)), ("after", "U14", (2,)), ("rearms", "i4"),
+        ("rearm_kind", "U8"), ("rearm_plane", "U7"), ("rearm_before", "U14"),
+        ("rearm_after", "U14")])
+    for name in ("t_start", "t_end", "switches", "nfev", "njev", "nlu", "nstep", "nreject",
+                 "rearms"):
+        table[name] = log[name]
+    table["method"] = method_names[log["method"] - low]
+    table["method_end"] = method_names[log["method_end"] - low]
+    table["end"] = ends[log["end"]]
+    user = log["end"] == _core.SEGMENT_ENDS.index("user")   # its plane is the event's index
+    table["plane"] = planes[np.where(user, -1, log["plane"])]
+    table["before"] = modes[log["before"]]
+    table["after"] = modes[log["after"]]
+    table["rearm_kind"] = ends[log["rearm_kind"]]
+    table["rearm_plane"] = planes[log["rearm_plane"]]
+    table["rearm_before"] = modes[log["rearm_before"]]
+    table["rearm_after"] = modes[log["rearm_after"]]
+    table.flags.writeable = False
+    return table
 
 
 def _contacts_from(arrays: dict) -> list:

@@ -1181,10 +1181,11 @@ def _simulate_c(scene, options, y, config, progress):
                     t_events=[user_t[user_event == k] for k in range(n_user)],
                     y_events=[user_y[user_event == k] for k in range(n_user)],
                     sol=PiecewiseSolution(pieces) if options.dense_output else None,
-                    method_switches=out["switches"] if options.method == "auto" else None)
+                    method_switches=out["switches"] if options.method == "auto" else None,
+                    _segment_log=out["segment_log"])
     result._driver = "c"
     result._driver_counts = {key: out[key] for key in (
-        "segments", "profiled", "integrator_ns", "drive_ns")}
+        "segments", "profiled", "integrator_ns", "drive_ns", "integrator_prof")}
     #: ballc.orbit's trials: [(t_from, t_to, accepted)]
     result._orbit_trials = out["trials"]
     stiff_at = out["stiff_at"]
