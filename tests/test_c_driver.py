@@ -333,20 +333,58 @@ def test_a_wrapped_integrator_seam_gets_the_python_driver(monkeypatch):
     assert result._driver == "python" and calls
 
 
+#: The child of test_ctrl_c_stops_a_long_c_run: a run of millions of elastic bounces
+#: (1e7 s, hours of work) in the C loop, sampled only at its ends (t_eval) so that its
+#: memory stays bounded however long it runs; "started" once the next line is the run.
+_LONG_RUN = """
+import sys
+import numpy as np
+import ballc
+scene = ballc.Scene(velocity=(0.0, 0.0, 0.0), observer_mass=0.0, c_tau=1.0,
+                    tangential_model="friction", friction_coefficient=0.0)
+t_eval = np.array([0.0, 1e7])
+ballc.simulate(scene, 10.0, t_eval=[0.0, 10.0], progress=False)   # imports, first calls
+c_loop = sys.modules["ballc.simulate"]._c_config(
+    scene, ballc.options.check_options(scene, 1e7, t_eval=t_eval), False, True) is not None
+print("started", "c" if c_loop else "python", flush=True)
+ballc.simulate(scene, 1e7, t_eval=t_eval, progress=False, max_nfev=10**12)
+print("finished", flush=True)
+"""
+
+
 def test_ctrl_c_stops_a_long_c_run():
-    """The C loop asks for pending signals before each segment, as the Python driver could
-    be interrupted between segments: a Ctrl-C (SIGINT, raised here 0.2 s into a run of
-    millions of elastic bounces that would take minutes) ends it with KeyboardInterrupt."""
+    """The C loop asks for pending signals (before each segment; a bounce is a few
+    segments), as the Python driver can be interrupted between segments: a Ctrl-C
+    (SIGINT) sent from this process to a child running a long C run ends it with
+    KeyboardInterrupt, promptly.  The signal comes from another process, after the
+    child said the run starts (and a second more, so that it lands inside the run
+    rather than just before it -- either way the child must stop, so no outcome of
+    this test depends on scheduling); 60 s is the generous bound on "promptly" (the
+    run would take hours)."""
+    import os
     import signal
-    import threading
-    scene = ballc.Scene(velocity=(0.0, 0.0, 0.0), observer_mass=0.0, c_tau=1.0,
-                        tangential_model="friction", friction_coefficient=0.0)
-    assert sys.modules["ballc.simulate"]._c_config(
-        scene, ballc.options.check_options(scene, 1e7), False, True) is not None
-    timer = threading.Timer(0.2, signal.raise_signal, (signal.SIGINT,))
-    timer.start()
+    import subprocess
+    import time
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    env.pop("BALLC_PYTHON_DRIVER", None)
+    child = subprocess.Popen([sys.executable, "-c", _LONG_RUN], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, env=env)
     try:
-        with pytest.raises(KeyboardInterrupt):
-            ballc.simulate(scene, 1e7, progress=False, max_nfev=10**12)
+        line = child.stdout.readline()
+        assert line.split()[:1] == ["started"], (line, child.stderr.read())
+        if C_NUMERICS:
+            assert line.split()[1] == "c"
+        time.sleep(1.0)
+        child.send_signal(signal.SIGINT)
+        try:
+            out, err = child.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            out = err = None
     finally:
-        timer.cancel()
+        if child.poll() is None:
+            child.kill()
+            child.communicate()
+    assert out is not None, "the run went on for 60 s after the Ctrl-C"
+    assert "finished" not in out
+    assert child.returncode != 0
+    assert err.rstrip().splitlines()[-1] == "KeyboardInterrupt", err
