@@ -337,9 +337,13 @@ def test_a_wrapped_integrator_seam_gets_the_python_driver(monkeypatch):
 #: (1e7 s, hours of work) in the C loop, sampled only at its ends (t_eval) so that its
 #: memory stays bounded however long it runs; "started" once the next line is the run.
 _LONG_RUN = """
+import signal
 import sys
 import numpy as np
 import ballc
+# a terminal's process: Ctrl-C raises KeyboardInterrupt (a process started in the
+# background by a shell without job control inherits SIGINT ignored)
+signal.signal(signal.SIGINT, signal.default_int_handler)
 scene = ballc.Scene(velocity=(0.0, 0.0, 0.0), observer_mass=0.0, c_tau=1.0,
                     tangential_model="friction", friction_coefficient=0.0)
 t_eval = np.array([0.0, 1e7])

@@ -279,8 +279,8 @@ def test_ball_comes_to_rest_and_stays_for_60_s(modulus, c_tau):
 def test_high_spin_fast(spin):
     """0.6 s of flight (the first contact is at 0.83 s) spinning at up to 200 rad/s with
     the seed's off-centre observer, so the ball's centre wobbles (~8 mm off its own
-    parabola here) and the flight is integrated.  Oracles: the centre of mass of ball and observer flies the parabola
-    x0 + v0 t - g t^2 / 2 z (v0 = (m v + m_o (v + omega x (x_o - x))) / (m + m_o), by
+    parabola here) and the flight is integrated.  Oracles: the centre of mass of ball
+    and observer flies the parabola x0 + v0 t - g t^2 / 2 z (v0 = (m v + m_o (v + omega x (x_o - x))) / (m + m_o), by
     hand; measured within 3e-12 m), and the total energy stays put."""
     result = run(t_end=0.6, velocity=(0.5, 0.0, -2.0), angular_velocity=spin, **FRICTION)
     assert result.status == 0
