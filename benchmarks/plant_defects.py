@@ -623,31 +623,35 @@ def main(argv=None):
         print(f"    {jobs} copy(ies) built in {time.perf_counter() - started:.0f} s",
               flush=True)
         named = sorted({t for d in defects for t in (args.tests or d.tests)})
-        if named and not args.no_baseline and not args.suite:
-            t0 = time.perf_counter()
-            base = copies[0].pytest(named)
-            ok = base.kind == "pass"
-            rows.append(Row("(baseline: the named tests, no defect)",
-                            "clean" if ok else "BASELINE FAILS", describe(base, "named"),
-                            time.perf_counter() - t0))
-            print(f"... {rows[-1].name}: {rows[-1].verdict}, {rows[-1].how}, "
-                  f"{rows[-1].seconds:.0f} s", flush=True)
-            if not ok:
-                failures += 1
         work = queue.Queue()
+        if named and not args.no_baseline and not args.suite:
+            work.put(None)                   # the baseline: the named tests, no defect
         for defect in ordered:
             work.put(defect)
         lock = threading.Lock()
 
         def worker(copy):
+            nonlocal failures
             while True:
                 try:
                     defect = work.get_nowait()
                 except queue.Empty:
                     return
-                future = futures.get(defect.name)
-                row = harness.check(copy, defect, future.result if future else None)
+                t0 = time.perf_counter()
+                try:
+                    if defect is None:
+                        base = copy.pytest(named)
+                        row = Row("(baseline: the named tests, no defect)",
+                                  "clean" if base.kind == "pass" else "BASELINE FAILS",
+                                  describe(base, "named"), time.perf_counter() - t0)
+                    else:
+                        future = futures.get(defect.name)
+                        row = harness.check(copy, defect, future.result if future else None)
+                except Exception as error:      # the harness's own failure: never a catch
+                    row = Row(defect.name if defect else "(baseline)", "harness error",
+                              f"{type(error).__name__}: {error}", time.perf_counter() - t0)
                 with lock:
+                    failures += defect is None and row.verdict != "clean"
                     rows.append(row)
                     print(f"... {row.name}: {row.verdict}, {row.how}, {row.seconds:.0f} s",
                           flush=True)
