@@ -1,8 +1,9 @@
 """Plant known defects, one at a time, and check that the default test suite catches each
 by an ordinary assertion.
 
-    python -m benchmarks.plant_defects [--only WORD ...] [--jobs N] [--suite] [--no-suite]
-                                       [--tests ID ...] [--check] [--keep] [--cache DIR]
+    python -m benchmarks.plant_defects [--only WORD ...] [--jobs N] [--codegen-jobs N]
+                                       [--suite] [--no-suite] [--tests ID ...] [--check]
+                                       [--keep] [--cache DIR]
 
 Every entry of DEFECTS is one text substitution in one file (the pattern must occur
 exactly ``count`` times on the current tree, or nothing runs: a refactoring must not
@@ -14,9 +15,9 @@ One work copy of the tree per job (``--jobs``, default 1), copied once (without 
 and build products) and built once.  For each defect, in that copy:
 
 1. plant it; a defect in codegen/ gets the generated C of the planted generator (made
-   by ``python -m codegen`` in a copy of codegen/ alone, in a background process
-   while other defects run, and cached by the hash of codegen/'s text: a later run
-   reuses it); generated/ must change;
+   by ``python -m codegen`` in a copy of codegen/ alone, in background processes
+   (``--codegen-jobs``) while other defects run, and cached by the hash of codegen/'s
+   text: a later run reuses it); generated/ must change;
 2. rebuild only when a compiled source changed (``setup.py build_ext --inplace`` with
    ``benchmarks/compile_cache.py`` as the compiler: a source whose preprocessed text
    is unchanged is a copy from the object cache, so a defect in one C file recompiles
@@ -219,6 +220,11 @@ DEFECTS = [
            "src/ballc/_integrator.c",
            "if (s->stiff_steps < AUTO_STIFF_STEPS && !s->stiff_probe) return 0;",
            "if (s->stiff_steps < AUTO_STIFF_STEPS || !s->stiff_probe) return 0;",
+           tests=("tests/test_auto_method.py::test_either_stiffness_test_switches_to_radau5",)),
+    Defect("method='auto' switches to radau5 on Hairer's test alone (the probe ignored)",
+           "src/ballc/_integrator.c",
+           "if (s->stiff_steps < AUTO_STIFF_STEPS && !s->stiff_probe) return 0;",
+           "if (s->stiff_steps < AUTO_STIFF_STEPS) return 0;",
            tests=("tests/test_auto_method.py::test_either_stiffness_test_switches_to_radau5",)),
     Defect("method='auto': the probe switches without Hairer's evidence",
            "src/ballc/_integrator.c",
@@ -575,6 +581,9 @@ def main(argv=None):
                         help="skip the named tests' run on the unplanted tree")
     parser.add_argument("--jobs", type=int, default=1,
                         help="defects checked at once, each in its own copy (default 1)")
+    parser.add_argument("--codegen-jobs", type=int, default=2,
+                        help="codegen runs at once for the codegen defects whose C is not "
+                             "cached (default 2; ~75 s of CPU each)")
     parser.add_argument("--keep", action="store_true", help="keep the work copies")
     parser.add_argument("--cache", type=Path, default=None,
                         help="object and generated-C cache (default "
@@ -608,7 +617,7 @@ def main(argv=None):
     print(f"work copies and log in {scratch}; caches in {cache}", flush=True)
 
     # the generated C of the codegen defects, made in the background meanwhile
-    generator = ThreadPoolExecutor(max_workers=1)
+    generator = ThreadPoolExecutor(max_workers=max(1, args.codegen_jobs))
     futures = {d.name: generator.submit(generate, d, cache, log, args.timeout)
                for d in defects if d.regenerate}
     # codegen defects last: their C is made while the others run
