@@ -256,3 +256,25 @@ def test_a_transient_then_stiffness_switches_both_ways():
     assert sol.method_end == "radau5" and sol.status == 0
     for t, y in zip(sol.t, sol.y.T):
         assert np.allclose(y, exact(fast, [1.0, 0.0], t), rtol=0, atol=1e-5)
+
+
+def test_either_stiffness_test_switches_to_radau5():
+    """docs/architecture.md, "The automatic method": auto switches to radau5 once Hairer's
+    test has seen 15 stiff steps in a row *or* once the probe finds the steps stiff.
+    On the steel scene at rtol 3e-4 Hairer's test never fires: dop853 run alone over the
+    whole 5 s does not report the scene stiff.  auto is that dop853 run step for step
+    until it switches, so a switch there is the probe's alone -- and it must come (measured
+    at t = 2.24 s, once the ball rolls in persistent contact), with far fewer calls than
+    dop853's.  Not a switch on the probe without Hairer's evidence: that is
+    test_auto_on_the_seed_scene_is_dop853."""
+    opts = dict(rtol=3e-4, atol=3e-4)
+    dop = ballc.simulate(STEEL, 5.0, method="dop853", **opts)
+    auto = ballc.simulate(STEEL, 5.0, method="auto", **opts)
+    assert dop.status == 0 and auto.status == 0
+    assert "found the scene stiff" not in dop.message   # Hairer's test never fired
+    assert auto.method_switches and auto.method_switches[0][1] == "radau5"
+    t_switch = auto.method_switches[0][0]
+    assert 2.0 < t_switch < 3.0
+    before = auto.t < t_switch
+    assert np.array_equal(auto.t[before], dop.t[:before.sum()])
+    assert auto.nfev < dop.nfev / 3

@@ -208,3 +208,28 @@ def test_the_compliant_throw_converges_across_the_viscous_capacity_kink():
     reference = runs[1e-12].y[:, -1]
     error = {tol: np.max(np.abs(runs[tol].y[:, -1] - reference)) for tol in (1e-9, 1e-8)}
     assert error[1e-9] < 1e-7 and error[1e-8] < 1e-6, error
+
+
+@pytest.mark.parametrize("driver", ["c", "python"])
+@pytest.mark.parametrize("vy", [-3.0, 3.0])
+def test_a_sliding_start_puts_the_spring_along_the_slip(vy, driver, monkeypatch):
+    """A contact that starts sliding (mu = 0.2, a slip of ~3 m/s against an approach of
+    ~3.7 m/s) puts its spring at the cap along the slip velocity: no spin, so the slip
+    is the horizontal velocity (1, vy), and the deflection right after the start points
+    that way (closed form: the direction of u), with either sign of u_y and in both
+    drivers (the C loop, compliantmodes.start for the Python driver's runs)."""
+    if driver == "python":
+        monkeypatch.setenv("BALLC_PYTHON_DRIVER", "1")
+    else:
+        monkeypatch.delenv("BALLC_PYTHON_DRIVER", raising=False)
+    scene = ballc.Scene(tangential_model="compliant", observer_mass=0.0, friction_coefficient=0.2,
+                        position=(0.0, 0.0, 1.5), velocity=(1.0, vy, -2.0))
+    result = ballc.simulate(scene, 0.2)
+    assert result._driver == driver
+    first = result.contacts[0]
+    assert first.transitions[0] == (first.t_start, "slip")
+    after = np.searchsorted(result.t, first.t_start, side="right")
+    names = ballc.STATE_NAMES
+    s = result.y[[names.index("floor_deflection_x"), names.index("floor_deflection_y")], after]
+    u = result.y[[names.index("vx"), names.index("vy")], after]
+    assert np.dot(s, u) / (np.linalg.norm(s) * np.linalg.norm(u)) > 1 - 1e-6

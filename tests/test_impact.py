@@ -225,6 +225,96 @@ def test_fit_impacts_recovers_known_parameters():
     assert "friction_coefficient" in fit.summary()
 
 
+# --- issue 28: fit_impacts' standard errors against the textbook and the refits' spread ---
+#: A linear least-squares problem: the friction law sliding through the whole impact
+#: (no gravity) changes vx by -mu (1 + e) v_n sign(u) and wy by +5/2 mu (1 + e) v_n
+#: sign(u) / r (test_tangential_restitution_in_gross_sliding), exactly linear in mu.
+#: Rows (angle from the normal in degrees, wy in rad/s) in gross sliding for any mu
+#: below 0.6, at 2 m/s.
+LINEAR_ROWS = ((60.0, -600.0), (70.0, -400.0), (75.0, -200.0))
+LINEAR_MU = 0.3
+NOISE = 1e-3   # of the incident speed (velocities) and of speed / r (spins)
+
+
+def linear_problem():
+    """(base scene, incident rows, a, b) with the rebounds, scaled as fit_impacts scales
+    its residuals, a + b mu by the rigid Coulomb map written out (columns vx_after,
+    wy_after; e by Hunt-Crossley's relation chi (1+e) = ln((1+chi)/(1-chi e)))."""
+    scene = steel(gravity=0.0, tangential_model="friction", friction_coefficient=LINEAR_MU)
+    chi = 1.5 * (1 - scene.c_tau)
+    e = brentq(lambda x: chi * (1 + x) - math.log((1 + chi) / (1 - chi * x)), 0.5, 1.0)
+    r, speed = scene.radius, 2.0
+    incident, a, b = [], [], []
+    for angle, wy in LINEAR_ROWS:
+        theta = math.radians(angle)
+        vx, vz = speed * math.sin(theta), -speed * math.cos(theta)
+        u = vx - r * wy
+        assert u > 3.5 * 0.6 * (1 + e) * -vz        # sliding to the end up to mu = 0.6
+        incident.append((vx, 0.0, vz, 0.0, wy, 0.0))
+        a += [vx / speed, wy / (speed / r)]
+        b += [-(1 + e) * -vz / speed, 2.5 * (1 + e) * -vz / r / (speed / r)]
+    return scene, np.array(incident), np.array(a), np.array(b)
+
+
+def noisy_table(incident, a, b, rng, speed=2.0, radius=None):
+    """The rebounds a + b mu plus Gaussian noise of NOISE, in the fit's scaled units,
+    as a table of measured values (unscaled)."""
+    import pandas as pd
+    from ballc.impact import INCIDENT_COLUMNS
+    measured = a + b * LINEAR_MU + NOISE * rng.standard_normal(a.size)
+    table = pd.DataFrame(incident, columns=list(INCIDENT_COLUMNS))
+    table["vx_after"] = measured[0::2] * speed
+    table["wy_after"] = measured[1::2] * speed / radius
+    return table, measured
+
+
+def textbook(measured, a, b):
+    """Linear least squares y = a + b mu: the estimate, and its standard error
+    sqrt(s^2 (J^T J)^-1), s^2 = |residual|^2 / (N - p), J = b, p = 1."""
+    mu = float(b @ (measured - a) / (b @ b))
+    residual = a + b * mu - measured
+    s2 = float(residual @ residual) / (measured.size - 1)
+    return mu, math.sqrt(s2 / float(b @ b))
+
+
+def test_fit_standard_errors_are_the_textbook_formula(rng):
+    """One fit of noisy rebounds of the linear problem: its value and standard error are
+    the textbook linear least-squares estimate and error computed here (the compliant
+    friction law is the rigid map to ~1e-11 of the speed, the noise is 1e-3)."""
+    scene, incident, a, b = linear_problem()
+    table, measured = noisy_table(incident, a, b, rng, radius=scene.radius)
+    fit = ballc.fit_impacts(scene.replace(friction_coefficient=0.2), table,
+                            free=("friction_coefficient",))
+    mu, error = textbook(measured, a, b)
+    assert fit.values[0] == pytest.approx(mu, abs=1e-3 * error)
+    assert fit.standard_errors[0] == pytest.approx(error, rel=1e-3)
+    assert 2 * fit.cost == pytest.approx(error ** 2 * float(b @ b) * (measured.size - 1),
+                                         rel=1e-3)
+
+
+def test_fit_standard_errors_match_the_spread_of_refits(rng):
+    """200 refits of the linear problem, each with its own noise (the seeded rng): the
+    fit's reported standard error (the root mean square over the refits: E[s^2] =
+    sigma^2) is the spread of the fitted mu, and both are the noise propagated by hand,
+    NOISE / |b|.  Sampling uncertainty: ~5 % for the standard deviation of 200 values,
+    ~2 % for the mean of 200 s^2 with 5 degrees of freedom; the bands are 4 of those
+    (an error off by sqrt(2) is 30 % off).  Measured: spread 1.018, reported 0.984 of
+    NOISE / |b|."""
+    scene, incident, a, b = linear_problem()
+    values, errors = [], []
+    for _ in range(200):
+        table, _ = noisy_table(incident, a, b, rng, radius=scene.radius)
+        fit = ballc.fit_impacts(scene, table, free=("friction_coefficient",), rtol=1e-8)
+        values.append(fit.values[0])
+        errors.append(fit.standard_errors[0])
+    spread = float(np.std(values, ddof=1))
+    reported = math.sqrt(float(np.mean(np.square(errors))))
+    expected = NOISE / math.sqrt(float(b @ b))
+    assert reported == pytest.approx(expected, rel=0.1)
+    assert spread == pytest.approx(expected, rel=0.2)
+    assert reported == pytest.approx(spread, rel=0.2)
+
+
 def rigid_coulomb_bounce(vx, vz, wy, radius, mu, e):
     """Oracle: the rigid Coulomb impact of a solid sphere (I = 2/5 m r^2) on the floor,
     in the x-z plane, in closed form.  u = vx - r wy is the contact point's velocity.

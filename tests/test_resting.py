@@ -5,6 +5,7 @@ bounces 20 times, stays in contact from t = 16.44 s, and its normal oscillation 
 out; it is at rest by t = 29.4 s.  The seed scene itself never rests: it rolls.
 """
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -136,3 +137,98 @@ def test_the_seed_observer_keeps_the_rolling_out_of_the_uniform_closed_form():
     first trial ends, tests/test_orbit.py) the run integrates on."""
     run = ballc.simulate(ballc.Scene(), 60)
     assert "rolls" not in run.message and math.isnan(run.contacts[-1].t_rolling)
+
+
+# --- issue 28: the rest threshold against its documented value, computed here ---
+#: docs/architecture.md (resting.py): "energy above the static Hertz equilibrium below that
+#: of a 10-tolerance oscillation"; ballc.resting's docstring, criterion 3.
+DOCUMENTED_FACTOR = 10.0
+VZ = ballc.STATE_NAMES.index("vz")
+
+
+def documented_bound(scene, rtol, atol):
+    """min(1/2 k_lin dx^2, 1/2 m dv^2), dx = 10 (atol + rtol r), dv = 10 (atol + rtol
+    sqrt(g r)), k_lin = 3/2 k0 rho_eq^(1/2): written out from the docstring, with k0 by
+    hand (hertz_k0)."""
+    k0 = hertz_k0(scene)
+    m = scene.mass + scene.observer_mass
+    rho_eq = (m * scene.gravity / k0) ** (2 / 3)
+    k_lin = 1.5 * k0 * math.sqrt(rho_eq)
+    dx = DOCUMENTED_FACTOR * (atol + rtol * scene.radius)
+    dv = DOCUMENTED_FACTOR * (atol + rtol * math.sqrt(scene.gravity * scene.radius))
+    return min(0.5 * k_lin * dx * dx, 0.5 * m * dv * dv)
+
+
+def test_at_rest_is_the_documented_energy_bound(drop):
+    """resting.at_rest, and the bound the C loop is given, at states built here whose
+    energy above rest is a known fraction of the documented bound: 1/2 m vz^2 exactly
+    (a vertical velocity at the equilibrium), or 1/2 k_lin dz^2 to ~dz / rho_eq (a
+    displacement from it: the Hertz spring's cubic term).  0.9 of the bound is at rest,
+    1.1 is not."""
+    rtol, atol = 1e-10, 1e-10
+    bound = documented_bound(drop, rtol, atol)
+    m = drop.mass
+    k0 = hertz_k0(drop)
+    rho_eq = (m * drop.gravity / k0) ** (2 / 3)
+    k_lin = 1.5 * k0 * math.sqrt(rho_eq)
+    period = 2 * math.pi * math.sqrt(m / k_lin)
+    t_start, t = 0.0, 25 * period          # the contact old enough (criterion 2)
+    rest = drop.initial_state()
+    rest[Z] = drop.radius - rho_eq
+    for share, expected in ((0.9, True), (1.1, False)):
+        moving = rest.copy()
+        moving[VZ] = math.sqrt(2 * share * bound / m)
+        assert bool(resting.at_rest(drop, moving, "floor", t_start, t, rtol, atol)) is expected
+        pressed = rest.copy()
+        pressed[Z] -= math.sqrt(2 * share * bound / k_lin)
+        assert bool(resting.at_rest(drop, pressed, "floor", t_start, t, rtol, atol)) is expected
+    # the bound the C loop compares with
+    config = sys.modules["ballc.simulate"]._c_config(
+        drop, ballc.options.check_options(drop, 100.0, rtol=rtol, atol=atol), False, True)
+    assert config["rest_threshold"] == pytest.approx(bound, rel=1e-12)
+
+
+@pytest.mark.parametrize("height, c_tau", [(5.0, None), (0.5, 0.9)])
+def test_rest_is_declared_at_the_first_check_below_the_bound(height, c_tau):
+    """The run (C loop) declares rest at the first check time whose state is below the
+    documented bound.  Oracle: the check times written out from the docstring (20 small-
+    oscillation periods into the contact, then every max(20 T0, age / 4)), the state
+    there from the same scene integrated without rest checks (rest=False, dense
+    output), its energy above rest by hand (the vertical drop: 1/2 m vz^2 and the Hertz
+    spring plus gravity about rho_eq, (2/5) k0 (rho^(5/2) - rho_eq^(5/2)) - m g (rho -
+    rho_eq), without cancellation) against the bound by hand.  Each decision must be
+    clear (a factor 3 from the bound either way), so that the two runs' different
+    segments cannot tip it.  Measured: at the 5-m drop the check before rest is at 12
+    times the bound (a 10x looser factor would rest there), at the 0.5-m drop (c_tau
+    0.9) the check at rest is at 2.5e-3 of it (a factor 100x tighter would not)."""
+    scene = ballc.Scene().replace(velocity=(0.0, 0.0, 0.0), observer_mass=0.0,
+                                  position=(0.0, 0.0, height))
+    if c_tau is not None:
+        scene = scene.replace(c_tau=c_tau)
+    run = ballc.simulate(scene, 1000.0)
+    contact = run.contacts[-1]
+    assert run.status == 0 and np.isfinite(contact.t_rest), run.message
+    m, g = scene.mass, scene.gravity
+    k0 = hertz_k0(scene)
+    rho_eq = (m * g / k0) ** (2 / 3)
+    period = 2 * math.pi * math.sqrt(m / (1.5 * k0 * math.sqrt(rho_eq)))
+    bound = documented_bound(scene, 1e-10, 1e-10)
+    free = ballc.simulate(scene, contact.t_rest + 100 * period, rest=False,
+                          dense_output=True)
+
+    def above_rest(y):
+        x = (scene.radius - y[Z] - rho_eq) / rho_eq
+        spring = m * g * rho_eq * (0.4 * math.expm1(2.5 * math.log1p(x)) - x)
+        velocity = y[ballc.STATE_NAMES.index("vx"):][:3]
+        return 0.5 * m * float(velocity @ velocity) + spring
+
+    t = contact.t_start + 20 * period
+    ratios = []
+    while True:
+        ratios.append((t, above_rest(free.sol(t)) / bound))
+        if ratios[-1][1] <= 1:
+            break
+        t += max(20 * period, 0.25 * (t - contact.t_start))
+        assert t < free.t[-1], ratios
+    assert all(not 1 / 3 < ratio < 3 for _, ratio in ratios), ratios
+    assert contact.t_rest == pytest.approx(ratios[-1][0], rel=1e-12, abs=1e-9), ratios

@@ -70,11 +70,17 @@ def test_t_eval_is_honoured():
     np.testing.assert_array_equal(result.t, t_eval)
 
 
-def test_t_eval_is_honoured_across_the_compliant_step_bound():
+@pytest.mark.parametrize("driver", ["c", "python"])
+def test_t_eval_is_honoured_across_the_compliant_step_bound(driver, monkeypatch):
     """A compliant contact's step bound ends segments before t_end; each segment must
     get only the t_eval times within it (before the fix: ValueError "t_eval must be ...
     within t_span", found by tests/test_properties.py's mirror test).  A ball starting
-    at rest on the floor, so the contact is open from t = 0."""
+    at rest on the floor, so the contact is open from t = 0.  Both drivers (the C loop
+    takes each segment's points as a range; the Python driver hands them over)."""
+    if driver == "python":
+        monkeypatch.setenv("BALLC_PYTHON_DRIVER", "1")
+    else:
+        monkeypatch.delenv("BALLC_PYTHON_DRIVER", raising=False)
     scene = ballc.Scene(observer_mass=0.0, ceiling_height=3.0, ball_youngs_modulus=1e7,
                         c_tau=1.0, friction_coefficient=1.0, tangential_model="compliant",
                         tangential_stiffness_ratio=1.0, position=(0.0, 0.0, 1.0),
@@ -82,6 +88,7 @@ def test_t_eval_is_honoured_across_the_compliant_step_bound():
     t_eval = np.linspace(0, 0.3, 31)
     result = ballc.simulate(scene, 0.3, rtol=1e-10, atol=1e-12, t_eval=t_eval)
     assert result.status == 0, result.message
+    assert result._driver == driver
     np.testing.assert_array_equal(result.t, t_eval)
 
 

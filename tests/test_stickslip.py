@@ -313,12 +313,18 @@ def test_start_in_contact_latches_the_elastic_approach_rate():
     assert result.contacts[0].penetration_rate_at_impact == pytest.approx(expected, rel=1e-12)
 
 
+@pytest.mark.parametrize("driver", ["c", "python"])
 @pytest.mark.parametrize("plane", ["floor", "ceiling"])
-def test_start_in_contact_latch_counts_the_observer_mass(plane):
+def test_start_in_contact_latch_counts_the_observer_mass(plane, driver, monkeypatch):
     """The same latch with an observer as heavy as the ball: the whole moving mass
     m_total = m + m_o carries the kinetic energy, 1/2 m_total r'^2 = 1/2 m_total rhodot^2
     + 2/5 k0 rho^5/2 (2/5 k0 rho^5/2 = the Hertz force's work, integral of k0 s^3/2 ds),
-    rho and rhodot from the centre's height and vertical speed."""
+    rho and rhodot from the centre's height and vertical speed.  Both drivers latch it
+    (the C loop, and modes.latch_values for the Python driver's runs)."""
+    if driver == "python":
+        monkeypatch.setenv("BALLC_PYTHON_DRIVER", "1")
+    else:
+        monkeypatch.delenv("BALLC_PYTHON_DRIVER", raising=False)
     H, r = 10.0, 1.0
     z, vz = (0.9, -0.3) if plane == "floor" else (H - 0.9, 0.3)
     scene = ballc.Scene(mass=1.0, observer_mass=1.0, radius=r, ceiling_height=H,
@@ -331,6 +337,7 @@ def test_start_in_contact_latch_counts_the_observer_mass(plane):
     ball_only = math.sqrt(rate ** 2 + 0.8 * scene.hertz_stiffness * rho ** 2.5 / scene.mass)
     assert ball_only > 1.3 * expected                        # the observer matters here
     result = ballc.simulate(scene, 0.05)
+    assert result._driver == driver
     first = result.contacts[0]
     assert first.plane == plane and first.t_start == 0.0
     assert first.penetration_rate_at_impact == pytest.approx(expected, rel=1e-9)

@@ -84,6 +84,31 @@ def first_contact_time(z0, vz, radius=1.0):
     return (vz + math.sqrt(vz * vz + 2 * G * (z0 - radius))) / G
 
 
+
+def tight_reference(t_end, **fields):
+    """The oracle of agreement: the same scene and method at rtol = atol = 1e-11."""
+    return ballc.simulate(ballc.Scene(**fields), t_end, method=METHOD, rtol=1e-11, atol=1e-11)
+
+
+def check_balance(result, rtol):
+    """The energy balance (kinetic + potential + springs + dissipated, dig-in's work
+    included) stays at its initial value within 5 rtol of the energy scale (measured
+    <= 0.7 rtol on the matrix's scenes)."""
+    balance = result.energy["balance"]
+    scale = abs(result.energy["total"][0]) + 1.0
+    assert np.max(np.abs(balance - balance[0])) <= 5 * rtol * scale
+
+
+def check_first_rebound(result, reference, rtol):
+    """The first contact's rebound (velocity and spin after it) agrees with the tight
+    reference's within 5 rtol of its size (measured <= 0.5 rtol): later contacts of a
+    several-bounce throw amplify differences, the first one does not."""
+    mine, theirs = result.contacts[0], reference.contacts[0]
+    assert mine.plane == theirs.plane
+    for name in ("velocity_after", "angular_velocity_after"):
+        got, want = np.asarray(getattr(mine, name)), np.asarray(getattr(theirs, name))
+        assert np.max(np.abs(got - want)) <= 5 * rtol * (1 + np.max(np.abs(want))), name
+
 # --- Young's modulus 1e3 ... 2e11 Pa ---------------------------------------------------
 
 @stress
@@ -130,6 +155,13 @@ def test_mixture_range(mixture):
     assert result.status in (0, 1)
     if mixture == 0.0:   # the friction model: passive
         check_passive(result, 1e-8)
+    # oracles: the ballistic flight to the first contact, the energy balance (dig-in's
+    # work is booked, so it closes for every mixture), the first rebound at rtol 1e-11
+    assert result.contacts[0].t_start == pytest.approx(first_contact_time(5.0, -25.0),
+                                                       abs=1e-9)
+    check_balance(result, 1e-8)
+    check_first_rebound(result, tight_reference(5.0, mixture=mixture,
+                                                tangential_model="mixture"), 1e-8)
 
 
 # --- grazing impacts: vertical speed -> 0 ----------------------------------------------
@@ -238,9 +270,27 @@ def test_ball_comes_to_rest_and_stays_for_60_s(modulus, c_tau):
 
 @pytest.mark.parametrize("spin", [(0.0, 200.0, 0.0), (150.0, -150.0, 50.0)])
 def test_high_spin_fast(spin):
+    """0.6 s of flight (the first contact is at 0.83 s) spinning at up to 200 rad/s with
+    the seed's off-centre observer, so the ball's centre wobbles (~8 mm off its own
+    parabola here) and the flight is integrated.  Oracles: the centre of mass of ball
+    and observer flies the parabola x0 + v0 t - g t^2 / 2 z (v0 = (m v + m_o (v + omega x (x_o - x))) / (m + m_o), by
+    hand; measured within 3e-12 m), and the total energy stays put."""
     result = run(t_end=0.6, velocity=(0.5, 0.0, -2.0), angular_velocity=spin, **FRICTION)
     assert result.status == 0
     check_passive(result, 1e-8)
+    assert not result.contacts
+    m, m_o = result.scene.mass, result.scene.observer_mass
+    x, x_o, t = result.position, result.observer_position, result.t
+    v0 = np.array(result.scene.velocity)
+    v0_observer = v0 + np.cross(np.array(spin), x_o[:, 0] - x[:, 0])
+    centre = (m * x + m_o * x_o) / (m + m_o)
+    rate = (m * v0 + m_o * v0_observer) / (m + m_o)
+    parabola = centre[:, :1] + rate[:, None] * t - np.array([0.0, 0.0, G / 2])[:, None] * t ** 2
+    assert np.max(np.abs(centre - parabola)) <= 1e-9
+    own = x[:, :1] + v0[:, None] * t - np.array([0.0, 0.0, G / 2])[:, None] * t ** 2
+    assert np.max(np.abs(x - own)) > 1e-3         # the ball's centre alone does not
+    total = result.energy["total"]
+    assert np.max(np.abs(total - total[0])) <= 1e-8 * (abs(total[0]) + 1.0)
 
 
 @stress
@@ -262,9 +312,18 @@ def test_high_spin(spin, model):
                                    (0.577, 0.577, 0.577)])
 @pytest.mark.parametrize("observer_mass", [1e-4, 0.5])
 def test_observer_near_the_surface(where, observer_mass):
+    """Oracles: the ballistic flight to the first contact (no spin before it, so the
+    centre flies the parabola whatever the observer), the energy balance with the
+    observer's energies, the first rebound at rtol 1e-11."""
     result = run(observer_position=where, observer_mass=observer_mass, **FRICTION)
     assert result.status == 0
     check_passive(result, 1e-8)
+    assert result.contacts[0].t_start == pytest.approx(first_contact_time(5.0, -25.0),
+                                                       abs=1e-9)
+    check_balance(result, 1e-8)
+    check_first_rebound(result, tight_reference(2.0, observer_position=where,
+                                                observer_mass=observer_mass, **FRICTION),
+                        1e-8)
 
 
 # --- a 1000-s run ------------------------------------------------------------------------
@@ -320,3 +379,11 @@ def test_loose_tolerance_fast(rtol):
     result = run(t_end=1.0, rtol=rtol, atol=rtol, max_nfev=50_000, **FRICTION)
     assert result.status == 0, result.message
     check_passive(result, rtol)
+    # and accurate to its tolerance: the balance, and the end state (two contacts) against
+    # rtol 1e-11 within 5 rtol of each state's size (measured <= 0.42 rtol)
+    check_balance(result, rtol)
+    reference = tight_reference(1.0, **FRICTION)
+    assert len(result.contacts) == len(reference.contacts) == 2
+    mechanical = ballc.STATE_NAMES.index("dissipated_normal")   # q, x, omega, v
+    want = reference.y[:mechanical, -1]
+    assert np.all(np.abs(result.y[:mechanical, -1] - want) <= 5 * rtol * (1 + np.abs(want)))

@@ -194,3 +194,34 @@ def test_rows_follow_the_grid_whatever_order_the_runs_complete_in(monkeypatch):
         assert table["final_height"].iloc[i] == one.position[2, -1]
     # the runs differ, so a misplaced row cannot pass for the right one
     assert len(set(table["final_height"])) == len(heights)
+
+
+def test_dask_rows_follow_the_grid_whatever_order_they_complete_in(monkeypatch):
+    """As the local pool's test above, on Dask: distributed.as_completed replaced by a
+    deterministic reversal (every future waited for, then handed back last submitted
+    first), so that a table filled in completion order is wrong on every run, not only
+    when the cluster happens to finish out of order.  Oracle: direct ballc.simulate
+    runs of each row's scene."""
+    distributed = pytest.importorskip("distributed", reason="Dask is the optional 'dask' extra")
+
+    def last_submitted_first(futures, *args, **kwargs):
+        futures = list(futures)
+        distributed.wait(futures)
+        return reversed(futures)
+
+    monkeypatch.setattr(distributed, "as_completed", last_submitted_first)
+    base = ballc.Scene(gravity=0.0, c_tau=0.99, ball_youngs_modulus=3e7,
+                       position=(0.0, 0.0, 1.025))
+    heights = [2.05, 2.5, 3.0, 3.5]
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            table = ballc.sweep(base, {"ceiling_height": heights}, 0.3, client=client,
+                                outputs=[final_height])
+    assert list(table["ceiling_height"]) == heights
+    for i, height in enumerate(heights):
+        one = ballc.simulate(base.replace(ceiling_height=height), 0.3)
+        assert table["status"].iloc[i] == 0
+        assert table["contacts"].iloc[i] == len(one.contacts)
+        assert table["final_height"].iloc[i] == one.position[2, -1]
+    assert len(set(table["final_height"])) == len(heights)
