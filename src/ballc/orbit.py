@@ -63,7 +63,10 @@ from .orientation import quaternion_multiply, rotation_matrix
 _PARAMETER = {name: i for i, name in enumerate(_core.PARAMETER_NAMES)}
 _Q, _P, _W, _V = layout.QUATERNION, layout.POSITION, layout.ANGULAR_VELOCITY, layout.VELOCITY
 _DISSIPATED = layout.DISSIPATED
-_DEFLECTIONS = [layout.DEFLECTION[plane] for plane in layout.PLANES]
+#: How each plane's deflection (in its own frame, components along t1, t2) turns when the
+#: scene turns by phi about the vertical: by phi n_z -- the floor's (normal +z) with it,
+#: the ceiling's (normal -z: t1 = x, t2 = -y) against it.
+_DEFLECTION_TURN = {"floor": 1.0, "ceiling": -1.0}
 
 #: Periods integrated to measure the orbit: one to measure G, one to test it, and the
 #: stretch before the first crossing.
@@ -138,10 +141,12 @@ class Motion:
         q = np.moveaxis(y[_Q], 0, -1)
         out[_Q] = np.moveaxis(quaternion_multiply(quaternion_multiply(vertical, q), spin),
                               -1, 0)
-        for block in (_P, _W, _V) + tuple(_DEFLECTIONS):
+        turns = [(block, 1.0) for block in (_P, _W, _V)]
+        turns += [(layout.DEFLECTION[plane], _DEFLECTION_TURN[plane]) for plane in layout.PLANES]
+        for block, sense in turns:
             x, yy = y[block.start], y[block.start + 1]
-            out[block.start] = c * x - s * yy
-            out[block.start + 1] = s * x + c * yy
+            out[block.start] = c * x - sense * s * yy
+            out[block.start + 1] = sense * s * x + c * yy
         if not rate:
             out[_P.start] += self.d[0]
             out[_P.start + 1] += self.d[1]
@@ -168,7 +173,8 @@ def equivariant(params, latch, flags, y, axis) -> bool:
     f = _core.rhs(np.ascontiguousarray(y), params, latch, int(flags))
     f_moved = _core.rhs(np.ascontiguousarray(test.apply(y)), params, latch, int(flags))
     expected = test.apply(f, rate=True)
-    scale = float(np.max(np.abs(f))) + params[_PARAMETER["gravity"]]
+    scale = float(np.max(np.abs(f))) + float(np.linalg.norm(
+        [params[_PARAMETER[f"gravity_{axis}"]] for axis in "xyz"]))
     return bool(np.max(np.abs(f_moved - expected)) <= 1e3 * np.finfo(float).eps * scale)
 
 
