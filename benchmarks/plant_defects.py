@@ -137,6 +137,16 @@ DEFECTS = [
            "{0.09443876248897524, -0.14125529502095421, 0.03002919410514742}",
            "{0.09443877248897524, -0.14125529502095421, 0.03002919410514742}",
            regenerate=False),
+    Defect("plane frame: a plane's normal left unnormalised", "src/ballc/_plane.c",
+           "        n[i] = normal[i] / length;\n", "        n[i] = normal[i];\n",
+           regenerate=False),
+    Defect("plane frame: a tangent basis that is not orthogonal (t1 the axis, not made "
+           "perpendicular to n)", "src/ballc/_plane.c",
+           "    for (int i = 0; i < 3; i++) t1[i] = (i == k) - along * n[i];\n",
+           "    for (int i = 0; i < 3; i++) t1[i] = (i == k);\n", regenerate=False),
+    Defect("plane frame: a plane's forces not turned back", "src/ballc/_system.c",
+           "        ballc_plane_to_inertial(pl, sum + BALLC_LAW_GENERALIZED_FORCE, 3);\n", "",
+           regenerate=False),
 ]
 
 
