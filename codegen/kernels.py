@@ -249,7 +249,7 @@ def plane_kernels(model: Model, pieces: dict):
     # Coulomb part's two square roots and division.
     law_kernels("friction_normal", "A plane's contact in its own frame, friction law with "
                 "mu = 0 (its normal share, weighted):")
-    kernels.append(slip_kernel(model, plane, pieces["force_map"]))
+    kernels += slip_kernels(model, plane, pieces["force_map"])
     margins = contact.compliant_margins(model, plane)
     accel = contact.penetration_acceleration(plane)
     restick = _affine_coefficient(margins[1], accel, "the re-stick margin")
@@ -374,27 +374,37 @@ def _check_same(model: Model, ours, theirs, what, samples=5, seed=20261123):
                 raise ValueError(f"{what}: {va} != {vb} at a random point")
 
 
-def slip_kernel(model: Model, plane: str, force_map: sm.Matrix):
-    """What exact (event-driven) Coulomb friction needs on a plane, in its own frame.
+def slip_kernels(model: Model, plane: str, force_map: sm.Matrix):
+    """What exact (event-driven) Coulomb friction needs on a plane, in its own frame:
+    two kernels.
 
-    Outputs: the slip velocity u (2: its components along the plane's tangents t1, t2),
-    its derivative du/d(contact state) (2 x N_CONTACT_STATES row-major: u is linear in
-    it), and the generalized-force map of a tangential force at the contact point
-    (6 x 2 row-major: columns for a unit force along t1 and t2, torque and force in the
-    plane's frame).  The driver's stick constraint force and the sliding Coulomb force
-    are applied through this map (turned back by the C core), so the mechanics of where a
-    contact force acts stay derived here.
+    ``plane_slip``: the slip velocity u (2: its components along the plane's tangents
+    t1, t2).  ``plane_slip_map``: its derivative du/d(contact state) (2 x
+    N_CONTACT_STATES row-major) and the generalized-force map of a tangential force at
+    the contact point (6 x 2 row-major: columns for a unit force along t1 and t2, torque
+    and force in the plane's frame) -- constants (u is linear in the contact state:
+    checked), which the C core turns into a plane's maps by the ball's state once per
+    parameter vector.  The driver's stick constraint force and the sliding Coulomb force
+    are applied through these maps, so the mechanics of where a contact force acts stay
+    derived here.
     """
     _, _, _, slip = contact.slip_kinematics(model, plane)
     slip = contact_state(model, slip, "the slip velocity")
     derivative = [u.diff(x) for u in slip for x in CONTACT_STATE_SYMBOLS]
-    tangential_map = [force_map[i, k] for i in range(6) for k in range(2)]
-    return Kernel("plane_slip", "A plane's contact in its own frame: slip velocity u (2), "
-                  f"du/d(contact state) (2x{len(CONTACT_STATE_SYMBOLS)} row-major), "
-                  "generalized-force map of a tangential force at the contact point "
-                  "(6x2 row-major).",
-                  slip + derivative + contact_state(model, tangential_map, "the force map"),
-                  [], state=CONTACT_STATE_SYMBOLS)
+    tangential_map = contact_state(model, [force_map[i, k] for i in range(6) for k in range(2)],
+                                   "the force map")
+    constant = derivative + tangential_map
+    if any(sm.sympify(e).has(*CONTACT_STATE_SYMBOLS) for e in constant):
+        raise ValueError("the slip velocity is not linear in the contact state, or the "
+                         "force map depends on it: plane_slip_map would not be constant")
+    return [
+        Kernel("plane_slip", "A plane's contact in its own frame: slip velocity u (2).",
+               slip, [], state=CONTACT_STATE_SYMBOLS),
+        Kernel("plane_slip_map", "A plane's contact in its own frame, constants: "
+               f"du/d(contact state) (2x{len(CONTACT_STATE_SYMBOLS)} row-major), "
+               "generalized-force map of a tangential force at the contact point "
+               "(6x2 row-major).", constant, [], state=CONTACT_STATE_SYMBOLS),
+    ]
 
 
 def output_kernels(model: Model):

@@ -31,41 +31,6 @@ void ballc_plane_init(ballc_plane_t *plane, const double *point, const double *n
     plane->deflection = deflection;
 }
 
-/* v_l = R^T v: the components along t1, t2, n. */
-static void to_local(const ballc_plane_t *plane, const double *v, double *local)
-{
-    for (int i = 0; i < 3; i++) local[i] = dot3(plane->frame[i], v);
-}
-
-void ballc_plane_contact_state(const ballc_plane_t *plane, const double *state, double *local)
-{
-    const double *p = plane->point, *n = plane->frame[2];
-    local[BALLC_CONTACT_STATE_Z] = n[0] * (state[BALLC_STATE_X] - p[0])
-                                   + n[1] * (state[BALLC_STATE_Y] - p[1])
-                                   + n[2] * (state[BALLC_STATE_Z] - p[2]);
-    to_local(plane, state + BALLC_STATE_OMEGA_X, local + BALLC_CONTACT_STATE_OMEGA_X);
-    to_local(plane, state + BALLC_STATE_VX, local + BALLC_CONTACT_STATE_VX);
-    local[BALLC_CONTACT_STATE_DEFLECTION_X] = state[plane->deflection];
-    local[BALLC_CONTACT_STATE_DEFLECTION_Y] = state[plane->deflection + 1];
-}
-
-void ballc_plane_inputs(const ballc_plane_t *plane, const double *latch, double *inputs)
-{
-    for (int i = 0; i < BALLC_N_LATCH_PER_PLANE; i++) inputs[i] = latch[i];
-    to_local(plane, latch + BALLC_LATCH_DIGIN_DIRECTION_X,
-             inputs + BALLC_LATCH_DIGIN_DIRECTION_X);
-    inputs[BALLC_PLANE_INPUT_GRAVITY] = plane->gravity_into;
-}
-
-void ballc_plane_to_inertial(const ballc_plane_t *plane, double *v, int count)
-{
-    const double (*f)[3] = plane->frame;
-    for (int k = 0; k < count; k++, v += 3) {
-        double a = v[0], b = v[1], c = v[2];
-        for (int i = 0; i < 3; i++) v[i] = f[0][i] * a + f[1][i] * b + f[2][i] * c;
-    }
-}
-
 void ballc_plane_state_columns(const ballc_plane_t *plane, const double *local, int rows,
                                double *jac)
 {

@@ -37,16 +37,51 @@ typedef struct {
 void ballc_plane_init(ballc_plane_t *plane, const double *point, const double *normal,
                       const double *gravity, int deflection);
 
-/* The ball's contact state (BALLC_N_CONTACT_STATES) in the plane's frame. */
-void ballc_plane_contact_state(const ballc_plane_t *plane, const double *state, double *local);
+/* v_l = R^T v: the components along t1, t2, n. */
+static inline void ballc_plane_to_local(const ballc_plane_t *plane, const double *v,
+                                        double *local)
+{
+    for (int i = 0; i < 3; i++)
+        local[i] = plane->frame[i][0] * v[0] + plane->frame[i][1] * v[1]
+                   + plane->frame[i][2] * v[2];
+}
+
+/* The ball's contact state (BALLC_N_CONTACT_STATES) in the plane's frame (inline: it and
+ * the two below run in every right-hand side with a contact). */
+static inline void ballc_plane_contact_state(const ballc_plane_t *plane, const double *state,
+                                             double *local)
+{
+    const double *p = plane->point, *n = plane->frame[2];
+    local[BALLC_CONTACT_STATE_Z] = n[0] * (state[BALLC_STATE_X] - p[0])
+                                   + n[1] * (state[BALLC_STATE_Y] - p[1])
+                                   + n[2] * (state[BALLC_STATE_Z] - p[2]);
+    ballc_plane_to_local(plane, state + BALLC_STATE_OMEGA_X, local + BALLC_CONTACT_STATE_OMEGA_X);
+    ballc_plane_to_local(plane, state + BALLC_STATE_VX, local + BALLC_CONTACT_STATE_VX);
+    local[BALLC_CONTACT_STATE_DEFLECTION_X] = state[plane->deflection];
+    local[BALLC_CONTACT_STATE_DEFLECTION_Y] = state[plane->deflection + 1];
+}
 
 /* A plane kernel's extra (BALLC_N_PLANE_INPUTS) from the plane's latch block
  * (BALLC_N_LATCH_PER_PLANE). */
-void ballc_plane_inputs(const ballc_plane_t *plane, const double *latch, double *inputs);
+static inline void ballc_plane_inputs(const ballc_plane_t *plane, const double *latch,
+                                      double *inputs)
+{
+    for (int i = 0; i < BALLC_N_LATCH_PER_PLANE; i++) inputs[i] = latch[i];
+    ballc_plane_to_local(plane, latch + BALLC_LATCH_DIGIN_DIRECTION_X,
+                         inputs + BALLC_LATCH_DIGIN_DIRECTION_X);
+    inputs[BALLC_PLANE_INPUT_GRAVITY] = plane->gravity_into;
+}
 
 /* ``count`` consecutive 3-vectors from the plane's frame to inertial components, in
  * place: v = R v_l. */
-void ballc_plane_to_inertial(const ballc_plane_t *plane, double *v, int count);
+static inline void ballc_plane_to_inertial(const ballc_plane_t *plane, double *v, int count)
+{
+    const double (*f)[3] = plane->frame;
+    for (int k = 0; k < count; k++, v += 3) {
+        double a = v[0], b = v[1], c = v[2];
+        for (int i = 0; i < 3; i++) v[i] = f[0][i] * a + f[1][i] * b + f[2][i] * c;
+    }
+}
 
 /* A plane kernel's Jacobian rows ``local`` (rows x BALLC_N_CONTACT_STATES, row-major) as
  * derivatives by the ball's state: ``jac`` (rows x BALLC_N_STATES, written). */

@@ -25,11 +25,18 @@ void ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
 {
     prepared->values = params;
     ballc_parameter_constants(params, prepared->constants);
+    const double anywhere[NC] = {0};   /* the slip maps are constants (codegen checks) */
+    double maps[BALLC_PLANE_SLIP_MAP_NOUT];
+    ballc_plane_slip_map(anywhere, PARAMS(prepared), NULL, maps);
     for (int p = 0; p < NP; p++) {
         const double *entry = params + BALLC_PARAMETER_PLANES + p * BALLC_N_PLANE_FIELDS;
-        ballc_plane_init(&prepared->planes[p], entry + BALLC_PLANE_POINT_X,
-                         entry + BALLC_PLANE_NORMAL_X, params + BALLC_PARAMETER_GRAVITY_X,
-                         DEFLECTION[p]);
+        ballc_plane_t *pl = &prepared->planes[p];
+        ballc_plane_init(pl, entry + BALLC_PLANE_POINT_X, entry + BALLC_PLANE_NORMAL_X,
+                         params + BALLC_PARAMETER_GRAVITY_X, DEFLECTION[p]);
+        /* the plane's slip map by the ball's state, its force map in inertial components */
+        ballc_plane_state_columns(pl, maps, 2, prepared->slip_map[p]);
+        memcpy(prepared->slip_force_map[p], maps + 2 * NC, sizeof prepared->slip_force_map[p]);
+        ballc_plane_rows_to_inertial(pl, prepared->slip_force_map[p], 2, 0, 2);
     }
 }
 
@@ -56,6 +63,14 @@ static const struct {
 };
 #define N_CONTACT_LAWS (sizeof CONTACT_LAWS / sizeof CONTACT_LAWS[0])
 #define LAW_NOUT BALLC_CONTACT_LAW_NOUT
+
+/* Whether any law of ``plane`` acts under ``flags``: the plane is in contact. */
+static int in_contact(int flags, int plane)
+{
+    int any = 0;
+    for (size_t k = 0; k < N_CONTACT_LAWS; k++) any |= CONTACT_LAWS[k].flag[plane];
+    return (flags & any) != 0;
+}
 
 /* Where a law's auxiliary outputs (dissipation normal, tangential, deflection rate x, y)
  * go in the state derivative. */
@@ -129,39 +144,42 @@ static int is_sliding(int mode)
     return mode == MODE_SLIP || mode == MODE_SLIP_FIXED;
 }
 
-/* ballc_slip_state's outputs: u (2), du/dx (2 x NS), tangential force map G_t (6 x 2). */
-#define SLIP_U 0
-#define SLIP_DU 2
-#define SLIP_G (2 + 2 * NS)
+/* A plane's slip: the velocity u (along t1, t2), its map du/dx (2 x NS, row-major) and the
+ * generalized-force map G_t (6 x 2) of a unit tangential force along t1, t2. */
+typedef struct {
+    double u[2];
+    const double *du, *G;
+} slip_t;
+
+/* The slip of ``plane`` at the contact state ``local`` (its frame). */
+static void slip_of(const ballc_parameters_t *params, int plane, const double *local,
+                    slip_t *slip)
+{
+    ballc_plane_slip(local, PARAMS(params), NULL, slip->u);
+    slip->du = params->slip_map[plane];
+    slip->G = params->slip_force_map[plane];
+}
 
 void ballc_slip_state(const double *state, const ballc_parameters_t *params, int plane,
                       double *out)
 {
-    const ballc_plane_t *pl = &params->planes[plane];
-    double local[NC], slip[BALLC_PLANE_SLIP_NOUT];
-    ballc_plane_contact_state(pl, state, local);
-    ballc_plane_slip(local, PARAMS(params), NULL, slip);
-    out[SLIP_U] = slip[0];
-    out[SLIP_U + 1] = slip[1];
-    ballc_plane_state_columns(pl, slip + 2, 2, out + SLIP_DU);
-    memcpy(out + SLIP_G, slip + 2 + 2 * NC, 12 * sizeof(double));
-    ballc_plane_rows_to_inertial(pl, out + SLIP_G, 2, 0, 2);   /* torque, force */
-}
-
-/* out[3 * plane ...] += a t1 + b t2 of the plane: a tangential force given along its
- * tangents, in inertial components. */
-static void add_tangential(const ballc_plane_t *pl, double a, double b, double *out)
-{
-    for (int i = 0; i < 3; i++) out[i] += a * pl->frame[0][i] + b * pl->frame[1][i];
+    double local[NC];
+    slip_t slip;
+    ballc_plane_contact_state(&params->planes[plane], state, local);
+    slip_of(params, plane, local, &slip);
+    out[0] = slip.u[0];
+    out[1] = slip.u[1];
+    memcpy(out + 2, slip.du, 2 * NS * sizeof(double));
+    memcpy(out + 2 + 2 * NS, slip.G, 12 * sizeof(double));
 }
 
 /* What one evaluation of the equations yields besides the state derivative. */
 typedef struct {
     double mass[BALLC_MASS_SIZE];
-    double contact_force[3 * BALLC_N_PLANES];   /* on the ball, per plane */
+    double contact_force[3 * BALLC_N_PLANES];   /* on the ball, per plane: its frame */
     int mode[BALLC_N_PLANES];                   /* exact Coulomb mode per plane */
     double load[BALLC_N_PLANES];                /* N: the friction share's normal force */
-    double slip[BALLC_N_PLANES][BALLC_SLIP_NOUT];
+    slip_t slip[BALLC_N_PLANES];
     double e[BALLC_N_PLANES][2];                /* sliding: the force direction is -e */
     double lambda[BALLC_N_PLANES][2];           /* sticking: the constraint force */
     /* the coefficients of rho'' in the auxiliary rates, per plane (0 without) */
@@ -203,18 +221,15 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
         ev->load[plane] = 0.0;
         for (int i = 0; i < 4; i++) ev->acceleration[plane][i] = 0.0;
     }
+    const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
     for (int plane = 0; plane < NP; plane++) {
+        if (!in_contact(flags, plane)) continue;   /* a plane far away costs nothing */
         const ballc_plane_t *pl = &params->planes[plane];
         plane_contact_t contact;
-        double sum[LAW_NOUT];
-        int active = 0;
+        double sum[LAW_NOUT] = {0};
+        plane_contact(params, plane, state, latch, &contact);
         for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
             if (!(flags & CONTACT_LAWS[k].flag[plane])) continue;
-            if (!active) {
-                plane_contact(params, plane, state, latch, &contact);
-                for (int i = 0; i < LAW_NOUT; i++) sum[i] = 0.0;
-                active = 1;
-            }
             int exact = ev->mode[plane] != MODE_NONE && CONTACT_LAWS[k].normal;
             (exact ? CONTACT_LAWS[k].normal : CONTACT_LAWS[k].value)(
                 contact.state, PARAMS(params), contact.inputs, out);
@@ -228,24 +243,22 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
                 for (int i = 0; i < 4; i++) ev->acceleration[plane][i] += coefficients[i];
             }
         }
-        if (!active) continue;
-        /* the laws' torque, force and contact force, turned back from the plane's frame */
-        ballc_plane_to_inertial(pl, sum + BALLC_LAW_GENERALIZED_FORCE, 3);
+        /* the laws' torque and force, turned back from the plane's frame */
+        ballc_plane_to_inertial(pl, sum + BALLC_LAW_GENERALIZED_FORCE, 2);
         for (int i = 0; i < NU; i++) force[i] += sum[BALLC_LAW_GENERALIZED_FORCE + i];
-        for (int i = 0; i < 3; i++) ev->contact_force[3 * plane + i] += sum[BALLC_LAW_FORCE + i];
-        if (!xdot) continue;
-        int target[4];
-        auxiliary_targets(pl, target);
-        for (int i = 0; i < 4; i++) xdot[target[i]] += sum[BALLC_LAW_DISSIPATION + i];
-    }
-    const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
-    for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+        double *contact_force = ev->contact_force + 3 * plane;
+        for (int i = 0; i < 3; i++) contact_force[i] = sum[BALLC_LAW_FORCE + i];
+        if (xdot) {
+            int target[4];
+            auxiliary_targets(pl, target);
+            for (int i = 0; i < 4; i++) xdot[target[i]] += sum[BALLC_LAW_DISSIPATION + i];
+        }
         if (ev->mode[plane] == MODE_NONE) continue;
-        double *slip = ev->slip[plane];
-        ballc_slip_state(state, params, plane, slip);
+        slip_t *slip = &ev->slip[plane];
+        slip_of(params, plane, contact.state, slip);
         if (!is_sliding(ev->mode[plane])) continue;
         const double *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
-        double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = sqrt(ux * ux + uy * uy);
+        double ux = slip->u[0], uy = slip->u[1], speed = sqrt(ux * ux + uy * uy);
         double *e = ev->e[plane];
         if (speed > 0 && ev->mode[plane] == MODE_SLIP) {
             double sign = ux * d[0] + uy * d[1] < 0 ? -1.0 : 1.0;
@@ -256,9 +269,10 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
             e[1] = d[1];
         }
         double f[2] = {-mu * ev->load[plane] * e[0], -mu * ev->load[plane] * e[1]};
-        const double *G = slip + SLIP_G;
+        const double *G = slip->G;
         for (int i = 0; i < NU; i++) force[i] += G[2 * i] * f[0] + G[2 * i + 1] * f[1];
-        add_tangential(&params->planes[plane], f[0], f[1], ev->contact_force + 3 * plane);
+        contact_force[0] += f[0];
+        contact_force[1] += f[1];
         if (xdot) xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -= f[0] * ux + f[1] * uy;
     }
 }
@@ -319,10 +333,10 @@ static void schur_solve(const schur_t *f, double *b)
 /* Responses of a sticking plane: z_k = M^-1 G_t e_k (6 x 2, column k at z[k]) and the
  * Delassus matrix W = (du/d speeds) z (2 x 2), inverted into Winv.  Returns
  * BALLC_SINGULAR when W is not invertible. */
-static int stick_response(const schur_t *factor, const double *slip, double z[2][NU],
+static int stick_response(const schur_t *factor, const slip_t *slip, double z[2][NU],
                           double Winv[2][2])
 {
-    const double *G = slip + SLIP_G, *du = slip + SLIP_DU;
+    const double *G = slip->G, *du = slip->du;
     double W[2][2];
     for (int k = 0; k < 2; k++) {
         for (int i = 0; i < NU; i++) z[k][i] = G[2 * i + k];
@@ -354,7 +368,8 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
     schur_solve(factor, udot);
     for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
         if (ev->mode[plane] != MODE_STICK) continue;
-        const double *slip = ev->slip[plane], *du = slip + SLIP_DU;
+        const slip_t *slip = &ev->slip[plane];
+        const double *du = slip->du;
         double z[2][NU], Winv[2][2], a0[2];
         status = stick_response(factor, slip, z, Winv);
         if (status != BALLC_OK) return status;
@@ -366,11 +381,11 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
         lambda[0] = -(Winv[0][0] * a0[0] + Winv[0][1] * a0[1]);
         lambda[1] = -(Winv[1][0] * a0[0] + Winv[1][1] * a0[1]);
         for (int i = 0; i < NU; i++) udot[i] += z[0][i] * lambda[0] + z[1][i] * lambda[1];
-        add_tangential(&params->planes[plane], lambda[0], lambda[1],
-                       ev->contact_force + 3 * plane);
+        ev->contact_force[3 * plane] += lambda[0];       /* along t1, t2 */
+        ev->contact_force[3 * plane + 1] += lambda[1];
         if (xdot)
             xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -=
-                lambda[0] * slip[SLIP_U] + lambda[1] * slip[SLIP_U + 1];
+                lambda[0] * slip->u[0] + lambda[1] * slip->u[1];
     }
     if (xdot)
         for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
@@ -448,6 +463,8 @@ int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t 
     int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
     memcpy(forces, ev.contact_force, sizeof ev.contact_force);
+    for (int p = 0; p < NP; p++)   /* from each plane's frame */
+        ballc_plane_to_inertial(&params->planes[p], forces + 3 * p, 1);
     return all_finite(forces, 3 * BALLC_N_PLANES) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
@@ -518,7 +535,8 @@ int ballc_remove_slip(const double *state, const double *params, int flags, int 
 {
     schur_t factor;
     double mass[BALLC_MASS_SIZE], buf[BALLC_BALL_NOUT];
-    double slip[BALLC_SLIP_NOUT], z[2][NU], Winv[2][2];
+    double local[NC], z[2][NU], Winv[2][2];
+    slip_t slip;
     memcpy(state_out, state, NS * sizeof(double));
     if (plane < 0 || plane >= BALLC_N_PLANES) return BALLC_SINGULAR;
     if (!all_finite(state, NS) || !all_finite(params, BALLC_N_PARAMETERS))
@@ -533,10 +551,11 @@ int ballc_remove_slip(const double *state, const double *params, int flags, int 
     }
     int status = schur_factor(mass, &factor);
     if (status != BALLC_OK) return status;
-    ballc_slip_state(state, &prepared, plane, slip);
-    status = stick_response(&factor, slip, z, Winv);
+    ballc_plane_contact_state(&prepared.planes[plane], state, local);
+    slip_of(&prepared, plane, local, &slip);
+    status = stick_response(&factor, &slip, z, Winv);
     if (status != BALLC_OK) return status;
-    const double *u = slip + SLIP_U;
+    const double *u = slip.u;
     double impulse[2] = {-(Winv[0][0] * u[0] + Winv[0][1] * u[1]),
                          -(Winv[1][0] * u[0] + Winv[1][1] * u[1])};
     for (int i = 0; i < NU; i++)
@@ -584,9 +603,10 @@ static int difference_jacobian(const double *state, const ballc_parameters_t *pa
 static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const double *latch,
                          const double *law_jac, double *dF, double *jac)
 {
-    const double *slip = ev->slip[plane], *du = slip + SLIP_DU, *G = slip + SLIP_G;
+    const slip_t *slip = &ev->slip[plane];
+    const double *du = slip->du, *G = slip->G;
     const double *e = ev->e[plane], *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
-    double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = hypot(ux, uy);
+    double ux = slip->u[0], uy = slip->u[1], speed = hypot(ux, uy);
     double N = ev->load[plane];
     double de[2][2] = {{0, 0}, {0, 0}};
     if (speed > 0 && ev->mode[plane] == MODE_SLIP) {
@@ -636,16 +656,14 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
     if (flags & BALLC_WITH_OBSERVER)
         add_dynamics_jac(ballc_observer_jac, state, params, udot, dF, dMa);
     for (int plane = 0; plane < NP; plane++) {
+        if (!in_contact(flags, plane)) continue;
         const ballc_plane_t *pl = &params->planes[plane];
         plane_contact_t contact;
-        int active = 0, target[4];
+        int target[4];
         auxiliary_targets(pl, target);
+        plane_contact(params, plane, state, latch, &contact);
         for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
             if (!(flags & CONTACT_LAWS[k].flag[plane])) continue;
-            if (!active) {
-                plane_contact(params, plane, state, latch, &contact);
-                active = 1;
-            }
             int exact = is_sliding(ev.mode[plane]) && CONTACT_LAWS[k].normal_jac;
             (exact ? CONTACT_LAWS[k].normal_jac : CONTACT_LAWS[k].jac)(
                 contact.state, PARAMS(params), contact.inputs, local);

@@ -81,6 +81,10 @@ typedef struct {
     const double *values;                               /* BALLC_N_PARAMETERS, borrowed */
     double constants[BALLC_N_PARAMETER_CONSTANTS];
     ballc_plane_t planes[BALLC_N_PLANES];
+    /* each plane's slip map du/dx (2 x BALLC_N_STATES) and the generalized-force map of a
+     * unit tangential force along its t1, t2 (6 x 2, inertial): constants */
+    double slip_map[BALLC_N_PLANES][2 * BALLC_N_STATES];
+    double slip_force_map[BALLC_N_PLANES][12];
 } ballc_parameters_t;
 
 void ballc_parameters_init(ballc_parameters_t *prepared, const double *params);
