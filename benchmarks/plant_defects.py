@@ -145,7 +145,7 @@ DEFECTS = [
            "    for (int i = 0; i < 3; i++) t1[i] = (i == k) - along * n[i];\n",
            "    for (int i = 0; i < 3; i++) t1[i] = (i == k);\n", regenerate=False),
     Defect("plane frame: a plane's forces not turned back", "src/ballc/_system.c",
-           "        ballc_plane_to_inertial(pl, sum + BALLC_LAW_GENERALIZED_FORCE, 3);\n", "",
+           "        ballc_plane_to_inertial(pl, sum + BALLC_LAW_GENERALIZED_FORCE, 2);\n", "",
            regenerate=False),
 ]
 

@@ -387,3 +387,18 @@ def test_a_ball_sticking_on_an_incline_rolls_as_the_closed_form(theta, inertia_r
     # the contact force: the load along n plus the constraint force
     total = _core.contact_forces(y[None, :], params, latch, flags)[0][:3]
     np.testing.assert_allclose(total, load * n + force, rtol=0, atol=1e-12 * m * g)
+
+
+def test_codegen_refuses_a_contact_law_that_depends_on_more_than_the_contact_state():
+    """A plane kernel reads one contact in its plane's frame only: an expression of the
+    orientation (a sphere's contact cannot depend on it) or of the position along the
+    plane is refused when generated, naming the state."""
+    sm = pytest.importorskip("sympy")
+    from codegen.kernels import contact_state
+    from codegen.model import build_model
+    model = build_model()
+    z, qw, x = model.state("z"), model.state("qw"), model.state("x")
+    assert contact_state(model, [2 * z], "a law") == [2 * sm.Symbol("z")]
+    for bad, name in ((qw * z, "qw"), (x + z, "x")):
+        with pytest.raises(ValueError, match=rf"a law depends on {name}\b"):
+            contact_state(model, [bad], "a law")
