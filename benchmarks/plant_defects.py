@@ -90,10 +90,11 @@ class Defect:
 
 
 DEFECTS = [
-    Defect("ceiling damping sign flipped (HC normal force of the friction law)",
+    Defect("Hunt-Crossley damping sign flipped (the friction law's normal force; every "
+           "plane: the laws are generated once, in the plane's own frame)",
            "codegen/contact.py",   # coulomb_friction and no_friction (its normal share)
            "    f_n = normal_force(rhodot)\n",
-           "    f_n = normal_force(rhodot if plane == 'floor' else -rhodot)\n", count=2,
+           "    f_n = normal_force(-rhodot)\n", count=2,
            tests=("tests/test_oracles.py::test_hunt_crossley_impact_at_the_ceiling",)),
     Defect("Hertz exponent 3/2 -> 1.4 (hertz_normal's force: every law)", "codegen/contact.py",
            "    return k0 * rho_pos**sm.Rational(3, 2), ",
@@ -278,6 +279,17 @@ DEFECTS = [
            "            rows[rows.index(None)] = future.result()\n",
            tests=("tests/test_sweep.py::"
                   "test_dask_rows_follow_the_grid_whatever_order_they_complete_in",)),
+    Defect("plane frame: a plane's normal left unnormalised", "src/ballc/_plane.c",
+           "        n[i] = normal[i] / length;\n", "        n[i] = normal[i];\n",
+           tests=("tests/test_plane_frame.py",)),
+    Defect("plane frame: a tangent basis that is not orthogonal (t1 the axis, not made "
+           "perpendicular to n)", "src/ballc/_plane.c",
+           "    for (int i = 0; i < 3; i++) t1[i] = (i == k) - along * n[i];\n",
+           "    for (int i = 0; i < 3; i++) t1[i] = (i == k);\n",
+           tests=("tests/test_plane_frame.py",)),
+    Defect("plane frame: a plane's forces not turned back", "src/ballc/_system.c",
+           "        ballc_plane_to_inertial(pl, sum + BALLC_LAW_GENERALIZED_FORCE, 2);\n", "",
+           tests=("tests/test_plane_frame.py",)),
 ]
 
 

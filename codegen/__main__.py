@@ -14,8 +14,9 @@ from .emit import (CONSTANTS_SIGNATURE, GENERATOR_VERSION, SIGNATURE, BallcPrint
                    ParameterConstants, c_string_array, constants_c, header_comment, kernel_c)
 from .contact import TANGENTIAL_LAWS
 from .kernels import MASS_LAYOUT, build_kernels, contact_law_offsets, describe_contact_law_layout
-from .model import (LATCH_FIELDS, LATCH_NAMES, MECHANICAL_STATE_NAMES, PARAMETER_NAMES,
-                    PARAMETERS, PLANES, STATE_NAMES)
+from .model import (CONTACT_STATE_NAMES, LATCH_FIELDS, LATCH_NAMES, MECHANICAL_STATE_NAMES,
+                    PARAMETER_NAMES, PARAMETERS, PLANE_FIELDS, PLANE_INPUT_NAMES, PLANES,
+                    STATE_NAMES)
 
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
@@ -48,7 +49,11 @@ def render(verbose=False) -> dict[str, str]:
         print(f"  {'parameter_constants':28s} {len(constants):4d} outputs {ops:6d} ops",
               file=sys.stderr)
 
-    law_names = {f"{plane}_{law}" for plane in PLANES for law in TANGENTIAL_LAWS}
+    law_names = {f"plane_{law}" for law in TANGENTIAL_LAWS}
+    first_plane_parameter = PARAMETER_NAMES.index(f"{PLANES[0]}_{PLANE_FIELDS[0][0]}")
+    if PARAMETER_NAMES[first_plane_parameter:] != tuple(
+            f"{plane}_{name}" for plane in PLANES for name, *_ in PLANE_FIELDS):
+        raise ValueError("the plane table must close the parameters, plane after plane")
     (contact_law_nout,) = {len(k.outputs) for k in kernels if k.name in law_names}
     units = [p[2] for p in PARAMETERS]
     h = [header, "#ifndef BALLC_KERNELS_H", "#define BALLC_KERNELS_H", "",
@@ -61,6 +66,18 @@ def render(verbose=False) -> dict[str, str]:
          f"#define BALLC_N_PARAMETER_CONSTANTS {len(constants)}",
          f"#define BALLC_N_LATCH_PER_PLANE {len(LATCH_FIELDS)}",
          f"#define BALLC_N_PLANES {len(PLANES)}",
+         "/* the plane table, in the parameters: BALLC_N_PLANE_FIELDS per plane from "
+         "BALLC_PARAMETER_PLANES on */",
+         f"#define BALLC_PARAMETER_PLANES {first_plane_parameter}",
+         f"#define BALLC_N_PLANE_FIELDS {len(PLANE_FIELDS)}",
+         *[f"#define BALLC_PLANE_{name.upper()} {i}" for i, (name, *_) in enumerate(PLANE_FIELDS)],
+         "/* a plane kernel's state: one contact in its plane's own frame */",
+         f"#define BALLC_N_CONTACT_STATES {len(CONTACT_STATE_NAMES)}",
+         *[f"#define BALLC_CONTACT_STATE_{name.upper()} {i}"
+           for i, name in enumerate(CONTACT_STATE_NAMES)],
+         "/* a plane kernel's extra: the plane's latch (its frame), gravity into the plane */",
+         f"#define BALLC_N_PLANE_INPUTS {len(PLANE_INPUT_NAMES)}",
+         f"#define BALLC_PLANE_INPUT_GRAVITY {PLANE_INPUT_NAMES.index('gravity_into_plane')}",
          f"#define BALLC_MASS_SIZE {len(MASS_LAYOUT)}",
          *[f"#define BALLC_STATE_{name.upper()} {i}" for i, name in enumerate(STATE_NAMES)],
          *[f"#define BALLC_PARAMETER_{name.upper()} {i}"
@@ -75,6 +92,7 @@ def render(verbose=False) -> dict[str, str]:
          c_string_array("BALLC_PARAMETER_NAMES", PARAMETER_NAMES).rstrip(),
          c_string_array("BALLC_PARAMETER_UNITS", units).rstrip(),
          c_string_array("BALLC_LATCH_NAMES", LATCH_NAMES).rstrip(),
+         c_string_array("BALLC_CONTACT_STATE_NAMES", CONTACT_STATE_NAMES).rstrip(),
          c_string_array("BALLC_PARAMETER_CONSTANT_NAMES", map(str, constants.values)).rstrip(),
          c_string_array("BALLC_MASS_LAYOUT", MASS_LAYOUT).rstrip(),
          "", *prototypes, "", "#endif", ""]

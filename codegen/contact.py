@@ -1,6 +1,9 @@
 """Contact laws, as sympy expressions of the contact-point kinematics, composed of parts.
 
-For a plane with unit normal ``n`` pointing towards the ball (floor: +z, ceiling: -z):
+Every law is derived once, in a plane's own frame (model.FRAME_PLANE: the plane z = 0
+with its unit normal ``n`` = +z towards the ball, the floor's case); the C core applies it
+to every plane, turning the contact into that frame and the forces back
+(src/ballc/_plane.c).  In that frame:
 
 * penetration ``rho = r - distance(centre, plane)`` (positive in contact),
 * penetration rate ``rhodot = -v_cp . n`` (positive while moving into the plane),
@@ -41,17 +44,14 @@ from dataclasses import dataclass
 import sympy as sm
 import sympy.physics.mechanics as me
 
-from .model import LATCH_FIELDS, Model, contact_point
+from .model import LATCH_FIELDS, Model, require_frame_plane, contact_point
 
 
 def plane_geometry(model: Model, plane: str):
-    """(normal towards the ball, penetration rho) of ``plane``."""
-    N = model.frame
-    p = model.p
-    z = model.state("z")
-    if plane == "floor":
-        return N.z, p["radius"] - z
-    return -N.z, p["radius"] - (p["ceiling_height"] - z)
+    """(normal towards the ball, penetration rho) of ``plane``, in its own frame: N.z
+    and r - z (model.FRAME_PLANE only)."""
+    require_frame_plane(plane)
+    return model.frame.z, model.p["radius"] - model.state("z")
 
 
 def hertz_stiffness(model: Model):
@@ -228,25 +228,31 @@ def damped_normal(model: Model, rho, rhodot, rate_at_impact):
 
 def penetration_acceleration(plane: str):
     """The symbol of rho'' on ``plane`` (m/s^2): the exact penetration acceleration,
-    which the C core computes from the solved accelerations (-a_z on the floor, +a_z on
-    the ceiling) and supplies to the kernels whose rates are affine in it
-    (ACCELERATION_LAWS, compliant_margins)."""
+    which the C core computes from the solved accelerations (-n . a, a the centre's)
+    and supplies to the kernels whose rates are affine in it (ACCELERATION_LAWS,
+    compliant_margins)."""
     return sm.Symbol(f"{plane}_rho_acceleration")
+
+
+def gravity_into_plane(plane: str):
+    """The symbol of gravity's component into ``plane``, -n . g (m/s^2): a plane kernel's
+    input (model.PLANE_INPUT_NAMES), which the C core computes from the gravity vector
+    and the plane's normal (the seed's g on the floor, -g on the ceiling)."""
+    return sm.Symbol(f"{plane}_gravity_into_plane")
 
 
 def normal_force_rate(model: Model, plane: str, rho, rhodot, rate_at_impact, f_n,
                       accel=None):
     """dF_n/dt (N/s) of the damped normal force ``f_n`` (damped_normal's) while it is
     positive, affine in the penetration's acceleration ``accel`` (rho'', m/s^2).
-    Without it, rho'' is taken as the contact's own, -F_n/m* + g n_z: exact for a ball
+    Without it, rho'' is taken as the contact's own, -F_n/m* - n . g: exact for a ball
     in one contact without observer, and what the Jacobian forms and the regularised
     law's yield use; the sliding mode and its re-stick guard get the exact rho''
     (penetration_acceleration)."""
     elastic, stiffness = hertz_normal(model, rho)
-    normal, _ = plane_geometry(model, plane)
     mass = effective_mass(model)
     if accel is None:
-        accel = -f_n / mass + model.p["gravity"] * me.dot(normal, model.frame.z)
+        accel = -f_n / mass + gravity_into_plane(plane)
     select = model.p["normal_damping_model"]
     # Hunt-Crossley: P = F_H (1 + chi rhodot / |v-|)
     chi = _hunt_crossley_chi(model) / sm.Abs(rate_at_impact)

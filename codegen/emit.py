@@ -46,6 +46,9 @@ class Kernel:
     extra: list            # symbols read from ``extra`` (may be empty)
     extra_doc: str = ""
     definitions: list = field(default_factory=list)  # [(symbol, expr)] emitted first, in order
+    #: the symbols the ``state`` argument holds, in order: None for the model's state
+    #: (STATE_NAMES), a plane kernel's contact state otherwise (CONTACT_STATE_NAMES)
+    state: list | None = None
 
 
 def forward_jacobian(outputs, variables, prefix="j"):
@@ -193,8 +196,8 @@ def kernel_c(kernel: Kernel, state_syms, param_syms, printer=None,
     parameter-only subexpressions are read from the ``constants`` argument (and added to
     ``constants``)."""
     printer = printer or BallcPrinter()
-    plain_states = plain_symbols(state_syms)
-    replacements = dict(zip(state_syms, plain_states))
+    plain_states = plain_symbols(state_syms) if kernel.state is None else list(kernel.state)
+    replacements = dict(zip(state_syms, plain_symbols(state_syms)))
     outputs = [_plain(e, replacements) for e in kernel.outputs]
     definitions = [(s, _plain(e, replacements)) for s, e in kernel.definitions]
 

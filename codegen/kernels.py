@@ -5,10 +5,18 @@ pays only for what acts on it:
 
 * ``ball``      M and F of the ball alone (gravity, gyroscopic terms),
 * ``observer``  the observer particle's additive share of M and F (zero when m_o = 0),
-* ``<plane>_<law>`` generalized forces of one contact law on one plane
-  (only called while that plane is in contact and the law has weight),
-* ``<plane>_friction_normal`` the friction law with mu = 0: its normal share, which is
+* ``plane_<law>`` generalized forces of one contact law on a plane, in the plane's own
+  frame (model.FRAME_PLANE), of the contact state (model.CONTACT_STATE_NAMES): the C
+  core turns each plane's contact into that frame, calls the kernel and turns the
+  forces back (src/ballc/_plane.c), only while that plane is in contact and the law
+  has weight,
+* ``plane_friction_normal`` the friction law with mu = 0: its normal share, which is
   all exact (event-driven) Coulomb friction takes from it.
+
+Every ``plane_*`` kernel reads the contact state of one plane (its ``state`` argument)
+and the plane's inputs (``extra``: model.PLANE_INPUT_NAMES); a contact law that depends
+on anything else of the state (the orientation, the position along the plane) is
+refused when generated (contact_state).
 
 ``M`` is stored as 16 numbers: the symmetric 3x3 block ``J`` (J00 J01 J02 J11 J12 J22),
 the 3x3 coupling block ``B`` row-major, and the scalar ``D`` of the block ``D I3``:
@@ -21,11 +29,12 @@ import random
 
 import sympy as sm
 import sympy.physics.mechanics as me
+from sympy.core.function import AppliedUndef
 
 from . import contact
 from .emit import Kernel, forward_jacobian, plain_symbols
-from .model import (PLANES, STATE_NAMES, Model, bodies, build_model, gravity_loads,
-                    kanes_equations, quaternion_dcm)
+from .model import (CONTACT_STATE, FRAME_PLANE, STATE_NAMES, Model, bodies, build_model,
+                    gravity_loads, gravity_vector, kanes_equations, quaternion_dcm)
 
 MASS_LAYOUT = ("J00", "J01", "J02", "J11", "J12", "J22",
                "B00", "B01", "B02", "B10", "B11", "B12", "B20", "B21", "B22", "D")
@@ -76,51 +85,83 @@ def _law_outputs(model, plane, force_map, law):
 
 
 def derive(model: Model | None = None):
-    """Derive everything once: returns (model, dict of sympy pieces)."""
+    """Derive everything once: returns (model, dict of sympy pieces).  The contact laws
+    are derived on the plane of model.FRAME_PLANE (a plane's own frame) only."""
     model = model or build_model()
     N = model.frame
     ball, observer = bodies(model)
-    contact_forces = {}
     loads = gravity_loads(model, ball) + gravity_loads(model, observer)
-    force_symbols = []
-    for plane in PLANES:
-        fs = sm.symbols(f"F_{plane}_x F_{plane}_y F_{plane}_z")
-        force_symbols += fs
-        point = contact.contact_point(model, plane)
-        loads.append((point, fs[0]*N.x + fs[1]*N.y + fs[2]*N.z))
-        contact_forces[plane] = fs
+    plane = FRAME_PLANE
+    force_symbols = sm.symbols("F_contact_x F_contact_y F_contact_z")
+    point = contact.contact_point(model, plane)
+    loads.append((point, sum((f*v for f, v in zip(force_symbols, (N.x, N.y, N.z))),
+                             me.Vector(0))))
     M, F = kanes_equations(model, [ball, observer], loads)
 
     mo = model.p["observer_mass"]
-    zero_forces = {f: 0 for f in force_symbols}
-    F_free = F.xreplace(zero_forces)
+    F_free = F.xreplace({f: 0 for f in force_symbols})
     pieces = {
         "M_ball": M.subs(mo, 0), "M_observer": M - M.subs(mo, 0),
         "F_ball": F_free.subs(mo, 0), "F_observer": F_free - F_free.subs(mo, 0),
     }
-    for plane in PLANES:
-        G = F.jacobian(sm.Matrix(contact_forces[plane]))   # generalized-force map, 6x3
-        pieces[f"{plane}_force_map"] = G
-        for name, function in contact.TANGENTIAL_LAWS.items():
-            pieces[f"{plane}_{name}"] = _law_outputs(model, plane, G, function(model, plane))
-            if name in contact.JACOBIAN_FORMS:
-                form = contact.JACOBIAN_FORMS[name](model, plane)
-                pieces[f"{plane}_{name}_jacobian_form"] = _law_outputs(model, plane, G, form)
-                pieces[f"{plane}_{name}_frozen"] = form.frozen or []
-        pieces[f"{plane}_friction_normal"] = _law_outputs(
-            model, plane, G, contact.compose(model, plane, contact.COMPOSITIONS["friction_normal"]))
+    G = F.jacobian(sm.Matrix(force_symbols))   # generalized-force map, 6x3
+    pieces["force_map"] = G
+    for name, function in contact.TANGENTIAL_LAWS.items():
+        pieces[name] = _law_outputs(model, plane, G, function(model, plane))
+        if name in contact.JACOBIAN_FORMS:
+            form = contact.JACOBIAN_FORMS[name](model, plane)
+            pieces[f"{name}_jacobian_form"] = _law_outputs(model, plane, G, form)
+            pieces[f"{name}_frozen"] = form.frozen or []
+    pieces["friction_normal"] = _law_outputs(
+        model, plane, G, contact.compose(model, plane, contact.COMPOSITIONS["friction_normal"]))
     return model, pieces
 
 
-def jacobian_kernel(model, name, doc, outputs, extra=(), extra_doc="", prefix="j", frozen=()):
+#: The plain symbols of the contact state (model.CONTACT_STATE_NAMES), in its order.
+CONTACT_STATE_SYMBOLS = [sm.Symbol(local) for _, local in CONTACT_STATE]
+
+
+def contact_state(model: Model, expressions, what):
+    """``expressions`` (of the model's state) as expressions of the contact state
+    (CONTACT_STATE_SYMBOLS): FRAME_PLANE's centre height, angular velocity, velocity and
+    deflection renamed.  Raises if one depends on any other state -- the quaternion (a
+    sphere's contact cannot depend on its orientation), the position along the plane,
+    the dissipated work or another plane's deflection -- which the C core does not turn
+    into the plane's frame."""
+    rename = {model.state(name): symbol for (name, _), symbol in
+              zip(CONTACT_STATE, CONTACT_STATE_SYMBOLS)}
+    result = [sm.sympify(e).xreplace(rename) for e in expressions]
+    others = set(model.states) - set(rename)
+    found = sorted({str(s.func) for e in result for s in e.atoms(AppliedUndef)
+                    if s in others})
+    if found:
+        raise ValueError(f"{what} depends on {', '.join(found)}: a contact law may depend "
+                         "only on the contact state in its plane's frame "
+                         f"({', '.join(map(str, CONTACT_STATE_SYMBOLS))})")
+    return result
+
+
+def plane_inputs(model: Model):
+    """The symbols of a plane kernel's ``extra`` (model.PLANE_INPUT_NAMES): the plane's
+    latched values, then gravity's component into the plane."""
+    return [*contact.latch_symbols(model, FRAME_PLANE), contact.gravity_into_plane(FRAME_PLANE)]
+
+
+def jacobian_kernel(model, name, doc, outputs, extra=(), extra_doc="", prefix="j", frozen=(),
+                    state=None):
     """Kernel of d(outputs)/d(state), row-major, by forward_jacobian.  ``frozen``:
-    [(symbol, expression)] computed first and differentiated as constants."""
-    states = plain_symbols(model.states)
-    replacements = dict(zip(model.states, states))
+    [(symbol, expression)] computed first and differentiated as constants.  ``state``:
+    the symbols of the kernel's state (a plane kernel's contact state), the model's by
+    default."""
+    if state is None:
+        states = plain_symbols(model.states)
+        replacements = dict(zip(model.states, states))
+    else:
+        states, replacements = list(state), {}
     outputs = [sm.sympify(e).xreplace(replacements) for e in outputs]
     leading = [(symbol, sm.sympify(e).xreplace(replacements)) for symbol, e in frozen]
     definitions, jac = forward_jacobian(outputs, states, prefix)
-    return Kernel(name, doc, jac, list(extra), extra_doc, leading + definitions)
+    return Kernel(name, doc, jac, list(extra), extra_doc, leading + definitions, state)
 
 
 def _dynamics_kernels(model, name, M, F, what):
@@ -157,60 +198,85 @@ def build_kernels():
     value, M_offset, F_offset = observer_value_kernel(model, pieces)
     jac = _dynamics_kernels(model, "observer", M_offset, F_offset, "Observer particle")[1]
     kernels += [value, jac]
-    n = len(x)
-    for plane in PLANES:
-        latch = contact.latch_symbols(model, plane)
-        for law in contact.TANGENTIAL_LAWS:
-            outputs = pieces[f"{plane}_{law}"]
-            doc = f"{plane} contact, {law} law (weighted):"
-            extra_doc = "latched rhodot^-, d_x, d_y, d_z of this plane"
-            if law in contact.ACCELERATION_LAWS:
-                outputs, coefficients = split_acceleration(outputs, plane)
-                kernels.append(Kernel(
-                    f"{plane}_{law}_acceleration", f"{doc} the coefficients of the exact "
-                    "penetration acceleration rho'' in its dissipation rates (normal, "
-                    "tangential) and deflection rates (x, y) (4); the value kernel's are "
-                    "at rho'' = 0.", coefficients, list(latch), extra_doc))
-            kernels.append(Kernel(f"{plane}_{law}", f"{doc} {describe_contact_law_layout()}.",
-                                  list(outputs), list(latch), extra_doc))
-            form = pieces.get(f"{plane}_{law}_jacobian_form", outputs)
-            note = "" if form is outputs else " (of the law's Jacobian form, " \
-                "contact.JACOBIAN_FORMS)"
-            kernels.append(jacobian_kernel(model, f"{plane}_{law}_jac", f"{doc} d(outputs)/dx "
-                                           f"({len(outputs)}x{n} row-major){note}.", list(form),
-                                           latch, extra_doc,
-                                           frozen=pieces.get(f"{plane}_{law}_frozen", ())))
-        # Exact (event-driven) Coulomb friction applies the tangential force itself and
-        # takes only the friction law's normal share: its composition with no tangential
-        # part (contact.COMPOSITIONS), the law with mu = 0, without the regularised
-        # Coulomb part's two square roots and division.
-        outputs = pieces[f"{plane}_friction_normal"]
-        doc = f"{plane} contact, friction law with mu = 0 (its normal share, weighted):"
-        kernels.append(Kernel(f"{plane}_friction_normal",
-                              f"{doc} {describe_contact_law_layout()}.",
-                              list(outputs), list(latch), extra_doc))
-        kernels.append(jacobian_kernel(model, f"{plane}_friction_normal_jac", f"{doc} "
-                                       f"d(outputs)/dx ({len(outputs)}x{n} row-major).",
-                                       list(outputs), latch, extra_doc))
-    for plane in PLANES:
-        kernels.append(slip_kernel(model, plane, pieces[f"{plane}_force_map"]))
-    for plane in PLANES:
-        margins = contact.compliant_margins(model, plane)
-        accel = contact.penetration_acceleration(plane)
-        restick = _affine_coefficient(margins[1], accel, f"{plane} re-stick margin")
-        kernels.append(Kernel(
-            f"{plane}_compliant_margins",
-            f"{plane} contact, the compliant law's mode guards (contact.compliant_margins): "
-            "yield margin 1 - k_t |s| / (mu F_n), re-stick margin (m/s) at rho'' = 0, "
-            "s_cap = mu F_n / k_t (m), k_t (N/m), the elastic mode's capacity margin (N) "
-            "and its negative, and the re-stick margin's coefficient of the exact "
-            "penetration acceleration rho'' (s).",
-            [margins[0], margins[1].xreplace({accel: 0}), margins[2], margins[3], margins[4],
-             -margins[4], restick],
-            list(contact.latch_symbols(model, plane)),
-            "latched rhodot^-, d_x, d_y, d_z of this plane"))
+    kernels += plane_kernels(model, pieces)
     kernels += output_kernels(model)
     return model, kernels
+
+
+def plane_kernels(model: Model, pieces: dict):
+    """The kernels of one plane's contact, in its own frame (model.FRAME_PLANE): each
+    law, its Jacobian (d/d contact state) and, for ACCELERATION_LAWS, its rates'
+    coefficients of rho''; the friction law's normal share; the slip kernel; the
+    compliant law's mode guards; the contact's energies and kinematics."""
+    plane = FRAME_PLANE
+    state = CONTACT_STATE_SYMBOLS
+    n = len(state)
+    inputs = plane_inputs(model)
+    extra_doc = ("the plane's latched rhodot^-, d_x, d_y, d_z (its frame), slip direction "
+                 "(2), gravity into the plane -n . g")
+    kernels = []
+
+    def local(expressions, name):
+        return contact_state(model, expressions, f"plane kernel {name}")
+
+    def law_kernels(law, doc):
+        outputs = pieces[law]
+        name = f"plane_{law}"
+        if law in contact.ACCELERATION_LAWS:
+            outputs, coefficients = split_acceleration(outputs, plane)
+            kernels.append(Kernel(
+                f"{name}_acceleration", f"{doc} the coefficients of the exact "
+                "penetration acceleration rho'' in its dissipation rates (normal, "
+                "tangential) and deflection rates (x, y) (4); the value kernel's are "
+                "at rho'' = 0.", local(coefficients, name), inputs, extra_doc, state=state))
+        kernels.append(Kernel(name, f"{doc} {describe_contact_law_layout()}.",
+                              local(outputs, name), inputs, extra_doc, state=state))
+        form = pieces.get(f"{law}_jacobian_form", outputs)
+        note = "" if form is outputs else " (of the law's Jacobian form, " \
+            "contact.JACOBIAN_FORMS)"
+        frozen = pieces.get(f"{law}_frozen", ())
+        frozen = list(zip([s for s, _ in frozen], local([e for _, e in frozen], name)))
+        kernels.append(jacobian_kernel(model, f"{name}_jac", f"{doc} d(outputs)/d(contact "
+                                       f"state) ({len(outputs)}x{n} row-major){note}.",
+                                       local(form, name), inputs, extra_doc, frozen=frozen,
+                                       state=state))
+
+    for law in contact.TANGENTIAL_LAWS:
+        law_kernels(law, f"A plane's contact in its own frame, {law} law (weighted):")
+    # Exact (event-driven) Coulomb friction applies the tangential force itself and
+    # takes only the friction law's normal share: its composition with no tangential
+    # part (contact.COMPOSITIONS), the law with mu = 0, without the regularised
+    # Coulomb part's two square roots and division.
+    law_kernels("friction_normal", "A plane's contact in its own frame, friction law with "
+                "mu = 0 (its normal share, weighted):")
+    kernels += slip_kernels(model, plane, pieces["force_map"])
+    margins = contact.compliant_margins(model, plane)
+    accel = contact.penetration_acceleration(plane)
+    restick = _affine_coefficient(margins[1], accel, "the re-stick margin")
+    kernels.append(Kernel(
+        "plane_compliant_margins",
+        "A plane's contact in its own frame, the compliant law's mode guards "
+        "(contact.compliant_margins): yield margin 1 - k_t |s| / (mu F_n), re-stick margin "
+        "(m/s) at rho'' = 0, s_cap = mu F_n / k_t (m), k_t (N/m), the elastic mode's "
+        "capacity margin (N) and its negative, and the re-stick margin's coefficient of the "
+        "exact penetration acceleration rho'' (s).",
+        local([margins[0], margins[1].xreplace({accel: 0}), margins[2], margins[3],
+               margins[4], -margins[4], restick], "plane_compliant_margins"),
+        inputs, extra_doc, state=state))
+    _, velocity, rho, rhodot = contact.contact_kinematics(model, plane)
+    N = model.frame
+    kernels.append(Kernel(
+        "plane_energy", "A plane's contact: the Hertz spring's energy 2/5 k0 rho^(5/2) and "
+        "the compliant law's tangential spring's 1/2 k_t |s|^2 (J).",
+        local([contact.spring_energy(model, plane),
+               contact.tangential_spring_energy(model, plane)], "plane_energy"),
+        [], state=state))
+    kernels.append(Kernel(
+        "plane_kinematics", "A plane's contact: rho, rhodot, the contact point's velocity "
+        "in the plane's frame (3).",
+        local([rho, rhodot] + [me.dot(velocity, v) for v in (N.x, N.y, N.z)],
+              "plane_kinematics"), [], state=state))
+    return kernels
 
 
 def _affine_coefficient(expression, symbol, what):
@@ -308,54 +374,54 @@ def _check_same(model: Model, ours, theirs, what, samples=5, seed=20261123):
                 raise ValueError(f"{what}: {va} != {vb} at a random point")
 
 
-def slip_kernel(model: Model, plane: str, force_map: sm.Matrix):
-    """What exact (event-driven) Coulomb friction needs on ``plane``.
+def slip_kernels(model: Model, plane: str, force_map: sm.Matrix):
+    """What exact (event-driven) Coulomb friction needs on a plane, in its own frame:
+    two kernels.
 
-    Outputs: the slip velocity u (2: x, y components of the contact-point velocity in
-    the plane), its derivative du/dx (2 x N_STATES row-major: u is linear in the
-    state), and the generalized-force map of a tangential force at the contact point
-    (6 x 2 row-major: columns for a unit force along N.x and N.y).  The driver's
-    stick constraint force and the sliding Coulomb force are applied through this
-    map, so the mechanics of where a contact force acts stay derived here.
+    ``plane_slip``: the slip velocity u (2: its components along the plane's tangents
+    t1, t2).  ``plane_slip_map``: its derivative du/d(contact state) (2 x
+    N_CONTACT_STATES row-major) and the generalized-force map of a tangential force at
+    the contact point (6 x 2 row-major: columns for a unit force along t1 and t2, torque
+    and force in the plane's frame) -- constants (u is linear in the contact state:
+    checked), which the C core turns into a plane's maps by the ball's state once per
+    parameter vector.  The driver's stick constraint force and the sliding Coulomb force
+    are applied through these maps, so the mechanics of where a contact force acts stay
+    derived here.
     """
     _, _, _, slip = contact.slip_kinematics(model, plane)
-    states = plain_symbols(model.states)
-    replacements = dict(zip(model.states, states))
-    slip = [sm.sympify(u).xreplace(replacements) for u in slip]
-    derivative = [u.diff(x) for u in slip for x in states]
-    tangential_map = [force_map[i, k].xreplace(replacements) for i in range(6) for k in range(2)]
-    return Kernel(f"{plane}_slip", f"{plane} contact: slip velocity u (2), du/dx "
-                  f"(2x{len(states)} row-major), generalized-force map of a tangential "
-                  "force at the contact point (6x2 row-major).",
-                  slip + derivative + tangential_map, [])
+    slip = contact_state(model, slip, "the slip velocity")
+    derivative = [u.diff(x) for u in slip for x in CONTACT_STATE_SYMBOLS]
+    tangential_map = contact_state(model, [force_map[i, k] for i in range(6) for k in range(2)],
+                                   "the force map")
+    constant = derivative + tangential_map
+    if any(sm.sympify(e).has(*CONTACT_STATE_SYMBOLS) for e in constant):
+        raise ValueError("the slip velocity is not linear in the contact state, or the "
+                         "force map depends on it: plane_slip_map would not be constant")
+    return [
+        Kernel("plane_slip", "A plane's contact in its own frame: slip velocity u (2).",
+               slip, [], state=CONTACT_STATE_SYMBOLS),
+        Kernel("plane_slip_map", "A plane's contact in its own frame, constants: "
+               f"du/d(contact state) (2x{len(CONTACT_STATE_SYMBOLS)} row-major), "
+               "generalized-force map of a tangential force at the contact point "
+               "(6x2 row-major).", constant, [], state=CONTACT_STATE_SYMBOLS),
+    ]
 
 
 def output_kernels(model: Model):
-    """Energies, contact-point kinematics and observer position."""
+    """Energies (kinetic, potential), observer position and the Hertz stiffness; the
+    contacts' energies and kinematics are plane kernels (plane_kernels)."""
     N = model.frame
     ball, observer = bodies(model)
-    g = model.p["gravity"]
+    g = gravity_vector(model)
     kinetic = ball.kinetic_energy(N) + observer.kinetic_energy(N)
-    z = model.state("z")
-    potential = ball.mass*g*z + observer.mass*g*(z + me.dot(
-        model.observer.pos_from(model.centre), N.z))
-    energy = [kinetic, potential] + [contact.spring_energy(model, plane) for plane in PLANES]
-    energy += [contact.tangential_spring_energy(model, plane) for plane in PLANES]
-
-    kin = []
-    for plane in PLANES:
-        _, velocity, rho, rhodot = contact.contact_kinematics(model, plane)
-        kin += [rho, rhodot] + [me.dot(velocity, v) for v in (N.x, N.y, N.z)]
-
     rel = model.observer.pos_from(model.centre)
+    position = sum((model.state(c)*v for c, v in zip("xyz", (N.x, N.y, N.z))), me.Vector(0))
+    potential = -ball.mass*me.dot(g, position) - observer.mass*me.dot(g, position + rel)
     observer_position = [model.state(c) + me.dot(rel, v)
                          for c, v in zip("xyz", (N.x, N.y, N.z))]
     return [
-        Kernel("energy", "Energies (J): kinetic, potential, spring floor, spring ceiling, "
-               "tangential spring floor, tangential spring ceiling (the compliant law's).",
-               energy, []),
-        Kernel("contact_kinematics", "Per plane (floor, ceiling): rho, rhodot, contact-point"
-               " velocity x y z (10).", kin, []),
+        Kernel("mechanical_energy", "Energies (J): kinetic, potential (-m g . c, the "
+               "observer's too); the contacts' springs: plane_energy.", [kinetic, potential], []),
         Kernel("observer_position", "Observer position in N (3).", observer_position, []),
         Kernel("hertz_stiffness", "Hertz stiffness k0 (N/m^(3/2)) of the ball on a plane (1): "
                "the one formula, also behind Scene.hertz_stiffness.",

@@ -7,7 +7,14 @@ singularity (the seed's explicit 123-angle kinematics divide by cos q3).
 
 Conventions
 -----------
-* ``N`` inertial frame, z up; floor z = 0, ceiling z = H.
+* ``N`` inertial frame, z up.  Gravity is a vector parameter (gravity_x, gravity_y,
+  gravity_z: the acceleration; the seed's g along -z is (0, 0, -g)).
+* Planes: each a point and a normal (towards the ball), parameters of the run
+  (PLANE_FIELDS per plane); the seed's floor is the plane z = 0 and its ceiling z = H.
+  The contact laws are derived once, in a plane's own frame (``FRAME_PLANE``: the
+  floor's, normal +z through the origin), for the state of one contact in that frame
+  (CONTACT_STATE_NAMES); the C core turns each plane's contact into that frame and the
+  law's forces back (src/ballc/_plane.c).
 * ``A`` ball-fixed frame; ``R = N.dcm(A)`` maps ball-frame components to inertial ones.
 * Quaternion ``(qw, qx, qy, qz)`` (Hamilton, scalar first).  ``R`` is built from the
   quaternion divided by its squared norm, so it is a proper rotation for any
@@ -50,7 +57,9 @@ STATE_NAMES = MECHANICAL_STATE_NAMES + AUXILIARY_STATE_NAMES
 PARAMETERS = (
     ("mass", "m", "kg", "mass of the ball"),
     ("observer_mass", "mo", "kg", "mass of the observer particle"),
-    ("gravity", "g", "m/s^2", "gravitational acceleration, along -z"),
+    ("gravity_x", "-", "m/s^2", "gravitational acceleration, x"),
+    ("gravity_y", "-", "m/s^2", "gravitational acceleration, y"),
+    ("gravity_z", "-g", "m/s^2", "gravitational acceleration, z (the seed's -g)"),
     ("radius", "r", "m", "radius of the ball"),
     ("observer_alpha", "alpha", "1", "observer position along ball x, in units of r"),
     ("observer_beta", "beta", "1", "observer position along ball y, in units of r"),
@@ -58,7 +67,6 @@ PARAMETERS = (
     ("inertia_xx", "iXX", "kg m^2", "central moment of inertia about ball x"),
     ("inertia_yy", "iYY", "kg m^2", "central moment of inertia about ball y"),
     ("inertia_zz", "iZZ", "kg m^2", "central moment of inertia about ball z"),
-    ("ceiling_height", "H", "m", "height of the ceiling plane"),
     ("mixture", "mixtur", "1", "weight of the dig-in model, 1 - weight of friction"),
     ("ball_poisson_ratio", "nyb", "1", "Poisson's ratio of the ball"),
     ("plane_poisson_ratio", "nyp", "1", "Poisson's ratio of the planes"),
@@ -79,22 +87,59 @@ PARAMETERS = (
     ("tangential_damping_ratio", "-", "1",
      "compliant model's tangential damping: c_t = 2 gamma_t sqrt(m* k_t)"),
 )
+PLANES = ("floor", "ceiling")
+#: Each plane's table entry, part of the parameters: a point of the plane and its normal,
+#: towards the ball (any length > 0: the C core normalises it and builds the plane's
+#: frame, src/ballc/_plane.c).  The seed's floor: (0, 0, 0), (0, 0, 1); its ceiling:
+#: (0, 0, H), (0, 0, -1).
+PLANE_FIELDS = (
+    ("point_x", "m", "a point of the plane, x"),
+    ("point_y", "m", "a point of the plane, y"),
+    ("point_z", "m", "a point of the plane, z"),
+    ("normal_x", "1", "the plane's normal towards the ball, x"),
+    ("normal_y", "1", "the plane's normal towards the ball, y"),
+    ("normal_z", "1", "the plane's normal towards the ball, z"),
+)
+PARAMETERS += tuple((f"{plane}_{name}", "-" if plane != "ceiling" or name != "point_z" else "H",
+                     unit, f"{plane}: {what}")
+                    for plane in PLANES for name, unit, what in PLANE_FIELDS)
 PARAMETER_NAMES = tuple(p[0] for p in PARAMETERS)
+
+#: The plane whose frame the contact laws are derived in: the floor's (normal +z through
+#: the origin).  Every plane's contact is evaluated by these laws, in its own frame.
+FRAME_PLANE = "floor"
+#: The state of one contact, in its plane's own frame (normal +z, the plane through the
+#: origin): the centre's height above the plane, the angular velocity and the centre's
+#: velocity in the plane's frame, and the plane's tangential deflection (the compliant
+#: law's; it lives in the plane's frame).  The order IS the layout of the plane kernels'
+#: ``state`` argument.  Names of the model's states (FRAME_PLANE's) -> contact state.
+CONTACT_STATE = (
+    ("z", "z"), ("omega_x", "omega_x"), ("omega_y", "omega_y"), ("omega_z", "omega_z"),
+    ("vx", "vx"), ("vy", "vy"), ("vz", "vz"),
+    (f"{FRAME_PLANE}_deflection_x", "deflection_x"),
+    (f"{FRAME_PLANE}_deflection_y", "deflection_y"),
+)
+CONTACT_STATE_NAMES = tuple(local for _, local in CONTACT_STATE)
 
 #: Values latched at the start of a contact, per plane, in this order.
 LATCH_FIELDS = (
     ("penetration_rate_at_impact", "rhodtu / rhodto",
      "m/s", "penetration rate when the contact started"),
-    ("digin_direction_x", "ru1 / ro1", "1", "unit contact-point velocity at impact, x"),
+    ("digin_direction_x", "ru1 / ro1", "1",
+     "unit contact-point velocity at impact, x (inertial components)"),
     ("digin_direction_y", "ru2 / ro2", "1", "unit contact-point velocity at impact, y"),
     ("digin_direction_z", "ru3 / ro3", "1", "unit contact-point velocity at impact, z"),
-    ("slip_direction_x", "-", "1",
-     "exact Coulomb friction: unit slip direction latched at the segment start, x"),
+    ("slip_direction_x", "-", "1", "exact Coulomb friction: unit slip direction latched at "
+     "the segment start, along the plane's first tangent t1 (its frame, as the slip)"),
     ("slip_direction_y", "-", "1",
-     "exact Coulomb friction: unit slip direction latched at the segment start, y"),
+     "exact Coulomb friction: unit slip direction latched at the segment start, along t2"),
 )
-PLANES = ("floor", "ceiling")
 LATCH_NAMES = tuple(f"{plane}_{f[0]}" for plane in PLANES for f in LATCH_FIELDS)
+#: A plane kernel's ``extra`` argument: the plane's latched values (LATCH_FIELDS, the
+#: dig-in direction turned into the plane's frame), then gravity's component into the
+#: plane, -n . g (m/s^2; the floor's g in the seed), the one parameter of the scene that
+#: depends on the plane.
+PLANE_INPUT_NAMES = tuple(f[0] for f in LATCH_FIELDS) + ("gravity_into_plane",)
 
 
 @dataclass
@@ -173,13 +218,22 @@ def build_model() -> Model:
 
 
 def contact_point(model: Model, plane: str) -> me.Point:
-    """The point of the ball nearest to ``plane`` ("floor" or "ceiling")."""
+    """The point of the ball nearest to ``plane``, in the plane's own frame
+    (FRAME_PLANE: the plane z = 0, the ball above it): C - r N.z."""
+    require_frame_plane(plane)
     N = model.frame
-    sign = -1 if plane == "floor" else 1
     point = me.Point(f"contact_{plane}")
-    point.set_pos(model.centre, sign*model.p["radius"]*N.z)
+    point.set_pos(model.centre, -model.p["radius"]*N.z)
     point.v2pt_theory(model.centre, N, model.ball_frame)
     return point
+
+
+def require_frame_plane(plane: str):
+    """Refuse a plane other than FRAME_PLANE: every other plane is that one turned, at
+    run time (src/ballc/_plane.c), and has no law of its own."""
+    if plane != FRAME_PLANE:
+        raise ValueError(f"the contact laws are derived in the plane's own frame "
+                         f"({FRAME_PLANE!r}) only, not for {plane!r}")
 
 
 def kanes_equations(model: Model, bodies, loads):
@@ -201,7 +255,12 @@ def bodies(model: Model):
     return ball, observer
 
 
+def gravity_vector(model: Model) -> me.Vector:
+    """The gravitational acceleration (m/s^2), a vector parameter."""
+    N, p = model.frame, model.p
+    return p["gravity_x"]*N.x + p["gravity_y"]*N.y + p["gravity_z"]*N.z
+
+
 def gravity_loads(model: Model, body):
-    """Weight of one body (ball or observer) along -z."""
-    point = body.masscenter
-    return [(point, -body.mass*model.p["gravity"]*model.frame.z)]
+    """Weight of one body (ball or observer): its mass times the gravity vector."""
+    return [(body.masscenter, body.mass*gravity_vector(model))]

@@ -22,19 +22,10 @@ cdef extern from "ballc_kernels.h":
     const char *const BALLC_PARAMETER_UNITS[]
     const char *const BALLC_LATCH_NAMES[]
     const char *BALLC_GENERATOR_VERSION
-    int BALLC_ENERGY_NOUT, BALLC_CONTACT_KINEMATICS_NOUT, BALLC_OBSERVER_POSITION_NOUT
-    void ballc_energy(const double *, const double *, const double *, const double *,
-        double *) nogil
-    void ballc_contact_kinematics(const double *, const double *, const double *, const double *,
-        double *) nogil
+    int BALLC_OBSERVER_POSITION_NOUT, BALLC_N_PLANES
     void ballc_observer_position(const double *, const double *, const double *, const double *,
         double *) nogil
     void ballc_hertz_stiffness(const double *, const double *, const double *, const double *,
-        double *) nogil
-    int BALLC_FLOOR_SLIP_NOUT
-    void ballc_floor_slip(const double *, const double *, const double *, const double *,
-        double *) nogil
-    void ballc_ceiling_slip(const double *, const double *, const double *, const double *,
         double *) nogil
 
 cdef extern from "_system.h":
@@ -44,10 +35,17 @@ cdef extern from "_system.h":
     int BALLC_OK
     int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
     int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
+    ctypedef struct ballc_plane_t:
+        double frame[3][3]     # rows t1, t2, n
     ctypedef struct ballc_parameters_t:
         const double *values
         double *constants      # an array in C (BALLC_N_PARAMETER_CONSTANTS)
+        ballc_plane_t *planes  # an array in C (BALLC_N_PLANES)
     void ballc_parameters_init(ballc_parameters_t *, const double *) nogil
+    int BALLC_ENERGY_NOUT, BALLC_CONTACT_KINEMATICS_NOUT, BALLC_SLIP_NOUT
+    void ballc_energy(const double *, const ballc_parameters_t *, double *) nogil
+    void ballc_contact_kinematics(const double *, const ballc_parameters_t *, double *) nogil
+    void ballc_slip_state(const double *, const ballc_parameters_t *, int, double *) nogil
     int ballc_rhs_checked_inputs(const double *, const ballc_parameters_t *, const double *,
                                  int, double *) nogil
     int ballc_jacobian_checked_inputs(const double *, const ballc_parameters_t *,
@@ -240,6 +238,7 @@ def rhs_per_sample(const double[:, ::1] states, const double[::1] params,
 
 ctypedef void (*kernel_fn)(const double *, const double *, const double *, const double *,
                            double *) nogil
+ctypedef void (*system_fn)(const double *, const ballc_parameters_t *, double *) nogil
 
 
 cdef object _per_row(kernel_fn kernel, int nout, const double[:, ::1] states,
@@ -256,14 +255,45 @@ cdef object _per_row(kernel_fn kernel, int nout, const double[:, ::1] states,
     return out
 
 
+cdef object _per_row_of_system(system_fn function, int nout, const double[:, ::1] states,
+                               const double[::1] params):
+    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    out = np.empty((states.shape[0], nout))
+    cdef double[:, ::1] o = out
+    cdef Py_ssize_t i
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
+    for i in range(states.shape[0]):
+        function(&states[i, 0], &prepared, &o[i, 0])
+    return out
+
+
 def energies(const double[:, ::1] states, const double[::1] params):
-    """(n, 4): kinetic, potential, spring floor, spring ceiling (J) per state row."""
-    return _per_row(ballc_energy, BALLC_ENERGY_NOUT, states, params)
+    """(n, 6): kinetic, potential, spring floor, spring ceiling, tangential spring floor,
+    tangential spring ceiling (J) per state row."""
+    return _per_row_of_system(ballc_energy, BALLC_ENERGY_NOUT, states, params)
 
 
 def contact_kinematics(const double[:, ::1] states, const double[::1] params):
-    """(n, 10): per plane rho, rhodot, contact-point velocity x, y, z."""
-    return _per_row(ballc_contact_kinematics, BALLC_CONTACT_KINEMATICS_NOUT, states, params)
+    """(n, 10): per plane rho, rhodot, contact-point velocity x, y, z (inertial)."""
+    return _per_row_of_system(ballc_contact_kinematics, BALLC_CONTACT_KINEMATICS_NOUT, states,
+                              params)
+
+
+def plane_frames(const double[::1] params):
+    """(N_PLANES, 3, 3): each plane's frame as the C core builds it from the parameters'
+    plane table, rows t1, t2, n (inertial components; see _plane.h)."""
+    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    out = np.empty((BALLC_N_PLANES, 3, 3))
+    cdef ballc_parameters_t prepared
+    cdef int p, i, j
+    ballc_parameters_init(&prepared, &params[0])
+    for p in range(BALLC_N_PLANES):
+        for i in range(3):
+            for j in range(3):
+                out[p, i, j] = prepared.planes[p].frame[i][j]
+    return out
 
 
 def observer_positions(const double[:, ::1] states, const double[::1] params):
@@ -294,22 +324,20 @@ def _plane_index(int plane):
 
 
 def slip_map(const double[::1] params, int plane):
-    """(2, N_STATES): du/dx of the slip velocity u (x, y) of ``plane``'s contact point;
-    u is linear in the state, u = slip_map . y."""
+    """(2, N_STATES): du/dx of the slip velocity u of ``plane``'s contact point, its
+    components along the plane's tangents t1, t2 (plane_frames); u is linear in the
+    state, u = slip_map . y."""
     _check("params", params.shape[0], BALLC_N_PARAMETERS)
     _plane_index(plane)
     cdef double ys[BALLC_MAX_STATES]
-    out = np.empty(BALLC_FLOOR_SLIP_NOUT)
+    out = np.empty(BALLC_SLIP_NOUT)
     cdef double[::1] o = out
     cdef Py_ssize_t i
     cdef ballc_parameters_t prepared
     ballc_parameters_init(&prepared, &params[0])
     for i in range(BALLC_N_STATES):
         ys[i] = 0.0
-    if plane == 0:
-        ballc_floor_slip(ys, &params[0], prepared.constants, NULL, &o[0])
-    else:
-        ballc_ceiling_slip(ys, &params[0], prepared.constants, NULL, &o[0])
+    ballc_slip_state(ys, &prepared, plane, &o[0])
     return out[2:2 + 2 * BALLC_N_STATES].reshape(2, BALLC_N_STATES)
 
 

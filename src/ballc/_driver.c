@@ -604,7 +604,7 @@ static int begin_contact(run_t *r, int p)
     ballc_drive_output *o = r->o;
     double *y = r->y;
     double kin[BALLC_CONTACT_KINEMATICS_NOUT];
-    ballc_contact_kinematics(y, c->params, r->prepared.constants, NULL, kin);
+    ballc_contact_kinematics(y, &r->prepared, kin);
     int k = p * KIN_PER_PLANE;
     double rho = kin[k], rate = kin[k + 1];
     const double *v = kin + k + 2;
@@ -1280,7 +1280,7 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
 /* _core.energies of one state row */
 static void energy_of(const run_t *r, const double *y, double *e)
 {
-    ballc_energy(y, r->c->params, r->prepared.constants, NULL, e);
+    ballc_energy(y, &r->prepared, e);
 }
 
 /* resting._booked: the energy y has above ``new`` added to dissipated_normal */

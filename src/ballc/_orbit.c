@@ -51,6 +51,10 @@ void ballc_motion_apply(const ballc_motion *g, const double *y, int rate, double
     static const int planar[] = {BALLC_STATE_X, BALLC_STATE_OMEGA_X, BALLC_STATE_VX,
                                  BALLC_STATE_FLOOR_DEFLECTION_X,
                                  BALLC_STATE_CEILING_DEFLECTION_X};
+    /* how each pair turns with the scene: inertial components with it; a plane's
+     * deflection lives in its own frame (_plane.h), whose (t1, t2) turn by phi n_z: the
+     * floor's (normal +z) with it, the ceiling's (normal -z: t1 = x, t2 = -y) against it */
+    static const double sense[] = {1.0, 1.0, 1.0, 1.0, -1.0};
     double in[N], turned[4];
     memcpy(in, y, sizeof in);
     memcpy(out, in, sizeof in);
@@ -64,8 +68,8 @@ void ballc_motion_apply(const ballc_motion *g, const double *y, int rate, double
     quaternion_multiply(turned, spin, out + BALLC_STATE_QW);
     for (size_t b = 0; b < sizeof planar / sizeof planar[0]; b++) {
         double x = in[planar[b]], yy = in[planar[b] + 1];
-        out[planar[b]] = c * x - s * yy;
-        out[planar[b] + 1] = s * x + c * yy;
+        out[planar[b]] = c * x - sense[b] * s * yy;
+        out[planar[b] + 1] = sense[b] * s * x + c * yy;
     }
     if (!rate) {
         out[BALLC_STATE_X] += g->d[0];
@@ -102,7 +106,9 @@ int ballc_orbit_equivariant(const double *params, const double *latch, int flags
         if (fabs(f[i]) > largest) largest = fabs(f[i]);
         if (miss > worst) worst = miss;
     }
-    double scale = largest + params[BALLC_PARAMETER_GRAVITY];
+    double scale = largest + sqrt(params[BALLC_PARAMETER_GRAVITY_X] * params[BALLC_PARAMETER_GRAVITY_X]
+                                  + params[BALLC_PARAMETER_GRAVITY_Y] * params[BALLC_PARAMETER_GRAVITY_Y]
+                                  + params[BALLC_PARAMETER_GRAVITY_Z] * params[BALLC_PARAMETER_GRAVITY_Z]);
     return worst <= 1e3 * DBL_EPSILON * scale;
 }
 
@@ -245,7 +251,7 @@ static double mechanical_energy(const double *y, const ballc_parameters_t *prepa
                                 double *kinetic)
 {
     double e[BALLC_ENERGY_NOUT];
-    ballc_energy(y, prepared->values, prepared->constants, NULL, e);
+    ballc_energy(y, prepared, e);
     double sum = 0.0;
     for (int i = 0; i < BALLC_ENERGY_NOUT; i++) sum += e[i];
     *kinetic = e[0];

@@ -1,4 +1,5 @@
-/* See _system.h.  Hand-written glue: calls generated kernels, solves M udot = F. */
+/* See _system.h.  Hand-written glue: calls generated kernels (the contact laws in each
+ * plane's frame, _plane.h), solves M udot = F. */
 #include <math.h>
 #include <string.h>
 
@@ -7,6 +8,8 @@
 #define NS BALLC_N_STATES
 #define NQ 7  /* coordinates: quaternion (4) and centre (3) */
 #define NU 6  /* speeds: angular velocity (3) and centre velocity (3) */
+#define NC BALLC_N_CONTACT_STATES
+#define NP BALLC_N_PLANES
 
 typedef void (*kernel_fn)(const double *restrict, const double *restrict,
                           const double *restrict, const double *restrict, double *restrict);
@@ -14,51 +17,83 @@ typedef void (*kernel_fn)(const double *restrict, const double *restrict,
 /* A kernel's parameter arguments: the parameters and their constants. */
 #define PARAMS(p) (p)->values, (p)->constants
 
+/* Each plane's deflection states (x; y next). */
+static const int DEFLECTION[NP] = {BALLC_STATE_FLOOR_DEFLECTION_X,
+                                   BALLC_STATE_CEILING_DEFLECTION_X};
+
 void ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
 {
     prepared->values = params;
     ballc_parameter_constants(params, prepared->constants);
+    const double anywhere[NC] = {0};   /* the slip maps are constants (codegen checks) */
+    double maps[BALLC_PLANE_SLIP_MAP_NOUT];
+    ballc_plane_slip_map(anywhere, PARAMS(prepared), NULL, maps);
+    for (int p = 0; p < NP; p++) {
+        const double *entry = params + BALLC_PARAMETER_PLANES + p * BALLC_N_PLANE_FIELDS;
+        ballc_plane_t *pl = &prepared->planes[p];
+        ballc_plane_init(pl, entry + BALLC_PLANE_POINT_X, entry + BALLC_PLANE_NORMAL_X,
+                         params + BALLC_PARAMETER_GRAVITY_X, DEFLECTION[p]);
+        /* the plane's slip map by the ball's state, its force map in inertial components */
+        ballc_plane_state_columns(pl, maps, 2, prepared->slip_map[p]);
+        memcpy(prepared->slip_force_map[p], maps + 2 * NC, sizeof prepared->slip_force_map[p]);
+        ballc_plane_rows_to_inertial(pl, prepared->slip_force_map[p], 2, 0, 2);
+    }
 }
 
-/* Contact laws: which flag switches them on, their kernels, their plane, (friction
- * only) the kernels of the law's normal share (mu = 0), used under exact Coulomb friction,
- * and (the compliant sliding mode only) the kernel of its rates' coefficients of the exact
- * penetration acceleration rho'' (codegen: contact.ACCELERATION_LAWS). */
+/* Contact laws: which flag switches them on, per plane, their kernels (in a plane's own
+ * frame), (friction only) the kernels of the law's normal share (mu = 0), used under
+ * exact Coulomb friction, and (the compliant sliding mode only) the kernel of its rates'
+ * coefficients of the exact penetration acceleration rho'' (codegen:
+ * contact.ACCELERATION_LAWS). */
 static const struct {
-    int flag; kernel_fn value, jac; int plane; kernel_fn normal, normal_jac, acceleration;
+    int flag[NP]; kernel_fn value, jac, normal, normal_jac, acceleration;
 } CONTACT_LAWS[] = {
-    {BALLC_FLOOR_FRICTION, ballc_floor_friction, ballc_floor_friction_jac, 0,
-     ballc_floor_friction_normal, ballc_floor_friction_normal_jac, NULL},
-    {BALLC_FLOOR_DIGIN, ballc_floor_digin, ballc_floor_digin_jac, 0, NULL, NULL, NULL},
-    {BALLC_FLOOR_COMPLIANT, ballc_floor_compliant, ballc_floor_compliant_jac, 0, NULL, NULL,
+    {{BALLC_FLOOR_FRICTION, BALLC_CEILING_FRICTION}, ballc_plane_friction,
+     ballc_plane_friction_jac, ballc_plane_friction_normal, ballc_plane_friction_normal_jac,
      NULL},
-    {BALLC_FLOOR_COMPLIANT_SLIDING, ballc_floor_compliant_sliding,
-     ballc_floor_compliant_sliding_jac, 0, NULL, NULL,
-     ballc_floor_compliant_sliding_acceleration},
-    {BALLC_FLOOR_COMPLIANT_ELASTIC, ballc_floor_compliant_elastic,
-     ballc_floor_compliant_elastic_jac, 0, NULL, NULL, NULL},
-    {BALLC_CEILING_FRICTION, ballc_ceiling_friction, ballc_ceiling_friction_jac, 1,
-     ballc_ceiling_friction_normal, ballc_ceiling_friction_normal_jac, NULL},
-    {BALLC_CEILING_DIGIN, ballc_ceiling_digin, ballc_ceiling_digin_jac, 1, NULL, NULL, NULL},
-    {BALLC_CEILING_COMPLIANT, ballc_ceiling_compliant, ballc_ceiling_compliant_jac, 1,
+    {{BALLC_FLOOR_DIGIN, BALLC_CEILING_DIGIN}, ballc_plane_digin, ballc_plane_digin_jac,
      NULL, NULL, NULL},
-    {BALLC_CEILING_COMPLIANT_SLIDING, ballc_ceiling_compliant_sliding,
-     ballc_ceiling_compliant_sliding_jac, 1, NULL, NULL,
-     ballc_ceiling_compliant_sliding_acceleration},
-    {BALLC_CEILING_COMPLIANT_ELASTIC, ballc_ceiling_compliant_elastic,
-     ballc_ceiling_compliant_elastic_jac, 1, NULL, NULL, NULL},
+    {{BALLC_FLOOR_COMPLIANT, BALLC_CEILING_COMPLIANT}, ballc_plane_compliant,
+     ballc_plane_compliant_jac, NULL, NULL, NULL},
+    {{BALLC_FLOOR_COMPLIANT_SLIDING, BALLC_CEILING_COMPLIANT_SLIDING},
+     ballc_plane_compliant_sliding, ballc_plane_compliant_sliding_jac, NULL, NULL,
+     ballc_plane_compliant_sliding_acceleration},
+    {{BALLC_FLOOR_COMPLIANT_ELASTIC, BALLC_CEILING_COMPLIANT_ELASTIC},
+     ballc_plane_compliant_elastic, ballc_plane_compliant_elastic_jac, NULL, NULL, NULL},
 };
 #define N_CONTACT_LAWS (sizeof CONTACT_LAWS / sizeof CONTACT_LAWS[0])
 #define LAW_NOUT BALLC_CONTACT_LAW_NOUT
 
+/* Whether any law of ``plane`` acts under ``flags``: the plane is in contact. */
+static int in_contact(int flags, int plane)
+{
+    int any = 0;
+    for (size_t k = 0; k < N_CONTACT_LAWS; k++) any |= CONTACT_LAWS[k].flag[plane];
+    return (flags & any) != 0;
+}
+
 /* Where a law's auxiliary outputs (dissipation normal, tangential, deflection rate x, y)
  * go in the state derivative. */
-static void auxiliary_targets(int plane, int target[4])
+static void auxiliary_targets(const ballc_plane_t *plane, int target[4])
 {
     target[0] = BALLC_STATE_DISSIPATED_NORMAL;
     target[1] = BALLC_STATE_DISSIPATED_TANGENTIAL;
-    target[2] = plane == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X;
+    target[2] = plane->deflection;
     target[3] = target[2] + 1;
+}
+
+/* A plane's contact state and kernel inputs (its frame), for its law kernels. */
+typedef struct {
+    double state[NC];
+    double inputs[BALLC_N_PLANE_INPUTS];
+} plane_contact_t;
+
+static void plane_contact(const ballc_parameters_t *params, int plane, const double *state,
+                          const double *latch, plane_contact_t *contact)
+{
+    const ballc_plane_t *pl = &params->planes[plane];
+    ballc_plane_contact_state(pl, state, contact->state);
+    ballc_plane_inputs(pl, latch + plane * BALLC_N_LATCH_PER_PLANE, contact->inputs);
 }
 
 static const double *law_latch(const double *latch, int plane)
@@ -109,31 +144,55 @@ static int is_sliding(int mode)
     return mode == MODE_SLIP || mode == MODE_SLIP_FIXED;
 }
 
-/* The slip kernel's outputs: u (2), du/dx (2 x NS), tangential force map G_t (6 x 2). */
-#define SLIP_U 0
-#define SLIP_DU 2
-#define SLIP_G (2 + 2 * NS)
-static const kernel_fn SLIP_KERNELS[BALLC_N_PLANES] = {ballc_floor_slip, ballc_ceiling_slip};
+/* A plane's slip: the velocity u (along t1, t2), its map du/dx (2 x NS, row-major) and the
+ * generalized-force map G_t (6 x 2) of a unit tangential force along t1, t2. */
+typedef struct {
+    double u[2];
+    const double *du, *G;
+} slip_t;
+
+/* The slip of ``plane`` at the contact state ``local`` (its frame). */
+static void slip_of(const ballc_parameters_t *params, int plane, const double *local,
+                    slip_t *slip)
+{
+    ballc_plane_slip(local, PARAMS(params), NULL, slip->u);
+    slip->du = params->slip_map[plane];
+    slip->G = params->slip_force_map[plane];
+}
+
+void ballc_slip_state(const double *state, const ballc_parameters_t *params, int plane,
+                      double *out)
+{
+    double local[NC];
+    slip_t slip;
+    ballc_plane_contact_state(&params->planes[plane], state, local);
+    slip_of(params, plane, local, &slip);
+    out[0] = slip.u[0];
+    out[1] = slip.u[1];
+    memcpy(out + 2, slip.du, 2 * NS * sizeof(double));
+    memcpy(out + 2 + 2 * NS, slip.G, 12 * sizeof(double));
+}
 
 /* What one evaluation of the equations yields besides the state derivative. */
 typedef struct {
     double mass[BALLC_MASS_SIZE];
-    double contact_force[3 * BALLC_N_PLANES];   /* on the ball, per plane */
+    double contact_force[3 * BALLC_N_PLANES];   /* on the ball, per plane: its frame */
     int mode[BALLC_N_PLANES];                   /* exact Coulomb mode per plane */
     double load[BALLC_N_PLANES];                /* N: the friction share's normal force */
-    double slip[BALLC_N_PLANES][BALLC_FLOOR_SLIP_NOUT];
+    slip_t slip[BALLC_N_PLANES];
     double e[BALLC_N_PLANES][2];                /* sliding: the force direction is -e */
     double lambda[BALLC_N_PLANES][2];           /* sticking: the constraint force */
     /* the coefficients of rho'' in the auxiliary rates, per plane (0 without) */
     double acceleration[BALLC_N_PLANES][4];
 } evaluation_t;
 
-/* The exact penetration acceleration rho'' of ``plane`` from the solved udot: rho = r - z
- * on the floor, z - (H - r) on the ceiling. */
-static double penetration_acceleration(int plane, const double *udot)
+/* The exact penetration acceleration rho'' of ``plane`` from the solved udot: rho = r -
+ * n . (c - p), so rho'' = -n . a. */
+static double penetration_acceleration(const ballc_parameters_t *params, int plane,
+                                       const double *udot)
 {
-    const double a_z = udot[BALLC_STATE_VZ - NQ];
-    return plane == 0 ? -a_z : a_z;
+    const double *n = params->planes[plane].frame[2], *a = udot + (BALLC_STATE_VX - NQ);
+    return -(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]);
 }
 
 /* Mass blocks and forcing of everything that acts under ``flags``; the rates of the
@@ -162,33 +221,44 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
         ev->load[plane] = 0.0;
         for (int i = 0; i < 4; i++) ev->acceleration[plane][i] = 0.0;
     }
-    for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
-        if (!(flags & CONTACT_LAWS[k].flag)) continue;
-        int plane = CONTACT_LAWS[k].plane, target[4];
-        int exact = ev->mode[plane] != MODE_NONE && CONTACT_LAWS[k].normal;
-        (exact ? CONTACT_LAWS[k].normal : CONTACT_LAWS[k].value)(state, PARAMS(params),
-                                                                 law_latch(latch, plane), out);
-        for (int i = 0; i < NU; i++) force[i] += out[BALLC_LAW_GENERALIZED_FORCE + i];
-        for (int i = 0; i < 3; i++) ev->contact_force[3 * plane + i] += out[BALLC_LAW_FORCE + i];
-        if (exact) ev->load[plane] = (plane == 0 ? 1.0 : -1.0) * out[BALLC_LAW_FORCE + 2];
-        if (!xdot) continue;
-        auxiliary_targets(plane, target);
-        for (int i = 0; i < 4; i++) xdot[target[i]] += out[BALLC_LAW_DISSIPATION + i];
-        if (CONTACT_LAWS[k].acceleration) {   /* its rho'' share is added after the solve */
-            double coefficients[4];
-            CONTACT_LAWS[k].acceleration(state, PARAMS(params), law_latch(latch, plane),
-                                         coefficients);
-            for (int i = 0; i < 4; i++) ev->acceleration[plane][i] += coefficients[i];
-        }
-    }
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
-    for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+    for (int plane = 0; plane < NP; plane++) {
+        if (!in_contact(flags, plane)) continue;   /* a plane far away costs nothing */
+        const ballc_plane_t *pl = &params->planes[plane];
+        plane_contact_t contact;
+        double sum[LAW_NOUT] = {0};
+        plane_contact(params, plane, state, latch, &contact);
+        for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
+            if (!(flags & CONTACT_LAWS[k].flag[plane])) continue;
+            int exact = ev->mode[plane] != MODE_NONE && CONTACT_LAWS[k].normal;
+            (exact ? CONTACT_LAWS[k].normal : CONTACT_LAWS[k].value)(
+                contact.state, PARAMS(params), contact.inputs, out);
+            for (int i = 0; i < LAW_NOUT; i++) sum[i] += out[i];
+            if (exact) ev->load[plane] = out[BALLC_LAW_FORCE + 2];   /* along n */
+            if (xdot && CONTACT_LAWS[k].acceleration) {
+                /* its rho'' share is added after the solve */
+                double coefficients[4];
+                CONTACT_LAWS[k].acceleration(contact.state, PARAMS(params), contact.inputs,
+                                             coefficients);
+                for (int i = 0; i < 4; i++) ev->acceleration[plane][i] += coefficients[i];
+            }
+        }
+        /* the laws' torque and force, turned back from the plane's frame */
+        ballc_plane_to_inertial(pl, sum + BALLC_LAW_GENERALIZED_FORCE, 2);
+        for (int i = 0; i < NU; i++) force[i] += sum[BALLC_LAW_GENERALIZED_FORCE + i];
+        double *contact_force = ev->contact_force + 3 * plane;
+        for (int i = 0; i < 3; i++) contact_force[i] = sum[BALLC_LAW_FORCE + i];
+        if (xdot) {
+            int target[4];
+            auxiliary_targets(pl, target);
+            for (int i = 0; i < 4; i++) xdot[target[i]] += sum[BALLC_LAW_DISSIPATION + i];
+        }
         if (ev->mode[plane] == MODE_NONE) continue;
-        double *slip = ev->slip[plane];
-        SLIP_KERNELS[plane](state, PARAMS(params), NULL, slip);
+        slip_t *slip = &ev->slip[plane];
+        slip_of(params, plane, contact.state, slip);
         if (!is_sliding(ev->mode[plane])) continue;
         const double *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
-        double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = sqrt(ux * ux + uy * uy);
+        double ux = slip->u[0], uy = slip->u[1], speed = sqrt(ux * ux + uy * uy);
         double *e = ev->e[plane];
         if (speed > 0 && ev->mode[plane] == MODE_SLIP) {
             double sign = ux * d[0] + uy * d[1] < 0 ? -1.0 : 1.0;
@@ -199,10 +269,10 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
             e[1] = d[1];
         }
         double f[2] = {-mu * ev->load[plane] * e[0], -mu * ev->load[plane] * e[1]};
-        const double *G = slip + SLIP_G;
+        const double *G = slip->G;
         for (int i = 0; i < NU; i++) force[i] += G[2 * i] * f[0] + G[2 * i + 1] * f[1];
-        ev->contact_force[3 * plane] += f[0];
-        ev->contact_force[3 * plane + 1] += f[1];
+        contact_force[0] += f[0];
+        contact_force[1] += f[1];
         if (xdot) xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -= f[0] * ux + f[1] * uy;
     }
 }
@@ -263,10 +333,10 @@ static void schur_solve(const schur_t *f, double *b)
 /* Responses of a sticking plane: z_k = M^-1 G_t e_k (6 x 2, column k at z[k]) and the
  * Delassus matrix W = (du/d speeds) z (2 x 2), inverted into Winv.  Returns
  * BALLC_SINGULAR when W is not invertible. */
-static int stick_response(const schur_t *factor, const double *slip, double z[2][NU],
+static int stick_response(const schur_t *factor, const slip_t *slip, double z[2][NU],
                           double Winv[2][2])
 {
-    const double *G = slip + SLIP_G, *du = slip + SLIP_DU;
+    const double *G = slip->G, *du = slip->du;
     double W[2][2];
     for (int k = 0; k < 2; k++) {
         for (int i = 0; i < NU; i++) z[k][i] = G[2 * i + k];
@@ -298,7 +368,8 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
     schur_solve(factor, udot);
     for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
         if (ev->mode[plane] != MODE_STICK) continue;
-        const double *slip = ev->slip[plane], *du = slip + SLIP_DU;
+        const slip_t *slip = &ev->slip[plane];
+        const double *du = slip->du;
         double z[2][NU], Winv[2][2], a0[2];
         status = stick_response(factor, slip, z, Winv);
         if (status != BALLC_OK) return status;
@@ -310,11 +381,11 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
         lambda[0] = -(Winv[0][0] * a0[0] + Winv[0][1] * a0[1]);
         lambda[1] = -(Winv[1][0] * a0[0] + Winv[1][1] * a0[1]);
         for (int i = 0; i < NU; i++) udot[i] += z[0][i] * lambda[0] + z[1][i] * lambda[1];
-        ev->contact_force[3 * plane] += lambda[0];
+        ev->contact_force[3 * plane] += lambda[0];       /* along t1, t2 */
         ev->contact_force[3 * plane + 1] += lambda[1];
         if (xdot)
             xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -=
-                lambda[0] * slip[SLIP_U] + lambda[1] * slip[SLIP_U + 1];
+                lambda[0] * slip->u[0] + lambda[1] * slip->u[1];
     }
     if (xdot)
         for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
@@ -322,8 +393,8 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
             if (!coefficients[0] && !coefficients[1] && !coefficients[2] && !coefficients[3])
                 continue;
             int target[4];
-            auxiliary_targets(plane, target);
-            double rho_dd = penetration_acceleration(plane, udot);
+            auxiliary_targets(&params->planes[plane], target);
+            double rho_dd = penetration_acceleration(params, plane, udot);
             for (int i = 0; i < 4; i++) xdot[target[i]] += coefficients[i] * rho_dd;
         }
     return all_finite(udot, NU) ? BALLC_OK : BALLC_NOT_FINITE;
@@ -392,6 +463,8 @@ int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t 
     int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
     memcpy(forces, ev.contact_force, sizeof ev.contact_force);
+    for (int p = 0; p < NP; p++)   /* from each plane's frame */
+        ballc_plane_to_inertial(&params->planes[p], forces + 3 * p, 1);
     return all_finite(forces, 3 * BALLC_N_PLANES) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
@@ -417,9 +490,6 @@ int ballc_stick_state(const double *state, const double *params, const double *l
     return all_finite(out, 4) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
-static const kernel_fn MARGIN_KERNELS[BALLC_N_PLANES] = {
-    ballc_floor_compliant_margins, ballc_ceiling_compliant_margins};
-
 /* The margins kernel's outputs: the BALLC_COMPLIANT_MARGINS margins (the re-stick margin
  * at rho'' = 0), then the re-stick margin's coefficient of rho''. */
 #define MARGINS_RESTICK_ACCELERATION BALLC_COMPLIANT_MARGINS
@@ -427,8 +497,10 @@ static const kernel_fn MARGIN_KERNELS[BALLC_N_PLANES] = {
 int ballc_compliant_margins_prepared(const double *state, const ballc_parameters_t *params,
                                      const double *latch, int plane, int row, double *out)
 {
-    double m[BALLC_FLOOR_COMPLIANT_MARGINS_NOUT];
-    MARGIN_KERNELS[plane](state, PARAMS(params), law_latch(latch, plane), m);
+    double m[BALLC_PLANE_COMPLIANT_MARGINS_NOUT];
+    plane_contact_t contact;
+    plane_contact(params, plane, state, latch, &contact);
+    ballc_plane_compliant_margins(contact.state, PARAMS(params), contact.inputs, m);
     for (int i = 0; i < BALLC_COMPLIANT_MARGINS; i++) out[i] = m[i];
     if ((row < 0 || row == 1) && m[MARGINS_RESTICK_ACCELERATION] != 0) {
         /* the exact rho'' of the contact sliding at the cap (the elastic law at the cap
@@ -440,7 +512,8 @@ int ballc_compliant_margins_prepared(const double *state, const ballc_parameters
         double udot[NU];
         int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
         if (status != BALLC_OK) return status;
-        out[1] += m[MARGINS_RESTICK_ACCELERATION] * penetration_acceleration(plane, udot);
+        out[1] += m[MARGINS_RESTICK_ACCELERATION]
+                  * penetration_acceleration(params, plane, udot);
     }
     return (row < 0 ? all_finite(out, BALLC_COMPLIANT_MARGINS) : isfinite(out[row]))
            ? BALLC_OK : BALLC_NOT_FINITE;
@@ -462,7 +535,8 @@ int ballc_remove_slip(const double *state, const double *params, int flags, int 
 {
     schur_t factor;
     double mass[BALLC_MASS_SIZE], buf[BALLC_BALL_NOUT];
-    double slip[BALLC_FLOOR_SLIP_NOUT], z[2][NU], Winv[2][2];
+    double local[NC], z[2][NU], Winv[2][2];
+    slip_t slip;
     memcpy(state_out, state, NS * sizeof(double));
     if (plane < 0 || plane >= BALLC_N_PLANES) return BALLC_SINGULAR;
     if (!all_finite(state, NS) || !all_finite(params, BALLC_N_PARAMETERS))
@@ -477,10 +551,11 @@ int ballc_remove_slip(const double *state, const double *params, int flags, int 
     }
     int status = schur_factor(mass, &factor);
     if (status != BALLC_OK) return status;
-    SLIP_KERNELS[plane](state, PARAMS(&prepared), NULL, slip);
-    status = stick_response(&factor, slip, z, Winv);
+    ballc_plane_contact_state(&prepared.planes[plane], state, local);
+    slip_of(&prepared, plane, local, &slip);
+    status = stick_response(&factor, &slip, z, Winv);
     if (status != BALLC_OK) return status;
-    const double *u = slip + SLIP_U;
+    const double *u = slip.u;
     double impulse[2] = {-(Winv[0][0] * u[0] + Winv[0][1] * u[1]),
                          -(Winv[1][0] * u[0] + Winv[1][1] * u[1])};
     for (int i = 0; i < NU; i++)
@@ -522,14 +597,17 @@ static int difference_jacobian(const double *state, const ballc_parameters_t *pa
 
 /* Add the sliding Coulomb force's derivatives: F_t = -mu N e(u), with
  * de/du = sign (I - e e^T) / |u| (sign: e's orientation along the latched direction;
- * 0 with a fixed direction), and those of the tangential dissipation rate mu N (e . u). */
+ * 0 with a fixed direction), and those of the tangential dissipation rate mu N (e . u).
+ * ``law_jac``: the normal share's Jacobian by the state, its rows in the plane's frame
+ * (the row of the force along n: dN/dx). */
 static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const double *latch,
                          const double *law_jac, double *dF, double *jac)
 {
-    const double *slip = ev->slip[plane], *du = slip + SLIP_DU, *G = slip + SLIP_G;
+    const slip_t *slip = &ev->slip[plane];
+    const double *du = slip->du, *G = slip->G;
     const double *e = ev->e[plane], *d = law_latch(latch, plane) + BALLC_LATCH_SLIP_DIRECTION_X;
-    double ux = slip[SLIP_U], uy = slip[SLIP_U + 1], speed = hypot(ux, uy);
-    double N = ev->load[plane], normal = plane == 0 ? 1.0 : -1.0;
+    double ux = slip->u[0], uy = slip->u[1], speed = hypot(ux, uy);
+    double N = ev->load[plane];
     double de[2][2] = {{0, 0}, {0, 0}};
     if (speed > 0 && ev->mode[plane] == MODE_SLIP) {
         double sign = ux * d[0] + uy * d[1] < 0 ? -1.0 : 1.0;
@@ -539,7 +617,7 @@ static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const dou
     }
     double eu = e[0] * ux + e[1] * uy;
     for (int j = 0; j < NS; j++) {
-        double dN = normal * law_jac[(BALLC_LAW_FORCE + 2) * NS + j];
+        double dN = law_jac[(BALLC_LAW_FORCE + 2) * NS + j];
         double du0 = du[j], du1 = du[NS + j];
         double df[2];
         for (int a = 0; a < 2; a++)
@@ -573,22 +651,31 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
     ballc_kinematics_jac(state, PARAMS(params), NULL, jac);   /* rows 0..6 */
 
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
-    double dF[NU * NS] = {0}, dMa[NU * 4] = {0}, buf[LAW_NOUT * NS];
+    double dF[NU * NS] = {0}, dMa[NU * 4] = {0}, buf[LAW_NOUT * NS], local[LAW_NOUT * NC];
     add_dynamics_jac(ballc_ball_jac, state, params, udot, dF, dMa);
     if (flags & BALLC_WITH_OBSERVER)
         add_dynamics_jac(ballc_observer_jac, state, params, udot, dF, dMa);
-    for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
-        if (!(flags & CONTACT_LAWS[k].flag)) continue;
-        int plane = CONTACT_LAWS[k].plane, target[4];
-        int exact = is_sliding(ev.mode[plane]) && CONTACT_LAWS[k].normal_jac;
-        (exact ? CONTACT_LAWS[k].normal_jac : CONTACT_LAWS[k].jac)(state, PARAMS(params),
-                                                                   law_latch(latch, plane), buf);
-        for (int i = 0; i < NU * NS; i++) dF[i] += buf[BALLC_LAW_GENERALIZED_FORCE * NS + i];
-        auxiliary_targets(plane, target);
-        for (int i = 0; i < 4; i++)
-            for (int j = 0; j < NS; j++)
-                jac[target[i] * NS + j] += buf[(BALLC_LAW_DISSIPATION + i) * NS + j];
-        if (exact) add_slip_jac(&ev, plane, mu, latch, buf, dF, jac);
+    for (int plane = 0; plane < NP; plane++) {
+        if (!in_contact(flags, plane)) continue;
+        const ballc_plane_t *pl = &params->planes[plane];
+        plane_contact_t contact;
+        int target[4];
+        auxiliary_targets(pl, target);
+        plane_contact(params, plane, state, latch, &contact);
+        for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
+            if (!(flags & CONTACT_LAWS[k].flag[plane])) continue;
+            int exact = is_sliding(ev.mode[plane]) && CONTACT_LAWS[k].normal_jac;
+            (exact ? CONTACT_LAWS[k].normal_jac : CONTACT_LAWS[k].jac)(
+                contact.state, PARAMS(params), contact.inputs, local);
+            ballc_plane_state_columns(pl, local, LAW_NOUT, buf);
+            if (exact) add_slip_jac(&ev, plane, mu, latch, buf, dF, jac);
+            /* the torque's and the force's rows back from the plane's frame */
+            ballc_plane_rows_to_inertial(pl, buf, NS, BALLC_LAW_GENERALIZED_FORCE, 2);
+            for (int i = 0; i < NU * NS; i++) dF[i] += buf[BALLC_LAW_GENERALIZED_FORCE * NS + i];
+            for (int i = 0; i < 4; i++)
+                for (int j = 0; j < NS; j++)
+                    jac[target[i] * NS + j] += buf[(BALLC_LAW_DISSIPATION + i) * NS + j];
+        }
     }
     /* d udot / dx_j = M^-1 (dF/dx_j - d(M udot)/dx_j); M depends on q only. */
     for (int j = 0; j < NS; j++) {
@@ -599,4 +686,27 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
         for (int i = 0; i < NU; i++) jac[(NQ + i) * NS + j] = col[i];
     }
     return all_finite(jac, NS * NS) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+void ballc_energy(const double *state, const ballc_parameters_t *params, double *out)
+{
+    double local[NC], e[BALLC_PLANE_ENERGY_NOUT];
+    ballc_mechanical_energy(state, PARAMS(params), NULL, out);
+    for (int p = 0; p < NP; p++) {
+        ballc_plane_contact_state(&params->planes[p], state, local);
+        ballc_plane_energy(local, PARAMS(params), NULL, e);
+        out[2 + p] = e[0];
+        out[2 + NP + p] = e[1];
+    }
+}
+
+void ballc_contact_kinematics(const double *state, const ballc_parameters_t *params,
+                              double *out)
+{
+    double local[NC];
+    for (int p = 0; p < NP; p++, out += BALLC_CONTACT_KINEMATICS_PER_PLANE) {
+        ballc_plane_contact_state(&params->planes[p], state, local);
+        ballc_plane_kinematics(local, PARAMS(params), NULL, out);
+        ballc_plane_to_inertial(&params->planes[p], out + 2, 1);   /* the velocity */
+    }
 }

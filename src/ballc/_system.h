@@ -4,11 +4,18 @@
  * M = [[J, B], [B^T, D I3]] (see codegen/kernels.py).  udot comes from a Schur
  * complement: S = J - B B^T / D (symmetric positive definite) is factored by
  * Cholesky, so no 6x6 (or 13x13) dense solve is needed.
+ *
+ * The contact laws are generated once, in a plane's own frame; each plane of the plane
+ * table (a point and a normal per plane, in the parameters) applies them in its frame
+ * (_plane.h).  A plane's slip velocity, slip direction latch, stick constraint force and
+ * tangential deflection are in its frame (components along its tangents t1, t2); forces,
+ * the dig-in direction latch and contact-point velocities in inertial components.
  */
 #ifndef BALLC_SYSTEM_H
 #define BALLC_SYSTEM_H
 
 #include "ballc_kernels.h"
+#include "_plane.h"
 
 /* Which contributions act in the current segment (bit flags). */
 enum {
@@ -46,7 +53,8 @@ enum {
     BALLC_CEILING_COMPLIANT_ELASTIC = 65536
 };
 
-/* Sum of the contact forces on the ball, per plane (floor x y z, ceiling x y z). */
+/* Sum of the contact forces on the ball, per plane (floor x y z, ceiling x y z:
+ * inertial components). */
 int ballc_contact_forces(const double *state, const double *params, const double *latch,
                          int flags, double *forces);
 
@@ -63,17 +71,42 @@ int ballc_rhs(const double *state, const double *params, const double *latch,
 int ballc_jacobian(const double *state, const double *params, const double *latch,
                    int flags, double *jac);
 
-/* A parameter vector and its parameter constants (the parameter-only subexpressions of
- * the kernels, see codegen/emit.py), computed from it by ballc_parameters_init: once per
- * segment by the integrator's adapter, once per call by the entry points that take a
- * plain parameter vector.  The constants are never taken from a caller, so they cannot
- * belong to other parameters. */
+/* A parameter vector, its parameter constants (the parameter-only subexpressions of
+ * the kernels, see codegen/emit.py) and its plane table (each plane's point and frame,
+ * from the parameters' point and normal), computed from it by ballc_parameters_init:
+ * once per segment by the integrator's adapter, once per call by the entry points that
+ * take a plain parameter vector.  The constants and planes are never taken from a
+ * caller, so they cannot belong to other parameters. */
 typedef struct {
     const double *values;                               /* BALLC_N_PARAMETERS, borrowed */
     double constants[BALLC_N_PARAMETER_CONSTANTS];
+    ballc_plane_t planes[BALLC_N_PLANES];
+    /* each plane's slip map du/dx (2 x BALLC_N_STATES) and the generalized-force map of a
+     * unit tangential force along its t1, t2 (6 x 2, inertial): constants */
+    double slip_map[BALLC_N_PLANES][2 * BALLC_N_STATES];
+    double slip_force_map[BALLC_N_PLANES][12];
 } ballc_parameters_t;
 
 void ballc_parameters_init(ballc_parameters_t *prepared, const double *params);
+
+/* Energies (J): kinetic, potential, then per plane the Hertz spring's and per plane the
+ * compliant law's tangential spring's. */
+#define BALLC_ENERGY_NOUT (2 + 2 * BALLC_N_PLANES)
+void ballc_energy(const double *state, const ballc_parameters_t *params, double *out);
+
+/* Per plane: rho, rhodot and the contact point's velocity (inertial x, y, z). */
+#define BALLC_CONTACT_KINEMATICS_PER_PLANE 5
+#define BALLC_CONTACT_KINEMATICS_NOUT (BALLC_CONTACT_KINEMATICS_PER_PLANE * BALLC_N_PLANES)
+void ballc_contact_kinematics(const double *state, const ballc_parameters_t *params,
+                              double *out);
+
+/* What exact Coulomb friction needs on ``plane``: the slip velocity u (2, along the
+ * plane's t1, t2), du/dx (2 x BALLC_N_STATES, row-major; u is linear in the state) and
+ * the generalized-force map of a unit tangential force along t1, t2 at the contact point
+ * (6 x 2, row-major, inertial components). */
+#define BALLC_SLIP_NOUT (2 + 2 * BALLC_N_STATES + 12)
+void ballc_slip_state(const double *state, const ballc_parameters_t *params, int plane,
+                      double *out);
 
 /* The compliant law's mode guards on ``plane`` (0 floor, 1 ceiling), BALLC_COMPLIANT_MARGINS
  * numbers: out[0] the yield margin 1 - k_t |s| / (mu F_n) (1), out[1] the re-stick margin
@@ -106,7 +139,8 @@ int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t 
 /* Stick state of ``plane`` (0 floor, 1 ceiling) under ``flags`` (which must hold that
  * plane's FRICTION and STICK flags): out = [lambda_x, lambda_y, N, mu N - |lambda|],
  * the constraint force that keeps the slip velocity constant, the friction share's
- * normal force and the margin to the Coulomb cone (the stick-to-slip event). */
+ * normal force and the margin to the Coulomb cone (the stick-to-slip event); lambda
+ * along the plane's tangents t1, t2. */
 int ballc_stick_state(const double *state, const double *params, const double *latch,
                       int flags, int plane, double *out);
 

@@ -57,8 +57,9 @@ _OMEGA = layout.ANGULAR_VELOCITY
 _VELOCITY = layout.VELOCITY
 _Z, _VZ = layout.INDEX["z"], layout.INDEX["vz"]
 _TO_VELOCITY = _VELOCITY.start - _POSITION.start
-_OBSERVER_MASS, _IXX, _IYY, _IZZ, _GRAVITY = (_PARAMETER[name] for name in (
-    "observer_mass", "inertia_xx", "inertia_yy", "inertia_zz", "gravity"))
+_OBSERVER_MASS, _IXX, _IYY, _IZZ = (_PARAMETER[name] for name in (
+    "observer_mass", "inertia_xx", "inertia_yy", "inertia_zz"))
+_GRAVITY = [_PARAMETER[f"gravity_{axis}"] for axis in "xyz"]
 
 #: Fewest sample intervals of an exact flight segment without t_eval.
 MIN_INTERVALS = 32
@@ -70,9 +71,11 @@ TERMINATED = "A termination event occurred."
 
 
 def scene_allows(params) -> bool:
-    """Whether the parameters admit exact flight: massless observer, isotropic inertia."""
+    """Whether the parameters admit exact flight: massless observer, isotropic inertia,
+    gravity along -z (or none)."""
     p = params
-    return bool(p[_OBSERVER_MASS] == 0 and p[_IXX] == p[_IYY] == p[_IZZ])
+    return bool(p[_OBSERVER_MASS] == 0 and p[_IXX] == p[_IYY] == p[_IZZ]
+                and p[_GRAVITY[0]] == p[_GRAVITY[1]] == 0)
 
 
 def applies(system, events) -> bool:
@@ -190,7 +193,7 @@ def propagate(system, t0, t1, y0, events, *, t_eval=None, max_step=np.inf,
     """The exact free-flight segment from (t0, y0) to t1 or its first terminal event
     (see the module's docstring); ``system``, ``events``, ``t_eval``, ``max_step`` and
     ``dense_output`` as for :func:`ballc.integrate.integrate_segment`."""
-    gravity = float(system.params[_GRAVITY])
+    gravity = -float(system.params[_GRAVITY[2]])
     flight = FreeFlight(t0, y0, gravity)
     span = t1 - t0
     hits = []                     # (s, event index)

@@ -355,10 +355,11 @@ class Scene:
         a, b, c = self.observer_position
         values = {
             "mass": self.mass, "observer_mass": self.observer_mass,
-            "gravity": self.gravity, "radius": self.radius,
+            "gravity_x": 0.0, "gravity_y": 0.0, "gravity_z": -self.gravity,
+            "radius": self.radius,
             "observer_alpha": a, "observer_beta": b, "observer_gamma": c,
             "inertia_xx": ix, "inertia_yy": iy, "inertia_zz": iz,
-            "ceiling_height": self.ceiling_height, "mixture": self.effective_mixture,
+            "mixture": self.effective_mixture,
             "ball_poisson_ratio": self.ball_poisson_ratio,
             "plane_poisson_ratio": self.plane_poisson_ratio,
             "ball_youngs_modulus": self.ball_youngs_modulus,
@@ -371,6 +372,9 @@ class Scene:
             "normal_damping_model": float(self.normal_damping == "viscoelastic"),
             "damping_ratio": self.damping_ratio or 0.0,
             "tangential_damping_ratio": self.tangential_damping_ratio or 0.0,
+            # the plane table: a point and a normal (towards the ball) per plane
+            **_plane_entries("floor", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+            **_plane_entries("ceiling", (0.0, 0.0, self.ceiling_height), (0.0, 0.0, -1.0)),
         }
         return np.array([float(values[name]) for name in _core.PARAMETER_NAMES])
 
@@ -380,6 +384,12 @@ class Scene:
                                      self.angular_velocity, self.velocity])
         auxiliary = np.zeros(_core.N_STATES - mechanical.size)   # dissipated work, deflections
         return np.concatenate([mechanical, auxiliary])
+
+
+def _plane_entries(plane: str, point, normal) -> dict:
+    """A plane's entries of the parameter vector (its point and normal)."""
+    names = ("point_x", "point_y", "point_z", "normal_x", "normal_y", "normal_z")
+    return {f"{plane}_{name}": value for name, value in zip(names, (*point, *normal))}
 
 
 @functools.lru_cache(maxsize=256)

@@ -1024,7 +1024,7 @@ def _c_config(scene, options, progress, rest):
         checks_rest=int(bool(rest) and t_eval is None and not options.events),
         t_eval=t_eval, dense_output=int(bool(options.dense_output)),
         exact_flight=int(flight_allowed), **users,
-        gravity=float(params[_core.PARAMETER_NAMES.index("gravity")]),
+        gravity=-float(params[_core.PARAMETER_NAMES.index("gravity_z")]),
         rho_scale=[entry[3] for entry in planes], rho_offset=[entry[4] for entry in planes],
         through_offset=[entry[7].offset for entry in planes],
         threshold_base=[entry[5] for entry in planes],
