@@ -374,12 +374,29 @@ def connect(address: str, name: str = "client"):
                          "address such as tcp://host:8786 (or, for client=, a "
                          "distributed.Client)")
     try:
+        _answers(address)
         return Client(address, timeout=CONNECT_TIMEOUT)
     except Exception as error:      # a bad address, nothing there, something else there
         reason = " ".join(str(error).split()) or type(error).__name__
         raise ValueError(f"{name} = {address!r} is not allowed: no Dask scheduler answered "
                          f"there within {CONNECT_TIMEOUT:g} s ({reason}); must be the "
                          "address of a running scheduler, such as tcp://host:8786") from None
+
+
+def _answers(address: str) -> None:
+    """Raise unless something accepts a TCP connection at a tcp:// ``address`` within
+    CONNECT_TIMEOUT s -- checked before a ``distributed.Client`` is made, because a Client
+    that fails to connect stays registered as dask's default scheduler and would divert
+    later dask work in this process (xarray's writers, for one)."""
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+    scheme, location = parse_address(address)
+    if scheme not in ("tcp", "tls"):
+        return          # other transports: the Client's own connect timeout decides
+    host, port = parse_host_port(location)
+    with socket.create_connection((host, port), timeout=CONNECT_TIMEOUT):
+        pass
 
 
 def _on_dask(client, tasks, rows, progress):
