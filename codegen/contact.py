@@ -393,7 +393,7 @@ def sliding_direction(model: Model, plane: str):
 
 
 def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, cap, slip,
-                    normal_force_rate, direction, turn, jacobian_form=False):
+                    normal_force_rate, direction, turn, jacobian_form=False, turning=None):
     """The incremental Mindlin spring in its sliding mode: the DEM codes' truncation in
     the limit dt -> 0 (docs/contact_laws.md, "Exact elastic and sliding modes").
 
@@ -411,7 +411,10 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     property test, found in stop 22).
     It is stiff as F_n -> 0 at the end (d ln(s_cap)/dt -> -inf): ``jacobian_form`` keeps
     that decay in d/ds and leaves out the growth while the cap rises (~ +1/t at a start:
-    the dilution's trap, see JACOBIAN_FORMS).  Returns
+    the dilution's trap, see JACOBIAN_FORMS).  ``turning``: the direction the turn of e
+    towards v_t is written with (the exact s/|s| where ``direction`` is held: the
+    Jacobian form keeps that turn's stiffness, (e . v_t) / |s|), else ``direction``.
+    Returns
     (applied force (2), deflection rate (2), rate of the stored energy 1/2 k_t |s|^2
     (W), k_t).  No viscous damping: it is dropped while sliding (capacity 0).
     """
@@ -422,7 +425,6 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     stiffening = rhodot / (2 * _rho_floor(rho))
     s_cap, s_cap_rate = capped_deflection(model, k_t, stiffening, normal_force,
                                           normal_force_rate)
-    along = ex * vx + ey * vy
     in_contact = loaded(model, normal_force)
     # d ln(s_cap)/dt = dF_n/dt / F_n - rhodot / (2 rho); below the force floor (F_n <
     # 1e-12 N, a contact's last instants) both terms are scaled by F_n / 1e-12 N alike
@@ -440,8 +442,9 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
                   ey * s_cap_rate + (sy - s_cap * ey) * shrinking]
     else:
         radial = [sx * relative, sy * relative]
-    rate = [in_contact * ((v - along * e) * turn + w)
-            for v, e, w in zip((vx, vy), (ex, ey), radial)]
+    tx, ty = direction if turning is None else turning
+    across = [v - (tx * vx + ty * vy) * e for v, e in zip((vx, vy), (tx, ty))]
+    rate = [in_contact * (a * turn + w) for a, w in zip(across, radial)]
     force = [-cap * ex, -cap * ey]
     storage = k_t * (sx*rate[0] + sy*rate[1]) + k_t * (sx**2 + sy**2) / 2 * stiffening
     return force, rate, storage, k_t
@@ -450,9 +453,10 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
 def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
     """The compliant law's sliding mode (``<plane>_compliant_sliding``): the same normal
     force, the tangential force -mu F_n e at the cap (sliding_mindlin).
-    ``jacobian_form``: the direction e (and the turn factor) enter as symbols defined
-    before the kernel's code (``ContactLaw.frozen``), so the Jacobian leaves out
-    de/ds ~ 1/|s|, singular at a contact that starts sliding (see JACOBIAN_FORMS)."""
+    ``jacobian_form``: the direction e of the force and of the radial rate (and the
+    turn factor) enter as symbols defined before the kernel's code
+    (``ContactLaw.frozen``); the turn of e towards v_t keeps its exact d/ds, the mode's
+    stiffness (e . v_t) / |s| (see JACOBIAN_FORMS)."""
     N = model.frame
     # the value's rates take the exact rho'' (affine in it: the C core adds its share,
     # ACCELERATION_LAWS); the Jacobian form keeps the contact's own
@@ -468,7 +472,7 @@ def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
     tangential, rate, storage, _ = sliding_mindlin(model, plane, c.stiffness, c.rho, c.rhodot,
                                                    c.normal_force, c.cap, c.slip,
                                                    c.normal_force_rate, held[:2], held[2],
-                                                   jacobian_form)
+                                                   jacobian_form, exact[:2])
     force = c.normal_force*c.normal + tangential[0]*N.x + tangential[1]*N.y
     return ContactLaw(c.point, force, sm.S.One, deflection_rate=rate,
                       tangential_storage=storage, frozen=frozen)
@@ -602,9 +606,18 @@ class ContactLaw:
 #: compliant seed throw drifted by 18 J at rtol 1e-8; scipy's Radau the same).  The
 #: Jacobian leaves the term out: a stiffness underestimated by 1/(2t) where the steps
 #: are ~t costs Newton little and never converges falsely (docs/contact_laws.md).
-#: The sliding mode's direction e = s/|s| has de/ds ~ 1/|s|, ~1e18 /s at a contact that
-#: starts sliding (|s| ~ 1e-18 m there): the same trap, so its Jacobian holds e fixed
-#: (the stabilising turn of e towards v_t, a rate ~ 1/t, is left to Newton).
+#: The sliding mode's direction e = s/|s| has de/ds ~ 1/|s|: its Jacobian holds e fixed
+#: in the force -mu F_n e and in the radial rate, but keeps the exact d/ds of the turn of
+#: e towards v_t, (v_t - (e . v_t) e) / |s| -- the mode's own stiffness, (e . v_t) / |s|
+#: across e.  That is no ~1/t: ~1e7 /s through a spinning steel ball's contact (|v_t| =
+#: 64 m/s, |s| ~ 5e-6 m) where its steps are ~1e-5 s, ~1e12 /s where it starts sliding
+#: at the arming depth (|s| ~ 4e-11 m).  Left to Newton (before issue 28) it held radau5
+#: to steps of ~2e-8 s with a Jacobian at nearly every one: 9.9 M calls for 2 s of that
+#: ball's bounces, against dop853's 45 k.  Because it follows |s| step by step, a
+#: Jacobian kept from an earlier step overestimates it (|s| grows ~ t from the start),
+#: and Newton then settled on a wrong direction of s (1e-5 m/s off after one contact at
+#: rtol 1e-10): a sliding segment takes its Jacobian at every step
+#: (radau5_problem.jacobian_every_step).
 JACOBIAN_FORMS = {
     "compliant": lambda model, plane: compliant_model_force(model, plane, jacobian_form=True),
     "compliant_sliding": lambda model, plane: compliant_sliding_force(model, plane,

@@ -97,6 +97,12 @@ typedef struct {
                                * step's explicit Euler end (the compliant law's contacts) */
     int auto_implicit;        /* RADAU5_METHOD_AUTO only: nonzero starts with Radau IIA
                                * instead of DOP853 (a segment continuing a stiff one) */
+    int jacobian_every_step;  /* nonzero: Radau IIA takes the Jacobian at every accepted
+                               * step's end, not only when Newton converged slowly (the
+                               * compliant law's sliding mode: its stiffness (e . v_t) / |s|
+                               * follows |s| step by step; a Jacobian kept from an earlier
+                               * step overestimates it and Newton settles on a wrong
+                               * deflection direction, issue 28) */
 } radau5_problem;
 
 /* RADAU5_METHOD_AUTO: LSODA's idea with the two steps.  The call starts with DOP853

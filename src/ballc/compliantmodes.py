@@ -87,6 +87,22 @@ def uses_modes(scene) -> bool:
             and scene.friction_coefficient > 0)
 
 
+def starts_armed(scene) -> bool:
+    """Whether ``scene``'s compliant contacts begin at the arming depth
+    (:func:`arm_penetration`) instead of at rho = 0: with the modes (their guards), and
+    with the viscoelastic damping.  Its force c_n rhodot, c_n = 2 gamma sqrt(m* k_n) ~
+    rho^(1/4), rises from rho = 0 with an infinite slope and no scale: an implicit
+    step from rho = 0 sees no force at its start, nor a slope that linearises it, at
+    any step size, so radau5's Newton iteration never converged there (a steel ball
+    dropped with mu = 0 failed at its first contact, issue 28).  From the arming depth
+    a step of ~rho / rhodot resolves it and the steps grow from there.  What it leaves
+    out is the impulse of the approach to that depth, the integral of c_n rhodot dt =
+    c_n drho: 4/5 c_n rho at the arming depth, whatever the impact speed (6e-8 N s for
+    a 1-kg steel ball of 1 m, 7e-9 of its momentum at 8.9 m/s: docs/limits.md)."""
+    return uses_modes(scene) or (scene.tangential_model == "compliant"
+                                 and scene.normal_damping == "viscoelastic")
+
+
 def mode_flags(plane: str, mode: str | None, armed: bool = True) -> int:
     """The C flag of the compliant law on ``plane`` in ``mode``: the sliding kernels;
     the elastic mode's (the spring alone) once its guards are ``armed``; else (mode

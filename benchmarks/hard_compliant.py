@@ -1,0 +1,99 @@
+"""radau5 against dop853 on hard balls with the compliant law (issue 28, item 3).
+
+    python -m benchmarks.hard_compliant [--rounds 3] [--budget 20000000]
+
+The scenes: a ball of Young's modulus E (2e11 Pa, steel; and 1e7 Pa) with the compliant
+tangential law, restitution e = 0.5, each normal damping (Hunt-Crossley and
+viscoelastic):
+
+* **drop**: released at rest from z = 5 m (4 m above contact), mu = 0, 3 s -- it
+  bounces ~11 times and settles by ~2.7 s;
+* **throw**: from z = 3 m at (4, 1, -6) m/s spinning at (30, 60, 5) rad/s, kappa = 1,
+  mu = 0.1, 2 s -- 6 contacts, each sliding under a slip of ~60 m/s.
+
+Every other field is the default (plane 2e10 Pa, observer 1e-4 kg), rtol = atol = 1e-10
+(simulate's default).  For each scene and method: status, RHS calls, CPU seconds
+(time.process_time, best of ``--rounds``), and the CPU ratio radau5 / dop853 measured in
+the same run; then how far radau5's result is from dop853's (largest difference of the
+contact start times and of the rebound velocities, and of the final position and
+velocity).
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import ballc
+
+METHODS = ("radau5", "dop853")
+DAMPINGS = ("hunt_crossley", "viscoelastic")
+MODULI = (2e11, 1e7)
+
+
+def drop(damping, modulus):
+    return ballc.Scene(ball_youngs_modulus=modulus, tangential_model="compliant",
+                       normal_damping=damping, restitution=0.5, friction_coefficient=0.0,
+                       velocity=(0.0, 0.0, 0.0))
+
+
+def throw(damping, modulus):
+    return ballc.Scene(ball_youngs_modulus=modulus, tangential_model="compliant",
+                       normal_damping=damping, restitution=0.5, friction_coefficient=0.1,
+                       tangential_stiffness_ratio=1.0, position=(0.0, 0.0, 3.0),
+                       velocity=(4.0, 1.0, -6.0), angular_velocity=(30.0, 60.0, 5.0))
+
+
+SCENES = {"drop": (drop, 3.0), "throw": (throw, 2.0)}
+
+
+def timed(scene, t_end, method, rounds, budget):
+    best, result = np.inf, None
+    for _ in range(rounds):
+        start = time.process_time()
+        result = ballc.simulate(scene, t_end, method=method, max_nfev=budget)
+        best = min(best, time.process_time() - start)
+    return result, best
+
+
+def differences(a, b):
+    """(contact start times, rebound velocities, final position and velocity): the largest
+    absolute difference between two results, over the contacts both have."""
+    n = min(len(a.contacts), len(b.contacts))
+    starts = max((abs(a.contacts[i].t_start - b.contacts[i].t_start) for i in range(n)),
+                 default=np.nan)
+    closed = [i for i in range(n) if np.isfinite(a.contacts[i].t_end)
+              and np.isfinite(b.contacts[i].t_end)]
+    rebound = max((float(np.max(np.abs(a.contacts[i].velocity_after
+                                       - b.contacts[i].velocity_after))) for i in closed),
+                  default=np.nan)
+    final = float(np.max(np.abs(np.concatenate([a.position[:, -1] - b.position[:, -1],
+                                                a.velocity[:, -1] - b.velocity[:, -1]]))))
+    return starts, rebound, final
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--budget", type=float, default=2e7)
+    args = parser.parse_args(argv)
+    print("| scene | damping | E (Pa) | radau5 status | radau5 RHS calls | dop853 status "
+          "| dop853 RHS calls | CPU radau5 / dop853 | contacts (r5, d8) | contact starts "
+          "| rebound velocities | final state |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for name, (make, t_end) in SCENES.items():
+        for damping in DAMPINGS:
+            for modulus in MODULI:
+                scene = make(damping, modulus)
+                (r5, c5), (d8, c8) = (timed(scene, t_end, m, args.rounds, int(args.budget))
+                                      for m in METHODS)
+                starts, rebound, final = differences(r5, d8)
+                print(f"| {name} | {damping} | {modulus:g} | {r5.status} | {r5.nfev:,} "
+                      f"| {d8.status} | {d8.nfev:,} | {c5 / c8:.2f} ({c5:.3f} s / {c8:.3f} s) "
+                      f"| {len(r5.contacts)}, {len(d8.contacts)} | {starts:.1e} "
+                      f"| {rebound:.1e} | {final:.1e} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
