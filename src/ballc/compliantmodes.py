@@ -23,9 +23,10 @@ elastic force leaves (or stops saturating it): a kink of the force that an integ
 error estimate can step over.
 
 A compliant contact begins where the penetration reaches the arming depth (ARM_ULPS
-ulp of the plane's position, and Hertz's force ARM_FORCE; the impulse before it, below
-1e-6 N for ~1e-10 s, is left out): below it rho's rounding, and the kernels' 1e-12-N
-load floor, would decide the mode changes.  It starts in the mode of its self-similar
+ulp of the plane's position, and Hertz's force ARM_FORCE; the impulse before it is left
+out: with Hunt-Crossley damping below 1e-6 N for ~1e-10 s, with the viscoelastic one
+4/5 c_n rho there, see :func:`starts_armed`): below it rho's rounding, and the kernels'
+1e-12-N load floor, would decide the mode changes.  It starts in the mode of its self-similar
 start (:func:`start`): sliding when the spring, at the cap along the slip velocity,
 would outgrow it (the re-stick margin there is >= 0; for Hunt-Crossley this is kappa
 |v_t| >= mu (1 + chi) rhodot^-, the ratio of the self-similar start s = 2/3 v_t t),
