@@ -17,6 +17,12 @@ Every other field is the default (plane 2e10 Pa, observer 1e-4 kg), rtol = atol 
 the same run; then each method's error against dop853 run 1000x tighter (rtol = atol =
 1e-13): the largest difference of the contact start times (s), of the rebound
 velocities (m/s) and of the final position and velocity.
+
+``--sweep N``: instead, N random spinning throws from z = 3 m (seed 1: E 1e6 ... 2e11 Pa
+log-uniform, mu in {0.05, 0.1, 0.3, 0.8}, kappa in {0.3, 1, 2}, e in {0.3, 0.5, 0.9},
+both dampings and observer masses 0 and 1e-4 kg in turn, velocity and spin uniform), 2 s
+each with both methods and a 3 M-call budget: the count of each status, and every run
+that did not end with status 0.
 """
 from __future__ import annotations
 
@@ -73,11 +79,51 @@ def differences(a, b):
     return starts, rebound, final
 
 
+def random_throws(n, seed=1):
+    """(index, scene) of ``--sweep``'s random spinning throws."""
+    rng = np.random.default_rng(seed)
+    for i in range(n):
+        damping = DAMPINGS[i % 2]
+        modulus = float(10 ** rng.uniform(6, 11.3))
+        observer = (0.0, 1e-4)[(i // 2) % 2]
+        velocity = rng.uniform(-6, 6, 3)
+        velocity[2] = -abs(velocity[2]) - 0.5
+        spin = rng.uniform(-80, 80, 3)
+        mu = float(rng.choice([0.05, 0.1, 0.3, 0.8]))
+        kappa = float(rng.choice([0.3, 1.0, 2.0]))
+        e = float(rng.choice([0.3, 0.5, 0.9]))
+        yield i, ballc.Scene(ball_youngs_modulus=modulus, tangential_model="compliant",
+                             restitution=e, normal_damping=damping, friction_coefficient=mu,
+                             tangential_stiffness_ratio=kappa, position=(0.0, 0.0, 3.0),
+                             velocity=tuple(velocity), angular_velocity=tuple(spin),
+                             observer_mass=observer)
+
+
+def sweep(n):
+    counts = {}
+    for i, scene in random_throws(n):
+        for method in METHODS:
+            result = ballc.simulate(scene, 2.0, method=method, max_nfev=3_000_000)
+            counts[method, result.status] = counts.get((method, result.status), 0) + 1
+            if result.status != 0:
+                print(f"{i} {method} {scene.normal_damping} E {scene.ball_youngs_modulus:.3g} "
+                      f"mu {scene.friction_coefficient} kappa "
+                      f"{scene.tangential_stiffness_ratio} e {scene.restitution} observer "
+                      f"{scene.observer_mass}: status {result.status}, {result.nfev} calls: "
+                      f"{result.message[:100]}", flush=True)
+    for (method, status), count in sorted(counts.items()):
+        print(f"{method}: status {status} in {count} of {n}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--budget", type=float, default=2e7)
+    parser.add_argument("--sweep", type=int, default=0, help="N random spinning throws")
     args = parser.parse_args(argv)
+    if args.sweep:
+        sweep(args.sweep)
+        return
     print("| scene | damping | E (Pa) | radau5 status | radau5 RHS calls | dop853 status "
           "| dop853 RHS calls | CPU radau5 / dop853 | contacts (r5, d8, ref) "
           "| radau5 error: starts, rebounds, final | dop853 error: starts, rebounds, final |")
