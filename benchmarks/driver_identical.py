@@ -186,6 +186,20 @@ def cases(quick=False):
                                             velocity=(0, 0, 0)), 1e6,
          dict(method="radau5", rtol=1e-6, atol=1e-6), True),
     ]
+    # issue 28: the viscoelastic damping's contacts begin at the arming depth (without
+    # modes too), and a sliding contact's Jacobian is taken at every step
+    # (benchmarks.hard_compliant's scenes)
+    hard = dict(ball_youngs_modulus=2e11, tangential_model="compliant", restitution=0.5)
+    for method in METHODS:
+        out += [
+            (f"compliant, steel drop, viscoelastic, mu 0 {method}",
+             dict(hard, normal_damping="viscoelastic", friction_coefficient=0.0,
+                  velocity=(0, 0, 0)), 3.0, dict(method=method), True),
+            (f"compliant, steel throw, spinning {method}",
+             dict(hard, friction_coefficient=0.1, tangential_stiffness_ratio=1.0,
+                  position=(0, 0, 3.0), velocity=(4.0, 1.0, -6.0),
+                  angular_velocity=(30.0, 60.0, 5.0)), 0.5, dict(method=method), True),
+        ]
     # stage 4: the user's events (callables called back from C; LinearEvents in C)
     def apex(t, y):   # vz falling through 0: each apex of a bounce
         return y[12]

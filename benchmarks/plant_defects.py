@@ -139,8 +139,8 @@ DEFECTS = [
            tests=("tests/test_c_driver.py::test_the_compliant_modes_are_bit_identical",)),
     Defect("compliant modes: the sliding spring does not turn with the slip",
            "codegen/contact.py",
-           "    rate = [in_contact * ((v - along * e) * turn + w)\n",
-           "    rate = [in_contact * ((v - along * e) * 0 + w)\n",
+           "    across = [(v - along * e) * turn for v, e in zip((vx, vy), (ex, ey))]\n",
+           "    across = [(v - along * e) * 0 for v, e in zip((vx, vy), (ex, ey))]\n",
            tests=("tests/test_compliant_modes.py::"
                   "test_the_sliding_spring_turns_with_the_slip_as_the_dem_truncation_does",)),
     Defect("per-contact energy split swapped (normal <-> tangential)", "src/ballc/simulate.py",

@@ -384,6 +384,12 @@ def capped_deflection(model: Model, k_t, stiffening, normal_force, normal_force_
 TURN_FLOOR = sm.Float(1e-12)
 
 
+def turn_reach(model: Model, plane: str):
+    """max(|s|, TURN_FLOOR) (m): the length the direction's turn rate is divided by."""
+    sx, sy = deflection_symbols(model, plane)
+    return sm.Max(sm.sqrt(sm.Max(sx**2 + sy**2, _DIRECTION_FLOOR2)), TURN_FLOOR)
+
+
 def turn_factor(model: Model, plane: str):
     """|s| / max(|s|, TURN_FLOOR): 1 above the floor (see TURN_FLOOR)."""
     sx, sy = deflection_symbols(model, plane)
@@ -399,7 +405,7 @@ def sliding_direction(model: Model, plane: str):
 
 
 def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_force, cap, slip,
-                    normal_force_rate, direction, turn, jacobian_form=False):
+                    normal_force_rate, direction, turn, jacobian_form=False, reach=None):
     """The incremental Mindlin spring in its sliding mode: the DEM codes' truncation in
     the limit dt -> 0 (docs/contact_laws.md, "Exact elastic and sliding modes").
 
@@ -417,7 +423,14 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     property test, found in stop 22).
     It is stiff as F_n -> 0 at the end (d ln(s_cap)/dt -> -inf): ``jacobian_form`` keeps
     that decay in d/ds and leaves out the growth while the cap rises (~ +1/t at a start:
-    the dilution's trap, see JACOBIAN_FORMS).  Returns
+    the dilution's trap, see JACOBIAN_FORMS).  ``reach`` (the Jacobian form, with e and
+    the turn held): max(|s|, TURN_FLOOR), held too, and the turn is written to first
+    order in the part of s across the held e, s_perp = s - (e . s) e: (v_t - (e . v_t)
+    e) f - ((e . v_t) s_perp + e (v_t . s_perp)) / reach.  At the state s_perp = 0 (the
+    same value), and its d/ds is the exact turn's, the mode's stiffness (e . v_t) / |s|
+    across e (/ TURN_FLOOR below it), computed without 1/|s| (|s| ~ mu: 1e-127 m for a
+    hypothesis-drawn mu of 1e-126 overflowed the exact form's d(s/|s|)/ds).
+    Returns
     (applied force (2), deflection rate (2), rate of the stored energy 1/2 k_t |s|^2
     (W), k_t).  No viscous damping: it is dropped while sliding (capacity 0).
     """
@@ -428,7 +441,6 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
     stiffening = rhodot / (2 * _rho_floor(rho))
     s_cap, s_cap_rate = capped_deflection(model, k_t, stiffening, normal_force,
                                           normal_force_rate)
-    along = ex * vx + ey * vy
     in_contact = loaded(model, normal_force)
     # d ln(s_cap)/dt = dF_n/dt / F_n - rhodot / (2 rho); below the force floor (F_n <
     # 1e-12 N, a contact's last instants) both terms are scaled by F_n / 1e-12 N alike
@@ -446,8 +458,14 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
                   ey * s_cap_rate + (sy - s_cap * ey) * shrinking]
     else:
         radial = [sx * relative, sy * relative]
-    rate = [in_contact * ((v - along * e) * turn + w)
-            for v, e, w in zip((vx, vy), (ex, ey), radial)]
+    along = ex * vx + ey * vy
+    across = [(v - along * e) * turn for v, e in zip((vx, vy), (ex, ey))]
+    if reach is not None:
+        perp = [sx - (ex * sx + ey * sy) * ex, sy - (ex * sx + ey * sy) * ey]
+        slip_perp = vx * perp[0] + vy * perp[1]
+        across = [a - (along * p + e * slip_perp) / reach
+                  for a, p, e in zip(across, perp, (ex, ey))]
+    rate = [in_contact * (a + w) for a, w in zip(across, radial)]
     force = [-cap * ex, -cap * ey]
     storage = k_t * (sx*rate[0] + sy*rate[1]) + k_t * (sx**2 + sy**2) / 2 * stiffening
     return force, rate, storage, k_t
@@ -456,9 +474,10 @@ def sliding_mindlin(model: Model, plane: str, stiffness, rho, rhodot, normal_for
 def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
     """The compliant law's sliding mode (``<plane>_compliant_sliding``): the same normal
     force, the tangential force -mu F_n e at the cap (sliding_mindlin).
-    ``jacobian_form``: the direction e (and the turn factor) enter as symbols defined
-    before the kernel's code (``ContactLaw.frozen``), so the Jacobian leaves out
-    de/ds ~ 1/|s|, singular at a contact that starts sliding (see JACOBIAN_FORMS)."""
+    ``jacobian_form``: the direction e, the turn factor and max(|s|, TURN_FLOOR) enter
+    as symbols defined before the kernel's code (``ContactLaw.frozen``), and the turn of
+    e towards v_t is written to first order across e (sliding_mindlin's ``reach``): its
+    d/ds is the exact one, the mode's stiffness (e . v_t) / |s| (see JACOBIAN_FORMS)."""
     N = model.frame
     # the value's rates take the exact rho'' (affine in it: the C core adds its share,
     # ACCELERATION_LAWS); the Jacobian form keeps the contact's own
@@ -466,15 +485,16 @@ def compliant_sliding_force(model: Model, plane: str, jacobian_form=False):
                           None if jacobian_form else penetration_acceleration(plane))
     exact = sliding_direction(model, plane) + [turn_factor(model, plane)]
     frozen = None
-    held = exact
+    held = exact + [None]
     if jacobian_form:
+        exact.append(turn_reach(model, plane))
         held = list(sm.symbols(f"{plane}_sliding_direction_x {plane}_sliding_direction_y "
-                               f"{plane}_sliding_turn"))
+                               f"{plane}_sliding_turn {plane}_sliding_reach"))
         frozen = list(zip(held, exact))
     tangential, rate, storage, _ = sliding_mindlin(model, plane, c.stiffness, c.rho, c.rhodot,
                                                    c.normal_force, c.cap, c.slip,
                                                    c.normal_force_rate, held[:2], held[2],
-                                                   jacobian_form)
+                                                   jacobian_form, held[3])
     force = c.normal_force*c.normal + tangential[0]*N.x + tangential[1]*N.y
     return ContactLaw(c.point, force, sm.S.One, deflection_rate=rate,
                       tangential_storage=storage, frozen=frozen)
@@ -608,9 +628,19 @@ class ContactLaw:
 #: compliant seed throw drifted by 18 J at rtol 1e-8; scipy's Radau the same).  The
 #: Jacobian leaves the term out: a stiffness underestimated by 1/(2t) where the steps
 #: are ~t costs Newton little and never converges falsely (docs/contact_laws.md).
-#: The sliding mode's direction e = s/|s| has de/ds ~ 1/|s|, ~1e18 /s at a contact that
-#: starts sliding (|s| ~ 1e-18 m there): the same trap, so its Jacobian holds e fixed
-#: (the stabilising turn of e towards v_t, a rate ~ 1/t, is left to Newton).
+#: The sliding mode's direction e = s/|s| has de/ds ~ 1/|s|: its Jacobian holds e fixed
+#: in the force -mu F_n e and in the radial rate, but keeps the exact d/ds of the turn of
+#: e towards v_t, (v_t - (e . v_t) e) / |s| -- the mode's own stiffness, (e . v_t) / |s|
+#: across e (written to first order in the part of s across the held e, divided by the
+#: held max(|s|, TURN_FLOOR), so that no 1/|s| is evaluated: sliding_mindlin).  That is no ~1/t: ~1e7 /s through a spinning steel ball's contact (|v_t| =
+#: 64 m/s, |s| ~ 5e-6 m) where its steps are ~1e-5 s, ~1e12 /s where it starts sliding
+#: at the arming depth (|s| ~ 4e-11 m).  Left to Newton (before issue 28) it held radau5
+#: to steps of ~2e-8 s with a Jacobian at nearly every one: 9.9 M calls for 2 s of that
+#: ball's bounces, against dop853's 45 k.  Because it follows |s| step by step, a
+#: Jacobian kept from an earlier step overestimates it (|s| grows ~ t from the start),
+#: and Newton then settled on a wrong direction of s (1e-5 m/s off after one contact at
+#: rtol 1e-10): a sliding segment takes its Jacobian at every step
+#: (radau5_problem.jacobian_every_step).
 JACOBIAN_FORMS = {
     "compliant": lambda model, plane: compliant_model_force(model, plane, jacobian_form=True),
     "compliant_sliding": lambda model, plane: compliant_sliding_force(model, plane,

@@ -946,7 +946,7 @@ static int segment_events(run_t *r, int flags)
             add_event(r, K_DEEPEST, p, NULL, BALLC_STATE_VZ, p == 0 ? -1.0 : 1.0, 0.0, 0, -1);
         } else {
             double threshold = py_max(base, rho0 + base);
-            if (c->compliant_modes) threshold = py_max(threshold, c->arm_depth[p]);
+            if (c->arm_depth[p] > 0) threshold = py_max(threshold, c->arm_depth[p]);
             add_event(r, K_ENTER, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
                       c->rho_offset[p] + (-threshold), 1, 1);
         }
@@ -1804,6 +1804,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.rearm = drv_rearm;
         pr.method = c->method;
         pr.jacobian_ahead = (flags & c->compliant_any) != 0;
+        pr.jacobian_every_step = (flags & c->compliant_sliding_any) != 0;
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
         pr.poll = drv_poll;

@@ -133,7 +133,8 @@ typedef struct {                       /* constants of one run, filled by the br
     int compliant_modes;               /* compliantmodes.uses_modes */
     int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* mode_flags per plane */
     int compliant_any;                 /* FLOOR_COMPLIANT | CEILING_COMPLIANT */
-    double arm_depth[2];               /* arm_penetration */
+    int compliant_sliding_any;         /* FLOOR_COMPLIANT_SLIDING | CEILING_COMPLIANT_SLIDING */
+    double arm_depth[2];               /* arm_penetration; 0: contacts begin at rho = 0 (compliantmodes.starts_armed) */
     double ulp8[2];                    /* 8 ulp(plane_position): _rounding */
     double restick_factor;             /* max(1, mu / max(tangential_stiffness_ratio, 1e-300)) */
     int damping_positive;              /* tangential_damping_ratio > 0: capacity guards */

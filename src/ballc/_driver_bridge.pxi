@@ -59,6 +59,7 @@ cdef extern from "_driver.h":
         int elastic_bits[2]
         int sliding_bits[2]
         int compliant_any
+        int compliant_sliding_any
         double arm_depth[2]
         double ulp8[2]
         double restick_factor
@@ -428,6 +429,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
         c.user_direction = &udirection[0]
     c.compliant_modes = k["compliant_modes"]
     c.compliant_any = k["compliant_any"]
+    c.compliant_sliding_any = k["compliant_sliding_any"]
     c.restick_factor = k["restick_factor"]
     c.damping_positive = k["damping_positive"]
     c.contact_time_base = k["contact_time_base"]

@@ -102,6 +102,12 @@ typedef struct {
      * a check for Ctrl-C); nonzero stops the integration there with status
      * RADAU5_INTERRUPTED, keeping what was computed */
     int (*poll)(void *ctx, double t);
+    int jacobian_every_step;  /* nonzero: Radau IIA takes the Jacobian at every accepted
+                               * step's end, not only when Newton converged slowly (the
+                               * compliant law's sliding mode: its stiffness (e . v_t) / |s|
+                               * follows |s| step by step; a Jacobian kept from an earlier
+                               * step overestimates it and Newton settles on a wrong
+                               * deflection direction, issue 28) */
 } radau5_problem;
 
 #define RADAU5_POLL_STEPS 16

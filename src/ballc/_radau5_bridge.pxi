@@ -64,6 +64,7 @@ cdef extern from "_integrator.h":
         int jacobian_ahead
         int auto_implicit
         int (*poll)(void *, double) noexcept nogil
+        int jacobian_every_step
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -562,13 +563,14 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    list users=None, bint dense_output=False, controller=None,
                    bint outputs_checked=False, bint refine_events=True,
                    ball_ctx *ball=NULL, method="radau5", bint jacobian_ahead=False,
-                   bint auto_implicit=False):
+                   bint auto_implicit=False, bint jacobian_every_step=False):
     """``ball``: ballc's system context (solve_system), which re-arms events;
-    ``jacobian_ahead``, ``auto_implicit``: radau5_problem's."""
+    ``jacobian_ahead``, ``auto_implicit``, ``jacobian_every_step``: radau5_problem's."""
     cdef radau5_problem p
     p.method = _method_code(method)
     p.jacobian_ahead = jacobian_ahead
     p.auto_implicit = auto_implicit
+    p.jacobian_every_step = jacobian_every_step
     cdef int ctrl = _controller_bits(controller)
     if max_nfev is not None and not (isinstance(max_nfev, (int, np.integer)) and max_nfev > 0):
         raise ValueError(f"max_nfev = {max_nfev!r} is not allowed: must be None or an "
@@ -727,7 +729,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  True,   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
                  bool(refine_events), &ctx, method,
                  (flags & (BALLC_FLOOR_COMPLIANT | BALLC_CEILING_COMPLIANT)) != 0,
-                 bool(auto_implicit))
+                 bool(auto_implicit),
+                 (flags & (BALLC_FLOOR_COMPLIANT_SLIDING
+                           | BALLC_CEILING_COMPLIANT_SLIDING)) != 0)
     if errors:
         raise errors[0]
     # each system event's code at the end (a capacity guard re-armed in C has toggled)

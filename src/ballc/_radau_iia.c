@@ -384,8 +384,9 @@ int radau_iia_step(solver_t *s)
         break;   /* step_accepted */
     }
 
-    int recompute_jac = (ctrl & RADAU5_CTRL_JAC) ? (have_rate && theta > 1e-3)
-                                                 : (n_iter > 2 && have_rate && rate > 1e-3);
+    int recompute_jac = p->jacobian_every_step
+                        || ((ctrl & RADAU5_CTRL_JAC) ? (have_rate && theta > 1e-3)
+                                                     : (n_iter > 2 && have_rate && rate > 1e-3));
     const double max_factor = (ctrl & RADAU5_CTRL_LIMITS) ? 8.0 : MAX_FACTOR;
     double fac;
     if (ctrl & RADAU5_CTRL_PRED) {

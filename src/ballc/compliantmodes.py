@@ -23,9 +23,10 @@ elastic force leaves (or stops saturating it): a kink of the force that an integ
 error estimate can step over.
 
 A compliant contact begins where the penetration reaches the arming depth (ARM_ULPS
-ulp of the plane's position, and Hertz's force ARM_FORCE; the impulse before it, below
-1e-6 N for ~1e-10 s, is left out): below it rho's rounding, and the kernels' 1e-12-N
-load floor, would decide the mode changes.  It starts in the mode of its self-similar
+ulp of the plane's position, and Hertz's force ARM_FORCE; the impulse before it is left
+out: with Hunt-Crossley damping below 1e-6 N for ~1e-10 s, with the viscoelastic one
+4/5 c_n rho there, see :func:`starts_armed`): below it rho's rounding, and the kernels'
+1e-12-N load floor, would decide the mode changes.  It starts in the mode of its self-similar
 start (:func:`start`): sliding when the spring, at the cap along the slip velocity,
 would outgrow it (the re-stick margin there is >= 0; for Hunt-Crossley this is kappa
 |v_t| >= mu (1 + chi) rhodot^-, the ratio of the self-similar start s = 2/3 v_t t),
@@ -85,6 +86,22 @@ def uses_modes(scene) -> bool:
     (not with mu = 0: no tangential force, the spring stays relaxed)."""
     return (scene.tangential_model == "compliant" and scene.friction_regularization == "exact"
             and scene.friction_coefficient > 0)
+
+
+def starts_armed(scene) -> bool:
+    """Whether ``scene``'s compliant contacts begin at the arming depth
+    (:func:`arm_penetration`) instead of at rho = 0: with the modes (their guards), and
+    with the viscoelastic damping.  Its force c_n rhodot, c_n = 2 gamma sqrt(m* k_n) ~
+    rho^(1/4), rises from rho = 0 with an infinite slope and no scale: an implicit
+    step from rho = 0 sees no force at its start, nor a slope that linearises it, at
+    any step size, so radau5's Newton iteration never converged there (a steel ball
+    dropped with mu = 0 failed at its first contact, issue 28).  From the arming depth
+    a step of ~rho / rhodot resolves it and the steps grow from there.  What it leaves
+    out is the impulse of the approach to that depth, the integral of c_n rhodot dt =
+    c_n drho: 4/5 c_n rho at the arming depth, whatever the impact speed (6e-8 N s for
+    a 1-kg steel ball of 1 m, 7e-9 of its momentum at 8.9 m/s: docs/limits.md)."""
+    return uses_modes(scene) or (scene.tangential_model == "compliant"
+                                 and scene.normal_damping == "viscoelastic")
 
 
 def mode_flags(plane: str, mode: str | None, armed: bool = True) -> int:

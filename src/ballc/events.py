@@ -187,14 +187,15 @@ class SegmentEvents:
     penetration, deepest-point and passing-through events, the rounding margin of its
     contact threshold and the compliant law's arming depth.  Same events, same bits.
     ``rho`` (plane -> its penetration, a LinearEvent) and ``arm_depth`` (plane -> the
-    arming depth, m; None without the compliant modes) serve the driver too."""
+    arming depth, m, where a compliant contact begins; None where contacts begin at rho
+    = 0: compliantmodes.starts_armed) serve the driver too."""
 
     def __init__(self, scene):
         self.scene = scene
         self.rho = {plane: penetration(plane, scene) for plane in PLANES}
         self.arm_depth = ({plane: compliantmodes.arm_penetration(scene, plane)
                            for plane in PLANES}
-                          if compliantmodes.uses_modes(scene) else None)
+                          if compliantmodes.starts_armed(scene) else None)
         self.planes = []
         for plane in PLANES:
             rho = self.rho[plane]

@@ -948,6 +948,8 @@ _FLAG_BITS = dict(
     elastic_bits=[_core.FLAGS[f"{plane}_compliant_elastic"] for plane in PLANES],
     sliding_bits=[_core.FLAGS[f"{plane}_compliant_sliding"] for plane in PLANES],
     compliant_any=_core.FLAGS["floor_compliant"] | _core.FLAGS["ceiling_compliant"],
+    compliant_sliding_any=(_core.FLAGS["floor_compliant_sliding"]
+                           | _core.FLAGS["ceiling_compliant_sliding"]),
     slip_bits=[_core.FLAGS[f"{plane}_slip"] for plane in PLANES],
     slip_fixed_bits=[_core.FLAGS[f"{plane}_slip_fixed"] for plane in PLANES],
     stick_bits=[_core.FLAGS[f"{plane}_stick"] for plane in PLANES])
