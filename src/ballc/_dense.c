@@ -71,7 +71,9 @@ int ballc_piecewise_states(void *ctx, long n, const double *t, double *y)
 
 /* ---- the owning buffer ---- */
 
-static int grow(void **p, long *cap, long need, size_t size)
+#define grow ballc_grow
+
+int ballc_grow(void **p, long *cap, long need, size_t size)
 {
     if (need <= *cap) return 0;
     long c = *cap ? *cap : 16;

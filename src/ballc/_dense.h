@@ -72,4 +72,8 @@ const ballc_piecewise *ballc_dense_view(ballc_dense *d);
  * t_new >= t_to: the same values there, from less memory.  0, or -1 out of memory */
 int ballc_dense_span(const ballc_dense *d, double t_from, double t_to, ballc_dense *out);
 
+/* Make room for ``need`` elements of ``size`` bytes in the array *p of capacity *cap
+ * (doubled from 16 until it fits; *p and *cap updated): 0, or -1 out of memory (*p kept). */
+int ballc_grow(void **p, long *cap, long need, size_t size);
+
 #endif

@@ -136,19 +136,9 @@ double ballc_dot3_fma(const double *v)
 static double py_max(double a, double b) { return b > a ? b : a; }
 static double py_min(double a, double b) { return b < a ? b : a; }
 
-/* ---- growable output ---- */
+/* ---- growable output (ballc_grow, _dense.c) ---- */
 
-static int grow(void **p, long *cap, long need, size_t size)
-{
-    if (need <= *cap) return 0;
-    long c = *cap ? *cap : 16;
-    while (c < need) c *= 2;
-    void *q = realloc(*p, (size_t)c * size);
-    if (!q) return -1;
-    *p = q;
-    *cap = c;
-    return 0;
-}
+#define grow ballc_grow
 
 void ballc_drive_free(ballc_drive_output *o)
 {
@@ -1525,7 +1515,7 @@ static int end_state(run_t *r, int p)
 static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, int flown)
 {
     ballc_drive_output *o = r->o;
-    if (!flown && r->seg_interpolant >= 0) {   /* kept by the integrator (scipy's) */
+    if (flown || r->seg_interpolant >= 0) {   /* no steps of ours: a piece that names it */
         if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1,
                  sizeof(ballc_piece_rec)))
             return -1;
@@ -1533,20 +1523,13 @@ static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, i
         memset(k, 0, sizeof *k);
         k->t0 = t0;
         k->t1 = t1;
-        k->own = 1;
-        k->interpolant = r->seg_interpolant;
-        return 0;
-    }
-    if (flown) {
-        if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1,
-                 sizeof(ballc_piece_rec)))
-            return -1;
-        ballc_piece_rec *k = &o->pieces[o->n_pieces++];
-        memset(k, 0, sizeof *k);
-        k->t0 = t0;
-        k->t1 = t1;
-        k->flight = 1;
-        memcpy(k->y0, r->y, sizeof k->y0);
+        if (flown) {   /* exact flight: FreeFlight(t0, y0, ...) */
+            k->flight = 1;
+            memcpy(k->y0, r->y, sizeof k->y0);
+        } else {       /* kept by the integrator (scipy's) */
+            k->own = 1;
+            k->interpolant = r->seg_interpolant;
+        }
         return 0;
     }
     long m = res->n_dense, width = (long)(1 + res->dense_terms) * N;
