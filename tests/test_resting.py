@@ -107,7 +107,7 @@ def test_the_first_rest_check_comes_after_the_seed_s_first_5_seconds():
 
 def test_observer_free_seed_rolls_in_closed_form():
     """The seed's throw without the observer rolls uniformly from t ~ 31 s: entered by
-    resting.rolls, then exact (ballc.flight.FreeFlight with g = 0).  Oracle: the
+    the C loop's uniform check, then exact (ballc.flight.FreeFlight with g = 0).  Oracle: the
     integrated run (rest=False), which keeps v and omega to 10 digits."""
     scene = ballc.Scene().replace(observer_mass=0.0)
     closed = ballc.simulate(scene, 2000)
@@ -132,7 +132,7 @@ def test_observer_free_seed_rolls_in_closed_form():
 
 def test_the_seed_observer_keeps_the_rolling_out_of_the_uniform_closed_form():
     """With the seed's observer (1e-4 kg off centre) rolling is not uniform (its
-    direction wanders): resting.rolls refuses it, and up to 60 s (before ballc.orbit's
+    direction wanders): the uniform check refuses it, and up to 60 s (before ballc.orbit's
     first trial ends, tests/test_orbit.py) the run integrates on."""
     run = ballc.simulate(ballc.Scene(), 60)
     assert "rolls" not in run.message and math.isnan(run.contacts[-1].t_rolling)

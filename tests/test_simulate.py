@@ -188,3 +188,24 @@ def test_an_absolute_tolerance_below_the_contact_depth_rounding_is_named():
     assert "regularised" not in stuck.message
     fine = ballc.simulate(scene, 3.0, rtol=1e-12, atol=1e-10, max_nfev=200_000, rest=False)
     assert fine.status == 0
+
+
+@pytest.mark.parametrize("method", ["dop853", "radau5", "RK45"])
+def test_a_user_event_that_raises_stops_the_run_with_its_exception(method):
+    """The C loop calls a user's event back: an exception it raises reaches the caller
+    as it is, and a NaN it returns is a ValueError naming the event and the time."""
+    def bad(t, y):
+        if t > 0.5:
+            raise KeyError("boom")
+        return 1.0
+
+    def never(t, y):
+        return 1.0
+
+    def nan(t, y):
+        return float("nan") if t > 0.5 else 1.0
+    with pytest.raises(KeyError, match="boom"):
+        ballc.simulate(ballc.Scene(), 2.0, method=method, events=[bad], progress=False)
+    with pytest.raises(ValueError, match=r"events\[1\] returned nan at t = "):
+        ballc.simulate(ballc.Scene(), 2.0, method=method, events=[never, nan], rtol=1e-6,
+                       atol=1e-6, progress=False)

@@ -93,7 +93,7 @@ def format_summary(result) -> str:
     return "\n".join(lines)
 
 
-# ---- post-processing of a finished run (simulate calls these) ----
+# ---- post-processing of a finished run (its Result calls these on first access) ----
 
 #: The loosest tolerance ballc is tested at (the stress matrix, the come-back maps'
 #: rtol = atol = 1e-3): with a looser rtol or atol the result is not to be trusted,
@@ -151,8 +151,12 @@ def summarize_contact_forces(result):
     """Peak normal force and sticking / slipping time of every contact, from the
     stored samples (solver steps, or t_eval: the resolution is that of the samples);
     with exact Coulomb friction the sticking and slipping times come from the
-    transition events instead."""
+    transition events instead.  (A run's contacts call it on first access to one of
+    them; NaN for a contact without samples.)"""
     contacts = result.contacts
+    for contact in contacts:
+        contact._summary = None
+        contact.peak_normal_force = contact.time_sticking = contact.time_slipping = math.nan
     if not contacts:
         return
     scene = result.scene

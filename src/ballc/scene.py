@@ -301,6 +301,13 @@ class Scene:
         with open(path, "w", encoding="utf-8") as stream:
             stream.write("\n".join(lines) + "\n")
 
+    def __getstate__(self):
+        """The fields and what they derive, without the C loop's converted constants
+        (ballc.loop_constants keeps them on the scene; rebuilt where it runs)."""
+        state = dict(self.__dict__)
+        state.pop("_drive_scene", None)
+        return state
+
     def replace(self, **changes) -> "Scene":
         """A copy with some fields changed (validated).  Giving one of c_tau,
         restitution and damping_ratio drops the others (a scene gives one)."""
@@ -375,11 +382,19 @@ class Scene:
         return np.array([float(values[name]) for name in _core.PARAMETER_NAMES])
 
     def initial_state(self) -> np.ndarray:
-        """State vector in the generated layout order (``ballc._core.STATE_NAMES``)."""
+        """State vector in the generated layout order (``ballc._core.STATE_NAMES``); a
+        fresh copy each call."""
+        return self._initial.copy()
+
+    @functools.cached_property
+    def _initial(self) -> np.ndarray:
+        """The initial state, built once (read-only: every run starts from it)."""
         mechanical = np.concatenate([_quaternion_of(*map(float, self.angles)), self.position,
                                      self.angular_velocity, self.velocity])
         auxiliary = np.zeros(_core.N_STATES - mechanical.size)   # dissipated work, deflections
-        return np.concatenate([mechanical, auxiliary])
+        state = np.concatenate([mechanical, auxiliary])
+        state.flags.writeable = False
+        return state
 
 
 @functools.lru_cache(maxsize=256)
