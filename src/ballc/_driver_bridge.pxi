@@ -598,24 +598,47 @@ cdef class Drive:
         return counts, flags, latches
 
     def contacts(self):
-        """Per contact, a tuple: (plane, ended, passed_through, rate_is_kernel_value,
-        t_start, t_end, v_before, w_before, v_after, w_after, rate, digin,
-        max_penetration, contact_point, lost (normal, tangential)), vectors as lists."""
+        """The contacts' records as arrays, one row per contact: "plane", "ended",
+        "passed_through", "kernel_rate" (ints), "t_start", "t_end", "rate",
+        "max_penetration" (n,), "v_before", "w_before", "v_after", "w_after", "digin"
+        (n, 3), "contact_point", "lost" (normal, tangential) (n, 2); a contact that did
+        not end has NaN for t_end, v_after, w_after and lost."""
+        cdef long n = self.o.n_contacts, i
+        cdef int j
         cdef ballc_contact_rec *rec
-        cdef long i
-        found = []
-        for i in range(self.o.n_contacts):
+        ints = np.empty((4, n), dtype=np.intc)
+        scalars = np.empty((4, n))
+        vectors = np.empty((5, n, 3))
+        pairs = np.empty((2, n, 2))
+        cdef int[:, ::1] iv = ints
+        cdef double[:, ::1] sv = scalars
+        cdef double[:, :, ::1] vv = vectors, pv = pairs
+        for i in range(n):
             rec = &self.o.contacts[i]
-            found.append((rec.plane, rec.ended, rec.passed_through, rec.rate_is_kernel_value,
-                          rec.t_start, rec.t_end,
-                          [rec.v_before[0], rec.v_before[1], rec.v_before[2]],
-                          [rec.w_before[0], rec.w_before[1], rec.w_before[2]],
-                          [rec.v_after[0], rec.v_after[1], rec.v_after[2]],
-                          [rec.w_after[0], rec.w_after[1], rec.w_after[2]],
-                          rec.rate, [rec.digin[0], rec.digin[1], rec.digin[2]],
-                          rec.max_penetration, [rec.contact_point[0], rec.contact_point[1]],
-                          (rec.lost[0], rec.lost[1])))
-        return found
+            iv[0, i], iv[1, i] = rec.plane, rec.ended
+            iv[2, i], iv[3, i] = rec.passed_through, rec.rate_is_kernel_value
+            sv[0, i], sv[1, i], sv[2, i], sv[3, i] = (rec.t_start, rec.t_end, rec.rate,
+                                                      rec.max_penetration)
+            for j in range(3):
+                vv[0, i, j] = rec.v_before[j]
+                vv[1, i, j] = rec.w_before[j]
+                vv[2, i, j] = rec.v_after[j]
+                vv[3, i, j] = rec.w_after[j]
+                vv[4, i, j] = rec.digin[j]
+            for j in range(2):
+                pv[0, i, j] = rec.contact_point[j]
+                pv[1, i, j] = rec.lost[j]
+            if not rec.ended:
+                sv[1, i] = NAN
+                for j in range(3):
+                    vv[2, i, j] = NAN
+                    vv[3, i, j] = NAN
+                pv[1, i, 0] = pv[1, i, 1] = NAN
+        return dict(plane=ints[0], ended=ints[1], passed_through=ints[2], kernel_rate=ints[3],
+                    t_start=scalars[0], t_end=scalars[1], rate=scalars[2],
+                    max_penetration=scalars[3], v_before=vectors[0], w_before=vectors[1],
+                    v_after=vectors[2], w_after=vectors[3], digin=vectors[4],
+                    contact_point=pairs[0], lost=pairs[1])
 
     def phases(self):
         """[(contact index, t, phase code: PHASE_NAMES)], in order."""

@@ -39,50 +39,55 @@ def _flag(name):
     return [_core.FLAGS[f"{plane}_{name}"] for plane in PLANES]
 
 
+#: The modes' flag bits per plane: the same for every scene
+_BITS = dict(
+    slip_bits=_flag("slip"), slip_fixed_bits=_flag("slip_fixed"), stick_bits=_flag("stick"),
+    compliant_bits=_flag("compliant"), elastic_bits=_flag("compliant_elastic"),
+    sliding_bits=_flag("compliant_sliding"),
+    compliant_any=_core.FLAGS["floor_compliant"] | _core.FLAGS["ceiling_compliant"])
+
+
 def _scene_dict(scene) -> dict:
     """The constants of ``scene`` as _core.DriveScene takes them."""
-    params = scene.parameter_vector()
+    params = scene._parameters   # (read only; DriveScene keeps a copy)
     observer = _core.FLAGS["observer"] if scene.observer_mass != 0 else 0
-    resting_plane = resting.resting_plane(scene)
+    resting_plane = resting.resting_plane(scene) is not None
     total_mass = resting.total_mass(scene)
+    radius, gravity = float(scene.radius), float(scene.gravity)
     rho = [events.penetration(plane, scene) for plane in PLANES]
-    arm_depth = ([compliantmodes.arm_penetration(scene, plane) for plane in PLANES]
-                 if compliantmodes.uses_modes(scene) else [0.0, 0.0])
+    modes_on = compliantmodes.uses_modes(scene)
     rho_eq = resting.equilibrium_penetration(scene) if resting_plane else 1.0
+    orbits = orbit.applies(scene)
     return dict(
-        observer_bits=observer,
+        _BITS, observer_bits=observer,
         contact_bits=[modes.flags(scene, {p: p == plane for p in PLANES}) ^ observer
                       for plane in PLANES],
-        slip_bits=_flag("slip"), slip_fixed_bits=_flag("slip_fixed"),
-        stick_bits=_flag("stick"), compliant_bits=_flag("compliant"),
-        elastic_bits=_flag("compliant_elastic"), sliding_bits=_flag("compliant_sliding"),
-        compliant_any=_core.FLAGS["floor_compliant"] | _core.FLAGS["ceiling_compliant"],
-        exact=int(stickslip.uses_exact_coulomb(scene)),
-        compliant_modes=int(compliantmodes.uses_modes(scene)),
-        radius=float(scene.radius), gravity=float(params[_core.PARAMETER_NAMES.index("gravity")]),
-        weight=total_mass * abs(scene.gravity), hertz_k=scene.hertz_stiffness,
-        total_mass=total_mass,
+        exact=int(stickslip.uses_exact_coulomb(scene)), compliant_modes=int(modes_on),
+        radius=radius, gravity=gravity, weight=total_mass * abs(gravity),
+        hertz_k=scene.hertz_stiffness, total_mass=total_mass,
         rho_scale=[e._scale for e in rho], rho_offset=[e.offset for e in rho],
-        through_offset=[e.offset - scene.radius for e in rho],
+        through_offset=[e.offset - radius for e in rho],
         threshold_base=[events.threshold_base(scene, plane) for plane in PLANES],
-        slip_map=np.ascontiguousarray([stickslip.slip_map(params, plane) for plane in PLANES]),
-        arm_depth=arm_depth,
+        slip_map=np.array([_core.slip_map(params, k) for k in range(len(PLANES))]),
+        arm_depth=([compliantmodes.arm_penetration(scene, plane) for plane in PLANES]
+                   if modes_on else [0.0, 0.0]),
         ulp8=[8 * math.ulp(compliantmodes.plane_position(scene, plane)) for plane in PLANES],
         restick_factor=max(1.0, scene.friction_coefficient
                            / max(scene.tangential_stiffness_ratio, 1e-300)),
         damping_positive=int(params[compliantmodes._TANGENTIAL_DAMPING] > 0),
         contact_time_base=compliantmodes.contact_time_base(scene),
-        resting_plane=-1 if resting_plane is None else PLANES.index(resting_plane),
+        resting_plane=PLANES.index("floor") if resting_plane else -1,
         rest_period=(resting.REST_PERIODS * resting.oscillation_period(scene)
                      if resting_plane else math.inf),
-        rho_eq=rho_eq, z_eq=scene.radius - rho_eq if resting_plane else 0.0,
-        rest_weight=total_mass * scene.gravity if resting_plane else 0.0,
-        observer_weight=scene.observer_mass * scene.gravity if resting_plane else 0.0,
-        rolls_level=float(resting.steady_level(scene)) if resting_plane else 0.0,
+        rho_eq=rho_eq, z_eq=radius - rho_eq if resting_plane else 0.0,
+        rest_weight=total_mass * gravity if resting_plane else 0.0,
+        observer_weight=scene.observer_mass * gravity if resting_plane else 0.0,
+        rolls_level=resting.steady_level(scene) if resting_plane else 0.0,
         half_mass=0.5 * total_mass if resting_plane else 0.0,
         observer_massive=int(scene.observer_mass > 0),
-        rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbit.applies(scene)),
-        orbit_axis=[float(a) for a in orbit.body_axis(scene)], rest_factor=resting.REST_FACTOR)
+        rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbits),
+        orbit_axis=[float(a) for a in orbit.body_axis(scene)] if orbits else [0.0, 0.0, 1.0],
+        rest_factor=resting.REST_FACTOR)
 
 
 def run_constants(scene, options, rest) -> dict:

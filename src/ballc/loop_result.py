@@ -19,7 +19,6 @@ from .resting import Constant
 from .result import Contact, Result
 
 PLANES = layout.PLANES
-_NAN_3, _NAN_2 = (math.nan,) * 3, (math.nan,) * 2
 
 
 def result_of(scene, options, run) -> Result:
@@ -85,25 +84,27 @@ def _user_events(result, run, options):
 
 def _contacts(result, run) -> list:
     """The run's contacts, their phases and end states; their force summaries are
-    computed on first access to one (ballc.outcome.summarize_contact_forces)."""
+    computed on first access to one (ballc.outcome.summarize_contact_forces).  Their
+    vectors are rows of one array per field (a contact that did not end: NaN after)."""
+    found = run.contacts()
+    t_end, lost, rates = found["t_end"].tolist(), found["lost"].tolist(), found["rate"]
+    v_before, w_before, v_after, w_after, digin, point = (found[name] for name in (
+        "v_before", "w_before", "v_after", "w_after", "digin", "contact_point"))
     contacts = []
     summary = lambda: outcome.summarize_contact_forces(result)   # noqa: E731
-    for (plane, ended, passed, kernel_rate, t_start, t_end, v_before, w_before, v_after,
-         w_after, rate, digin, depth, point, lost) in run.contacts():
+    for k, (plane, kernel_rate, t_start, depth) in enumerate(zip(
+            found["plane"].tolist(), found["kernel_rate"].tolist(), found["t_start"].tolist(),
+            found["max_penetration"].tolist())):
         contact = Contact.__new__(Contact)
         contact.__dict__.update(
-            plane=PLANES[plane], t_start=t_start, t_end=t_end if ended else math.nan,
-            velocity_before=np.array(v_before), angular_velocity_before=np.array(w_before),
-            penetration_rate_at_impact=np.float64(rate) if kernel_rate else rate,
-            digin_direction=np.array(digin),
-            velocity_after=np.array(v_after if ended else _NAN_3),
-            angular_velocity_after=np.array(w_after if ended else _NAN_3),
-            max_penetration=depth,
-            contact_point=np.array(_NAN_2 if math.isnan(point[0]) else point),
-            energy_lost_normal=lost[0] if ended else math.nan,
-            energy_lost_tangential=lost[1] if ended else math.nan,
-            transitions=[], t_rest=math.nan, t_rolling=math.nan, t_sliding=math.nan,
-            _summary=summary)
+            plane=PLANES[plane], t_start=t_start, t_end=t_end[k],
+            velocity_before=v_before[k], angular_velocity_before=w_before[k],
+            penetration_rate_at_impact=rates[k] if kernel_rate else float(rates[k]),
+            digin_direction=digin[k], velocity_after=v_after[k],
+            angular_velocity_after=w_after[k], max_penetration=depth,
+            contact_point=point[k], energy_lost_normal=lost[k][0],
+            energy_lost_tangential=lost[k][1], transitions=[], t_rest=math.nan,
+            t_rolling=math.nan, t_sliding=math.nan, _summary=summary)
         contacts.append(contact)
     for k, when, phase in run.phases():
         name = _core.PHASE_NAMES[phase]

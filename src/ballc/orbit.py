@@ -77,7 +77,7 @@ TILT_SAMPLES = _core.ORBIT_TILT_SAMPLES
 
 def applies(scene) -> bool:
     """Routh's sphere on the floor: g > 0, isotropic inertia, a massive observer."""
-    p = scene.parameter_vector()
+    p = scene._parameters   # (read only)
     return bool(scene.gravity > 0 and scene.observer_mass > 0
                 and p[_PARAMETER["inertia_xx"]] == p[_PARAMETER["inertia_yy"]]
                 == p[_PARAMETER["inertia_zz"]])

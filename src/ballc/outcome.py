@@ -108,9 +108,10 @@ MAX_BALANCE_DRIFT = 1e-2
 def tolerance_warning(rtol, atol) -> str:
     """A warning for the message when rtol or atol is looser than the loosest
     tolerance ballc is tested at (LOOSEST_TRUSTED_TOLERANCE); "" otherwise."""
-    loose = [f"{name} = {float(np.max(value)):g}" for name, value in (("rtol", rtol),
-                                                                     ("atol", atol))
-             if float(np.max(value)) > LOOSEST_TRUSTED_TOLERANCE]
+    largest = [(name, value if type(value) is float else float(np.max(value)))
+               for name, value in (("rtol", rtol), ("atol", atol))]
+    loose = [f"{name} = {value:g}" for name, value in largest
+             if value > LOOSEST_TRUSTED_TOLERANCE]
     if not loose:
         return ""
     return (f" Warning: {' and '.join(loose)} is looser than "

@@ -78,6 +78,7 @@ CHECK_GROWTH = _core.CHECK_GROWTH
 
 #: At most this many samples of a closed-form end state (sol(t) is exact anywhere).
 MAX_ROLL_SAMPLES = _core.MAX_ROLL_SAMPLES
+_EPS = float(np.finfo(float).eps)
 
 
 def resting_plane(scene) -> str | None:
@@ -118,7 +119,7 @@ def speed_tolerance(scene, rtol, atol) -> float:
 def steady_level(scene) -> float:
     """The rounding level (1e3 eps g, m/s^2) below which a state's accelerations count as
     zero (uniform motion's steady state)."""
-    return 1e3 * np.finfo(float).eps * scene.gravity
+    return 1e3 * _EPS * scene.gravity
 
 
 def energy_threshold(scene, rtol, atol) -> float:
