@@ -233,3 +233,17 @@ def test_whole_run_agrees_with_the_integrated_flight(changes, rtol):
             assert np.max(np.abs(quantity(run) - quantity(reference))) <= 3e-4
     balance = on.energy["balance"]
     assert abs(balance[-1] - balance[0]) <= 1e-6 * abs(balance[0])
+
+
+def test_a_flight_too_long_to_sample_stops_honestly():
+    """A ball floating without gravity, spinning, for 1e9 s: its exact flight would store
+    ~5e10 samples (pi/16 of turn each).  The run stops at once with status -1 and says
+    why and what to do, keeping what was computed (the start); with t_eval it runs."""
+    scene = ballc.Scene(gravity=0.0, observer_mass=0.0, velocity=(0.0, 0.0, 0.0),
+                        angular_velocity=(0.0, 0.0, 10.0))
+    run = ballc.simulate(scene, 1e9, progress=False)
+    assert run.status == -1 and "more than 1e8 samples" in run.message
+    assert "t_eval" in run.message and run.t.tolist() == [0.0]
+    sampled = ballc.simulate(scene, 1e9, t_eval=[0.0, 5e8, 1e9], progress=False)
+    assert sampled.status == 0 and sampled.nfev == 0
+    np.testing.assert_allclose(sampled.angular_velocity[:, -1], (0.0, 0.0, 10.0), rtol=0)

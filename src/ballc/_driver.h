@@ -146,7 +146,7 @@ typedef struct {                       /* constants of one run, filled by the br
     int (*interrupted)(void *ctx);
     /* the compliant law's exact modes (ballc.compliantmodes) */
     int compliant_modes;               /* compliantmodes.uses_modes */
-    int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* mode_flags per plane */
+    int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* the modes' bits per plane */
     int compliant_any;                 /* FLOOR_COMPLIANT | CEILING_COMPLIANT */
     double arm_depth[2];               /* arm_penetration */
     double ulp8[2];                    /* 8 ulp(plane_position): _rounding */

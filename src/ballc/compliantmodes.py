@@ -97,17 +97,6 @@ def uses_modes(scene) -> bool:
             and scene.friction_coefficient > 0)
 
 
-def mode_flags(plane: str, mode: str | None, armed: bool = True) -> int:
-    """The C flag of the compliant law on ``plane`` in ``mode``: the sliding kernels;
-    the elastic mode's (the spring alone) once its guards are ``armed``; else (mode
-    None: no modes, or before the arming) the law with its smooth yield."""
-    if mode == "sliding":
-        return _core.FLAGS[f"{plane}_compliant_sliding"]
-    if mode == "elastic" and armed:
-        return _core.FLAGS[f"{plane}_compliant_elastic"]
-    return _core.FLAGS[f"{plane}_compliant"]
-
-
 def margins(y, params, latch, plane: str) -> np.ndarray:
     """(yield margin (1), re-stick margin (m/s), s_cap (m), k_t (N/m), capacity margin
     (N), its negative) at state y (_core.compliant_margins)."""

@@ -2,8 +2,11 @@
 
 A segment's *mode* is which planes the ball touches and, with exact Coulomb friction,
 each contact's slip/stick mode (ballc.stickslip), or with the compliant law its
-elastic/sliding mode (ballc.compliantmodes).  :func:`flags` maps it to the C kernels
-that run; the C loop takes each plane's bits from it once per scene.
+elastic/sliding mode (ballc.compliantmodes).  Each is a set of C kernels, chosen by the
+right-hand side's flags (``_core.FLAGS``): :func:`flags` gives those of the contacts'
+laws, which the C loop takes once per scene and adds each mode's own bits to
+(``<plane>_slip``, ``_slip_fixed``, ``_stick``; with the compliant law
+``<plane>_compliant_elastic`` once armed or ``_compliant_sliding`` instead).
 
 At a contact start (the automaton's "enter", ``_driver.c``: begin_contact) the C loop
 latches, from the contact kinematics at that state, the penetration rate rhodot^- and
@@ -18,7 +21,7 @@ below MIN_IMPACT_RATE is latched as MIN_IMPACT_RATE.
 """
 from __future__ import annotations
 
-from . import _core, compliantmodes, stickslip
+from . import _core
 
 PLANES = ("floor", "ceiling")
 
@@ -28,25 +31,21 @@ PLANES = ("floor", "ceiling")
 MIN_IMPACT_RATE = _core.MIN_IMPACT_RATE
 
 
-def flags(scene, in_contact, coulomb=None, compliant=None, armed=None):
-    """The C flags of a segment: the observer's kernels (when it has mass), each
-    contact's laws (compliant; or friction and/or dig-in by the mixture) and, with
-    ``coulomb`` (plane -> "slip", "slip_fixed", "stick" or None), each contact's
-    exact Coulomb mode; with ``compliant`` (plane -> "elastic", "sliding" or None) and
-    ``armed`` (plane -> bool), each compliant contact's mode (ballc.compliantmodes)."""
+def flags(scene, in_contact):
+    """The C flags of a segment in contact with the planes ``in_contact`` (plane ->
+    bool), before any mode: the observer's kernels (when it has mass) and each contact's
+    laws (the compliant law, with its smooth yield; or friction and/or dig-in by the
+    mixture)."""
     flags = _core.FLAGS["observer"] if scene.observer_mass != 0 else 0
     mixture = scene.effective_mixture
     for plane in PLANES:
         if not in_contact[plane]:
             continue
         if scene.tangential_model == "compliant":
-            flags |= compliantmodes.mode_flags(plane, compliant[plane] if compliant else None,
-                                               armed[plane] if armed else False)
+            flags |= _core.FLAGS[f"{plane}_compliant"]
             continue
         if mixture < 1:
             flags |= _core.FLAGS[f"{plane}_friction"]
         if mixture > 0:
             flags |= _core.FLAGS[f"{plane}_digin"]
-        if coulomb:
-            flags |= stickslip.mode_flags(plane, coulomb[plane])
     return flags

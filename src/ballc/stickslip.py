@@ -95,11 +95,6 @@ def uses_exact_coulomb(scene) -> bool:
             and scene.effective_mixture < 1 and scene.friction_coefficient > 0)
 
 
-def mode_flags(plane: str, mode: str | None) -> int:
-    """The C flags of a plane's Coulomb mode ("slip", "slip_fixed", "stick" or None)."""
-    return _core.FLAGS[f"{plane}_{mode}"] if mode else 0
-
-
 def slip_map(params, plane: str) -> np.ndarray:
     """du/dy (2 x N_STATES) of ``plane``'s slip velocity u (u is linear in the state),
     kept per parameter vector.  Read-only: shared between callers."""
