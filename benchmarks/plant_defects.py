@@ -128,11 +128,6 @@ DEFECTS = [
     Defect("rigid map: tangential restitution sign flipped (1 - e_t)", "src/ballc/rigid.py",
            "p_t = -tangential_mass * (1 + tangential_restitution) * u",
            "p_t = -tangential_mass * (1 - tangential_restitution) * u", regenerate=False),
-    Defect("C loop: a segment gets the t_eval times up to t_end, beyond its own end",
-           "src/ballc/_driver.c",
-           "while (hi < c->n_eval && c->t_eval[hi] <= t_stop) hi++;",
-           "while (hi < c->n_eval && c->t_eval[hi] <= c->t_end) hi++;", regenerate=False,
-           count=2),   # the exact flight's and the integrators'
     Defect("radau5 T[0][0] off in its 7th significant digit", "src/ballc/_radau_iia.c",
            "{0.09443876248897524, -0.14125529502095421, 0.03002919410514742}",
            "{0.09443877248897524, -0.14125529502095421, 0.03002919410514742}",
