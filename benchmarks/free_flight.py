@@ -40,7 +40,8 @@ def flight_segments(result, scene, t_end):
     output) that ended in a contact start: [dict(inputs=(params, latch, flags, t0, t1,
     y0, events), nstep, nfev)], from its segment log, as the loop integrated them: from
     t0 towards t1 = t_end (a flight has no rest check to stop at) with the contact
-    starts' events past their thresholds (events.contact_threshold); y0 is the
+    starts' events past their thresholds (max(base, base + rho0), base
+    events.threshold_base, as the C loop's segment_events makes them); y0 is the
     segment's piece of result.sol at t0 (its first step's start state, exactly), the
     latch and flags its samples'."""
     log = result.segments
@@ -57,7 +58,8 @@ def flight_segments(result, scene, t_end):
         events = []
         for plane in ("floor", "ceiling"):
             rho = ev.penetration(plane, scene)
-            threshold = ev.contact_threshold(scene, plane, float(rho(t0, y0)), True)
+            base = ev.threshold_base(scene, plane)
+            threshold = max(base, float(rho(t0, y0)) + base)
             events.append(ev.LinearEvent(rho.coefficients, rho.offset - threshold,
                                          terminal=True, direction=1))
         found.append(dict(inputs=(params, np.array(result.latch[:, first]),

@@ -5,12 +5,9 @@
 
 For each t_end: ``ballc.simulate(scene, t_end)`` with the default options (radau5,
 rtol = atol = 1e-10, exact Coulomb friction, max_nfev = 2e7), timed in wall-clock and
-CPU (time.process_time) as users run it (the C loop where it applies; which driver ran
-is a column), then timed again with the Python driver (the integrator seam wrapped; the
-results must be the same), with its status, the simulated time reached, the integrator
-segments and the steps of the last one (the C loop's segment log, ``result.segments``;
-for a run that fell back, the wrapper's count of the driver's integrate_segment calls),
-the right-hand-side calls, the samples, the contacts, and the median
+CPU (time.process_time) as users run it, with its status, the simulated time reached,
+the integrator segments and the steps of the last one (the C loop's segment log,
+``result.segments``), the right-hand-side calls, the samples, the contacts, and the median
 step after the last contact started.  For the largest run, the figures
 (``result.plot()``, ``plot_energy()``, ``plot_observer()``, ``plot_contacts()``, matplotlib
 Agg, not saved) and the animation (GIF) are timed too.  ``--scene drop``: a vertical
@@ -34,8 +31,8 @@ from pathlib import Path
 import numpy as np
 
 import ballc
+from ballc.messages import SUCCESS
 
-SIM = sys.modules["ballc.simulate"]
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 
 
@@ -53,51 +50,19 @@ def rolling_scene():
 SCENES = {"seed": ballc.Scene, "drop": drop_scene, "rolling": rolling_scene}
 
 
-class Segments:
-    """Counts the driver's integrate_segment calls and the steps of the last one."""
-
-    def __init__(self):
-        self.inner = SIM.integrate_segment
-        self.count, self.last_steps = 0, 0
-
-    def __call__(self, *args, **options):
-        sol = self.inner(*args, **options)
-        self.count += 1
-        self.last_steps = int(sol.get("nstep", len(sol["t"])) or len(sol["t"]))
-        return sol
-
-    def __enter__(self):
-        SIM.integrate_segment = self
-        return self
-
-    def __exit__(self, *exc):
-        SIM.integrate_segment = self.inner
-
-
 def run(scene, t_end, method, rest):
-    """The run timed as users make it (the default driver: the C loop where it applies),
-    then again with the Python driver's integrator seam wrapped to count segments (a
-    wrapped seam makes simulate take the Python driver: the same results)."""
+    """The run timed as users make it, with the counts of its segment log."""
     wall, cpu = time.perf_counter(), time.process_time()
-    plain = ballc.simulate(scene, t_end, method=method, progress=False, rest=rest)
+    result = ballc.simulate(scene, t_end, method=method, progress=False, rest=rest)
     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-    with Segments() as segments:
-        python_cpu = time.process_time()
-        result = ballc.simulate(scene, t_end, method=method, progress=False, rest=rest)
-        python_cpu = time.process_time() - python_cpu
-    if not (np.array_equal(plain.t, result.t) and np.array_equal(plain.y, result.y)):
-        raise SystemExit(f"t_end {t_end}: the two drivers differ")
-    log = getattr(plain, "segments", None)
-    if log is not None:   # the C loop's own account
-        segments.count, segments.last_steps = len(log), int(log["nstep"][-1])
+    log = result.segments   # the C loop's own account
     last = result.contacts[-1].t_start if result.contacts else 0.0
     late = np.diff(result.t[result.t >= last])
     return dict(t_end=t_end, status=result.status, reached=float(result.t[-1]), wall=wall,
-                cpu=cpu, driver=getattr(plain, "_driver", "python"), python_cpu=python_cpu,
-                segments=segments.count, last_steps=segments.last_steps,
+                cpu=cpu, segments=len(log), last_steps=int(log["nstep"][-1]),
                 nfev=result.nfev, samples=result.t.size, contacts=len(result.contacts),
                 median_step=float(np.median(late)) if late.size else float("nan"),
-                message=result.message.replace(SIM.SUCCESS, "t_end reached.").replace(
+                message=result.message.replace(SUCCESS, "t_end reached.").replace(
                     "|", "/")), result
 
 
@@ -124,9 +89,9 @@ def time_figures(result):
     return times
 
 
-HEADER = ("| t_end (s) | rest | status | reached (s) | wall (s) | CPU (s) | driver | CPU, "
-          "Python driver (s) | segments | steps of last segment | RHS calls | samples | "
-          "contacts | median step after last contact start (s) | message |")
+HEADER = ("| t_end (s) | rest | status | reached (s) | wall (s) | CPU (s) | segments | "
+          "steps of last segment | RHS calls | samples | contacts | median step after last "
+          "contact start (s) | message |")
 
 
 def main(argv=None):
@@ -156,8 +121,8 @@ def main(argv=None):
                     largest = result
                 lines.append(
                     f"| {r['t_end']:g} | {rest} | {r['status']} | {r['reached']:.6g} "
-                    f"| {r['wall']:.3g} | {r['cpu']:.3g} | {r['driver']} "
-                    f"| {r['python_cpu']:.3g} | {r['segments']} | {r['last_steps']} "
+                    f"| {r['wall']:.3g} | {r['cpu']:.3g} "
+                    f"| {r['segments']} | {r['last_steps']} "
                     f"| {r['nfev']} | {r['samples']} | {r['contacts']} | {r['median_step']:.4g} "
                     f"| {r['message']} |")
         lines.append("")

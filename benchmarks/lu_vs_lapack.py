@@ -5,8 +5,9 @@
 Times ``ballc.simulate(ballc.Scene(), 5.0, rtol=1e-10, atol=1e-10)`` in this process
 (best of ``--repeat``, time.process_time around the call) and prints the counts
 (nfev, njev, nlu, and nstep / nreject summed over the segments of the C loop's
-segment log, ``result.segments``; a build without one: over the Python driver's calls of
-``_radau5.solve_system``, wrapped).  Run it once
+segment log, ``result.segments``; a build without one: over the calls of
+``_radau5.solve_system``, wrapped, which in such an older build made simulate take its
+Python driver).  Run it once
 against a build that factors radau5's Newton matrices with LAPACK (before
 src/ballc/_lu.c) and once against a build that uses _lu.c, and compare: the script
 itself does not care which build it imports, it prints the path.
@@ -23,8 +24,8 @@ from ballc import _radau5
 
 
 def _counting(solve_system, totals):
-    """Wrap _radau5.solve_system to sum nstep / nreject over segments (a build without
-    the segment log; the wrapper makes simulate take the Python driver)."""
+    """Wrap _radau5.solve_system to sum nstep / nreject over segments (an older build
+    without the segment log, where the wrapper made simulate take its Python driver)."""
     def wrapped(*args, **kwargs):
         sol = solve_system(*args, **kwargs)
         totals["nstep"] += sol.nstep

@@ -1,6 +1,6 @@
 """Do two builds of ballc give the same answers, to within each run's own integration error?
 
-    python -m benchmarks.same_answers BEFORE_SRC AFTER_SRC [--quick] [--only TEXT]
+    python -m benchmarks.same_answers BEFORE_SRC AFTER_SRC [--quick] [--only TEXT] [--verbose]
 
 For changes that may move bits but must not move results (issue 29: the C loop became
 the only driver; its numerics no longer reproduce CPython's ``hypot`` or the BLAS ``dot``).
@@ -251,6 +251,8 @@ def main(argv=None) -> int:
     parser.add_argument("after", type=Path, help="src/ of the second build (this tree)")
     parser.add_argument("--quick", action="store_true", help="a few cases of each kind")
     parser.add_argument("--only", default="", help="only the cases whose name contains this")
+    parser.add_argument("--verbose", action="store_true",
+                        help="print every case's quantities, not only those that differ")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         before = run(args.before.resolve(), Path(tmp), args.quick, args.only, False)
@@ -262,7 +264,7 @@ def main(argv=None) -> int:
         failed += not ok
         status = before[name].get("status", "-")
         print(f"{'same     ' if ok else 'DIFFERENT'} {name} (status {status})")
-        if not ok or args.only:
+        if not ok or args.only or args.verbose:
             print("\n".join(lines))
     print(f"{len(before) - failed} of {len(before)} cases the same within their own error")
     return 1 if failed else 0

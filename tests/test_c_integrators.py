@@ -3,8 +3,7 @@ methods segment by segment through a callback, per-state atol, every form of a u
 LinearEvent, the progress bar as a callback from C, and Ctrl-C inside a long segment.
 
 Oracles: closed forms of free flight (the crossings of a parabola), radau5 at a tight
-tolerance for the scipy methods' runs, the Python driver while it exists (29d deletes it
-and that comparison), and a real SIGINT into a separate process."""
+tolerance for the scipy methods' runs, and a real SIGINT into a separate process."""
 from __future__ import annotations
 
 import math
@@ -21,16 +20,13 @@ import pytest
 import ballc
 from ballc import _core
 from ballc.events import LinearEvent
+from ballc.loop_constants import run_constants, scene_constants
 from ballc.options import SCIPY_METHODS, check_options
 
 N = _core.N_STATES
 X, Z, VZ = (_core.STATE_INDEX[name] for name in ("x", "z", "vz"))
 G = 9.81
 DRIVER = sys.modules["ballc.simulate"]
-
-
-def _c_config(scene, t_end, progress=False, **kwargs):
-    return DRIVER._c_config(scene, check_options(scene, t_end, **kwargs), progress, True)
 
 
 def _crossing(z0, vz0, height):
@@ -48,7 +44,7 @@ def test_scipy_methods_run_in_the_c_loop_and_agree_with_radau5(method):
     scene = ballc.Scene()
     result = ballc.simulate(scene, 1.2, method=method, rtol=1e-9, atol=1e-9, progress=False)
     reference = ballc.simulate(scene, 1.2, rtol=1e-11, atol=1e-11, progress=False)
-    assert result._driver == "c" and result.status == 0 and result.t[-1] == 1.2
+    assert result.status == 0 and result.t[-1] == 1.2
     assert len(result.contacts) == len(reference.contacts) == 3
     for ours, theirs in zip(result.contacts, reference.contacts):
         assert ours.t_start == pytest.approx(theirs.t_start, abs=1e-7)
@@ -57,41 +53,16 @@ def test_scipy_methods_run_in_the_c_loop_and_agree_with_radau5(method):
     assert result.nfev > 0 and np.all(np.diff(result.t) > 0)
 
 
-@pytest.mark.parametrize("method", ["Radau", "DOP853", "LSODA"])
-def test_scipy_methods_in_the_c_loop_match_the_python_driver(monkeypatch, method):
-    """The same segments as the Python driver's (same modes and events), the states to
-    within rounding amplified by the contacts (the C guards' plain dots against
-    numpy's BLAS dot move an event's root in its last bits, and a step may follow):
-    far inside the integration error."""
-    scene = ballc.Scene()
-    kw = dict(method=method, rtol=1e-9, atol=1e-9, progress=False, dense_output=True)
-    c = ballc.simulate(scene, 1.2, **kw)
-    monkeypatch.setenv("BALLC_PYTHON_DRIVER", "1")
-    p = ballc.simulate(scene, 1.2, **kw)
-    assert (c._driver, p._driver) == ("c", "python")
-    assert (c.status, c.message) == (p.status, p.message)
-    assert c.nfev == pytest.approx(p.nfev, rel=0.01)   # a step more or less, rounding
-    assert len(c.contacts) == len(p.contacts)
-    for a, b in zip(c.contacts, p.contacts):
-        assert a.t_start == pytest.approx(b.t_start, abs=1e-8)
-        assert a.t_end == pytest.approx(b.t_end, abs=1e-8)
-        assert [phase for _, phase in a.transitions] == [phase for _, phase in b.transitions]
-    np.testing.assert_allclose(c.y[:13, -1], p.y[:13, -1], rtol=1e-6, atol=1e-7)
-    grid = np.linspace(0.0, 1.2, 97)
-    np.testing.assert_allclose(c.sol(grid)[:13], p.sol(grid)[:13], rtol=1e-5, atol=1e-6)
-
-
 def test_a_scipy_run_keeps_its_interpolants_and_failures_honest():
     """Result.sol of a scipy run is made of scipy's own interpolants (one per segment),
     and a call budget stops it with status -1 and what was computed."""
     result = ballc.simulate(ballc.Scene(), 0.4, method="RK45", rtol=1e-8, atol=1e-8,
                             dense_output=True, progress=False)
     from scipy.integrate import OdeSolution
-    assert result._driver == "c"
     assert all(isinstance(piece, OdeSolution) for _, _, piece in result.sol.pieces)
     np.testing.assert_allclose(result.sol(result.t), result.y, rtol=1e-10, atol=1e-9)
     stopped = ballc.simulate(ballc.Scene(), 1.0, method="BDF", max_nfev=500, progress=False)
-    assert stopped._driver == "c" and stopped.status == -1 and "max_nfev" in stopped.message
+    assert stopped.status == -1 and "max_nfev" in stopped.message
     assert 0 < stopped.t[-1] < 1.0 and stopped.nfev <= 600
 
 
@@ -128,12 +99,11 @@ def test_per_state_atol_runs_in_the_c_loop(method):
     kw = dict(method=method, rtol=1e-6, progress=False)
     scalar = ballc.simulate(scene, 1.2, atol=1e-6, **kw)
     same = ballc.simulate(scene, 1.2, atol=np.full(N, 1e-6), **kw)
-    assert same._driver == "c"
     assert np.array_equal(scalar.t, same.t) and np.array_equal(scalar.y, same.y)
     tight = np.full(N, 1e-6)
     tight[[Z, VZ]] = 1e-12
     tighter = ballc.simulate(scene, 1.2, atol=tight, **kw)
-    assert tighter._driver == "c" and tighter.status == 0
+    assert tighter.status == 0
     assert tighter.nfev > scalar.nfev
 
 
@@ -163,12 +133,11 @@ def test_a_linear_event_subclass_is_taken_as_it_declares(method):
     kw = dict(method=method, rtol=1e-10, atol=1e-10, progress=False)
     plain = ballc.simulate(scene, 0.1, events=LinearEvent.of_state("z", offset=-3.0), **kw)
     sub = ballc.simulate(scene, 0.1, events=_Height(3.0), **kw)
-    assert sub._driver == "c"
     assert np.array_equal(plain.t_events[0], sub.t_events[0])
     assert sub.t_events[0] == pytest.approx([expected], abs=1e-9)
     _Counted.calls = 0
     own = ballc.simulate(scene, 0.1, events=_Counted(np.eye(N)[Z], -3.0), **kw)
-    assert own._driver == "c" and _Counted.calls > 0
+    assert _Counted.calls > 0
     assert own.t_events[0] == pytest.approx([expected], abs=1e-9)
 
 
@@ -194,7 +163,7 @@ def test_rearm_of_a_users_linear_event_is_called_back(method):
     calls = []
     result = ballc.simulate(ballc.Scene(), 1.0, method=method, rtol=1e-10, atol=1e-10,
                             events=_rearmed_to(3.0, calls), progress=False)
-    assert result._driver == "c" and result.status == 1
+    assert result.status == 1
     assert len(calls) == 2
     assert calls[0][0] == pytest.approx(_crossing(5.0, -25.0, 4.0), abs=1e-9)
     assert calls[0][1] == pytest.approx(4.0, abs=1e-9)
@@ -209,7 +178,7 @@ def test_rearm_is_ignored_by_scipy_and_exact_flight(method, exact_flight):
     result = ballc.simulate(scene, 1.0, method=method, rtol=1e-10, atol=1e-10,
                             events=_rearmed_to(3.0, calls), exact_flight=exact_flight,
                             progress=False)
-    assert result._driver == "c" and result.status == 1 and not calls
+    assert result.status == 1 and not calls
     assert result.t_events[0] == pytest.approx([_crossing(5.0, -25.0, 4.0)], abs=1e-9)
 
 
@@ -232,7 +201,7 @@ def test_a_linear_event_of_several_states_in_exact_flight(method):
     row[Z], row[VZ] = 1.0, 0.1
     result = ballc.simulate(scene, 0.1, method=method, events=LinearEvent(row, -1.5),
                             progress=False)
-    assert result._driver == "c" and result.nfev == 0
+    assert result.nfev == 0
     # 5 - 25 t - g t^2 / 2 + 0.1 (-25 - g t) - 1.5 = 0
     a, b, c = -G / 2, -25.0 - 0.1 * G, 5.0 - 2.5 - 1.5
     root = (-b - math.sqrt(b * b - 4 * a * c)) / (2 * a)
@@ -245,7 +214,7 @@ def test_a_linear_event_in_exact_flight_records_its_crossing(terminal):
     LinearEvent's crossing was lost (t_events empty).  Oracle: the parabola's."""
     result = ballc.simulate(ballc.Scene(observer_mass=0.0), 0.1, progress=False,
                             events=LinearEvent.of_state("z", offset=-3.0, terminal=terminal))
-    assert result._driver == "c" and result.nfev == 0
+    assert result.nfev == 0
     assert result.t_events[0] == pytest.approx([_crossing(5.0, -25.0, 3.0)], abs=1e-12)
     assert result.y_events[0][:, Z] == pytest.approx([3.0], abs=1e-12)
     assert result.status == int(terminal)
@@ -281,22 +250,9 @@ def test_any_number_of_user_events(method):
             events.append(lambda t, y, h=h: y[Z] - h)
     result = ballc.simulate(ballc.Scene(), 0.12, method=method, rtol=1e-10, atol=1e-10,
                             events=events, progress=False)
-    assert result._driver == "c" and len(result.t_events) == 60
+    assert len(result.t_events) == 60
     expected = [[_crossing(5.0, -25.0, h)] for h in heights]
     np.testing.assert_allclose(np.array(result.t_events), expected, atol=1e-9)
-
-
-@pytest.mark.parametrize("kwargs", [
-    dict(method="Radau"), dict(method="LSODA"), dict(atol=np.full(N, 1e-3)),
-    dict(events=[LinearEvent(np.eye(N)[Z] + np.eye(N)[X], -1.0)]),
-    dict(events=[_Height(1.0)]), dict(events=[_Counted(np.eye(N)[Z], -1.0)]),
-    dict(events=[_rearmed_to(3.0, [])]),
-], ids=["Radau", "LSODA", "atol per state", "several states", "subclass",
-        "own __call__", "rearm"])
-@pytest.mark.parametrize("progress", [False, True])
-def test_what_fell_back_runs_in_the_c_loop(kwargs, progress):
-    scene = ballc.Scene(observer_mass=0.0)   # exact flight applies
-    assert _c_config(scene, 0.5, progress, **kwargs) is not None
 
 
 # ---- the progress bar ----
@@ -323,7 +279,7 @@ def test_the_progress_bar_is_advanced_from_c_to_the_end(monkeypatch):
         return bars[-1] if progress else None
     monkeypatch.setattr(DRIVER, "progress_bar", progress_bar)
     result = ballc.simulate(ballc.Scene(), 2.0, method="dop853", progress=True)
-    assert result._driver == "c" and len(bars) == 1
+    assert result.status == 0 and len(bars) == 1
     bar = bars[0]
     assert bar.closed and bar.n == 2.0 and np.all(np.diff(bar.seen) >= 0)
 
@@ -333,14 +289,15 @@ def test_the_progress_reports_are_throttled_in_wall_time(method):
     """Reports come at most every poll_interval s of wall time: none from C with an
     interval longer than any run, one at least per segment with none."""
     scene = ballc.Scene()
-    config = _c_config(scene, 1.0, method=method, rtol=1e-6, atol=1e-6)
+    run = run_constants(scene, check_options(scene, 1.0, method=method, rtol=1e-6,
+                                             atol=1e-6), True)
     y0 = scene.initial_state()
     never, always = _Bar(1.0), _Bar(1.0)
-    quiet = _core.drive(config["params"], y0, dict(config, poll_interval=1e9), never)
-    loud = _core.drive(config["params"], y0, dict(config, poll_interval=1e-300), always)
-    assert quiet["segments"] == loud["segments"] >= 5
+    quiet = _core.drive(scene_constants(scene), y0, dict(run, poll_interval=1e9), never)
+    loud = _core.drive(scene_constants(scene), y0, dict(run, poll_interval=1e-300), always)
+    assert quiet.segments == loud.segments >= 5
     assert never.seen == []
-    assert len(always.seen) >= loud["segments"] and np.all(np.diff(always.seen) >= 0)
+    assert len(always.seen) >= loud.segments and np.all(np.diff(always.seen) >= 0)
     assert 0 < always.seen[-1] <= 1.0
 
 

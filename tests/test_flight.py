@@ -8,7 +8,6 @@ import pytest
 
 import ballc
 from ballc import _core, events as ev, flight, layout, outcome
-from ballc.integrate import integrate_segment
 from ballc.scene import SceneError
 
 TIGHT = dict(rtol=1e-12, atol=1e-12)
@@ -22,16 +21,16 @@ def flying_scene(**changes):
     return ballc.Scene(**values)
 
 
-def flight_segment(scene, y0=None, t_end=5.0, exact=True, t_eval=None, dense_output=False,
-                   extra_events=(), method="radau5"):
-    y0 = scene.initial_state() if y0 is None else y0
-    system = _core.System(scene.parameter_vector(), LATCH, 0)
-    driver = ev.segment_events(scene, {"floor": False, "ceiling": False}, y0)
-    sol = integrate_segment(system, 0.0, t_end, y0, [e for _, _, e in driver]
-                            + list(extra_events), method=method, t_eval=t_eval,
-                            max_step=np.inf, dense_output=dense_output, exact_flight=exact,
-                            **TIGHT)
-    return sol, driver
+def flown(scene, t_end=5.0, exact=True, **kw):
+    """The run up to its first contact start (a terminal user event there: the contact
+    start's own event is the C loop's), at 1e-12, exact flight on or off."""
+    return ballc.simulate(scene, t_end, exact_flight=exact, progress=False, **TIGHT, **kw)
+
+
+def first_contact(run):
+    """(t, state) where the run's first contact started."""
+    k = int(np.flatnonzero(run.t == run.contacts[0].t_start)[0])
+    return run.t[k], run.y[:, k]
 
 
 def test_exact_solution_satisfies_the_compiled_rhs():
@@ -57,58 +56,63 @@ def test_exact_solution_satisfies_the_compiled_rhs():
          velocity=(0.1, 0.0, -3.0)),                            # no gravity: linear z
 ])
 def test_exact_flight_equals_radau5(changes):
+    """The C loop's closed-form flight (no right-hand-side call) and its contact start,
+    the root of the start's own event, against radau5 at 1e-12 on the same flight."""
     scene = flying_scene(**changes)
-    exact, driver = flight_segment(scene)
-    assert exact.exact_flight and exact.nfev == 0 and exact.status == 1
-    integrated, _ = flight_segment(scene, exact=False)
-    assert integrated.nfev > 0 and integrated.status == 1
-    for te_a, te_b, ye_a, ye_b in zip(exact.t_events, integrated.t_events, exact.y_events,
-                                      integrated.y_events):
-        assert len(te_a) == len(te_b)
-        np.testing.assert_allclose(te_a, te_b, rtol=0, atol=1e-9)
-        np.testing.assert_allclose(ye_a, ye_b, rtol=0, atol=1e-9)
-    # the contact start is the root of exactly the driver's event: its residual is rounding
-    index = [k for k, t in enumerate(exact.t_events) if len(t)][0]
-    event = driver[index][2]
-    assert abs(event(0, exact.y_events[index][0])) < 1e-14
-    assert exact.t[-1] == exact.t_events[index][0]
-    # samples at the integrator's times
-    t_eval = np.linspace(0, exact.t[-1], 17)[1:-1]
-    on, _ = flight_segment(scene, t_eval=t_eval)
-    off, _ = flight_segment(scene, t_eval=t_eval, exact=False)
+    t_end = 5.0
+    exact, integrated = flown(scene, t_end), flown(scene, t_end, exact=False)
+    first = exact.segments[0]
+    assert (first["method"], first["nfev"], first["end"]) == ("flight", 0, "enter")
+    assert integrated.segments[0]["nfev"] > 0
+    (t_a, y_a), (t_b, y_b) = first_contact(exact), first_contact(integrated)
+    assert abs(t_a - t_b) <= 1e-9
+    np.testing.assert_allclose(y_a[:13], y_b[:13], rtol=0, atol=1e-9)
+    # the contact start is the root of rho - threshold, threshold 4 ulp of the plane's
+    # height: rho there is that threshold, to rounding
+    plane = exact.contacts[0].plane
+    rho = ev.penetration(plane, scene)(0.0, y_a)
+    assert abs(rho - ev.threshold_base(scene, plane)) < 1e-14
+    # samples at given times within the flight
+    t_eval = np.linspace(0, t_a, 17)[1:-1]
+    on = ballc.simulate(scene, t_a, t_eval=t_eval, progress=False, **TIGHT)
+    off = ballc.simulate(scene, t_a, t_eval=t_eval, exact_flight=False, progress=False,
+                         **TIGHT)
     np.testing.assert_array_equal(on.t, t_eval)
+    assert on.nfev == 0
     np.testing.assert_allclose(on.y, off.y, rtol=0, atol=1e-9)
 
 
 def test_no_event_reaches_t_end():
     scene = flying_scene(velocity=(1.0, 2.0, 0.5), position=(0, 0, 4.0))
-    exact, _ = flight_segment(scene, t_end=0.2)
-    integrated, _ = flight_segment(scene, t_end=0.2, exact=False)
-    assert exact.status == integrated.status == 0
+    exact, integrated = flown(scene, 0.2), flown(scene, 0.2, exact=False)
+    assert exact.status == integrated.status == 0 and exact.nfev == 0
     assert exact.t[0] == 0.0 and exact.t[-1] == 0.2 and exact.t.size >= 33
-    assert all(len(t) == 0 for t in exact.t_events)
+    assert not exact.contacts
     np.testing.assert_allclose(exact.y[:, -1], integrated.y[:, -1], rtol=0, atol=1e-10)
 
 
 def test_default_samples_resolve_the_rotation():
     scene = flying_scene(angular_velocity=(0.0, 0.0, 200.0))
-    sol, _ = flight_segment(scene)
-    turn = 200.0 * np.diff(sol.t)
+    run = flown(scene, 0.5)
+    flight_end = run.contacts[0].t_start if run.contacts else run.t[-1]
+    t = run.t[run.t <= flight_end]
+    turn = 200.0 * np.diff(t)
     assert turn.max() <= flight.MAX_TURN * (1 + 1e-12)
-    assert np.all(np.diff(sol.t) > 0)
+    assert np.all(np.diff(t) > 0)
 
 
 def test_energy_constant_in_flight():
     scene = flying_scene()
     y0 = scene.initial_state()
     y0[13:] = [0.25, 0.5, 1e-6, -2e-6, 3e-6, 4e-6]    # dissipated work, deflections
-    sol, _ = flight_segment(scene, y0=y0)
-    energy = _core.energies(np.ascontiguousarray(sol.y.T), scene.parameter_vector())
+    run = ballc.simulate(scene, 0.3, y0=y0, progress=False)
+    assert not run.contacts and run.nfev == 0
+    energy = _core.energies(np.ascontiguousarray(run.y.T), scene.parameter_vector())
     total = energy[:, 0] + energy[:, 1]
     assert np.ptp(total) <= 1e-13 * total[0]
-    np.testing.assert_array_equal(sol.y[13:], np.repeat(y0[13:, None], sol.t.size, axis=1))
-    omega = sol.y[layout.ANGULAR_VELOCITY]
-    np.testing.assert_array_equal(omega, np.repeat(y0[7:10, None], sol.t.size, axis=1))
+    np.testing.assert_array_equal(run.y[13:], np.repeat(y0[13:, None], run.t.size, axis=1))
+    omega = run.y[layout.ANGULAR_VELOCITY]
+    np.testing.assert_array_equal(omega, np.repeat(y0[7:10, None], run.t.size, axis=1))
 
 
 def _exact_polynomial(c0, c1, c2, s):
@@ -125,7 +129,7 @@ def _exact_polynomial(c0, c1, c2, s):
 ])
 def test_roots_are_correct_to_rounding(c0, c1, c2):
     """Oracle: the sign of the quadratic in exact rational arithmetic two ulps either side."""
-    roots = flight.crossings(c0, c1, c2, 0, np.inf)
+    roots = _core.flight_crossings(c0, c1, c2, 0, np.inf)
     assert roots
     for s in roots:
         below, above = s - 2 * np.spacing(s), s + 2 * np.spacing(s)
@@ -133,50 +137,53 @@ def test_roots_are_correct_to_rounding(c0, c1, c2):
 
 
 def test_crossing_directions_and_tangency():
+    crossings = _core.flight_crossings   # the C loop's, which locates flight's events
     # opening upwards, roots 1 and 3: falls through 1, rises through 3
-    assert flight.crossings(3.0, -4.0, 1.0, 0, 10) == [1.0, 3.0]
-    assert flight.crossings(3.0, -4.0, 1.0, 1, 10) == [3.0]
-    assert flight.crossings(3.0, -4.0, 1.0, -1, 10) == [1.0]
-    assert flight.crossings(3.0, -4.0, 1.0, 0, 2) == [1.0]
-    assert flight.crossings(4.0, -4.0, 1.0, 0, 10) == []      # tangent at 2: no sign change
-    assert flight.crossings(1.0, 0.0, 1.0, 0, 10) == []
+    assert crossings(3.0, -4.0, 1.0, 0, 10) == [1.0, 3.0]
+    assert crossings(3.0, -4.0, 1.0, 1, 10) == [3.0]
+    assert crossings(3.0, -4.0, 1.0, -1, 10) == [1.0]
+    assert crossings(3.0, -4.0, 1.0, 0, 2) == [1.0]
+    assert crossings(4.0, -4.0, 1.0, 0, 10) == []      # tangent at 2: no sign change
+    assert crossings(1.0, 0.0, 1.0, 0, 10) == []
 
 
 def test_user_linear_event_located_exactly():
     """A user's LinearEvent (the apex, vz = 0, falling) is located in closed form."""
     scene = flying_scene()
     apex = ev.LinearEvent.of_state("vz", 1.0, 0.0, False, -1)
-    exact, driver = flight_segment(scene, extra_events=[apex])
-    integrated, _ = flight_segment(scene, extra_events=[apex], exact=False)
-    assert exact.nfev == 0
     t_apex = scene.velocity[2] / scene.gravity
-    np.testing.assert_allclose(exact.t_events[-1], [t_apex], rtol=1e-15)
-    np.testing.assert_allclose(integrated.t_events[-1], [t_apex], rtol=1e-9)
+    exact = flown(scene, 0.8, events=[apex])
+    integrated = flown(scene, 0.8, events=[apex], exact=False)
+    assert exact.nfev == 0 and integrated.nfev > 0
+    np.testing.assert_allclose(exact.t_events[0], [t_apex], rtol=1e-15)
+    np.testing.assert_allclose(integrated.t_events[0], [t_apex], rtol=1e-9)
 
 
 def test_dense_output_is_the_exact_solution():
     scene = flying_scene()
-    sol, _ = flight_segment(scene, dense_output=True)
-    np.testing.assert_array_equal(sol.interpolant(sol.t), sol.y)
-    assert sol.interpolant.t_max == sol.t[-1]
+    run = flown(scene, 0.3, dense_output=True)
+    assert run.nfev == 0 and not run.contacts
+    (_, _, piece), = run.sol.pieces
+    assert isinstance(piece, flight.FreeFlight) and piece.t_max == run.t[-1]
+    np.testing.assert_array_equal(run.sol(run.t), run.y)
 
 
-@pytest.mark.parametrize("why", ["callable event", "anisotropic", "observer", "off"])
+@pytest.mark.parametrize("why", ["callable event", "quaternion event", "anisotropic",
+                                 "observer", "off"])
 def test_fallbacks_integrate(why):
+    """Exact flight only where it is exact: a callable user event, a LinearEvent of the
+    quaternion (not polynomial in flight), anisotropic inertia, a massive observer, or
+    exact_flight=False integrate the flight (the log names the integrator)."""
     scene = flying_scene(inertia=(0.4, 0.4, 0.41) if why == "anisotropic" else None,
                          observer_mass=1e-4 if why == "observer" else 0.0)
-    extra = [lambda t, y: y[layout.INDEX["vz"]]] if why == "callable event" else []
-    flags = ballc.modes.flags(scene, {"floor": False, "ceiling": False})
-    y0 = scene.initial_state()
-    system = _core.System(scene.parameter_vector(), LATCH, flags)
-    driver = [e for _, _, e in ev.segment_events(scene, {"floor": False, "ceiling": False},
-                                                 y0)]
-    sol = integrate_segment(system, 0.0, 5.0, y0, driver + extra, method="radau5",
-                            t_eval=None, max_step=np.inf, exact_flight=why != "off", **TIGHT)
-    assert sol.nfev > 0 and not getattr(sol, "exact_flight", False)
-    result = ballc.simulate(scene, 0.3, events=extra or None,
-                            exact_flight=why != "off", progress=False)
+    extra = {"callable event": [lambda t, y: y[layout.INDEX["vz"]]],
+             "quaternion event": [ev.LinearEvent.of_state("qx", 1.0, 2.0)]}.get(why)
+    result = ballc.simulate(scene, 0.3, events=extra, exact_flight=why != "off",
+                            progress=False)
     assert result.nfev > 0
+    assert "flight" not in set(result.segments["method"])
+    if why in ("callable event", "off"):   # the same scene flies where nothing stops it
+        assert ballc.simulate(scene, 0.3, progress=False).segments[0]["method"] == "flight"
 
 
 def test_simulate_flight_only_costs_nothing_for_any_method():
@@ -226,3 +233,17 @@ def test_whole_run_agrees_with_the_integrated_flight(changes, rtol):
             assert np.max(np.abs(quantity(run) - quantity(reference))) <= 3e-4
     balance = on.energy["balance"]
     assert abs(balance[-1] - balance[0]) <= 1e-6 * abs(balance[0])
+
+
+def test_a_flight_too_long_to_sample_stops_honestly():
+    """A ball floating without gravity, spinning, for 1e9 s: its exact flight would store
+    ~5e10 samples (pi/16 of turn each).  The run stops at once with status -1 and says
+    why and what to do, keeping what was computed (the start); with t_eval it runs."""
+    scene = ballc.Scene(gravity=0.0, observer_mass=0.0, velocity=(0.0, 0.0, 0.0),
+                        angular_velocity=(0.0, 0.0, 10.0))
+    run = ballc.simulate(scene, 1e9, progress=False)
+    assert run.status == -1 and "more than 1e8 samples" in run.message
+    assert "t_eval" in run.message and run.t.tolist() == [0.0]
+    sampled = ballc.simulate(scene, 1e9, t_eval=[0.0, 5e8, 1e9], progress=False)
+    assert sampled.status == 0 and sampled.nfev == 0
+    np.testing.assert_allclose(sampled.angular_velocity[:, -1], (0.0, 0.0, 10.0), rtol=0)

@@ -5,13 +5,12 @@ bounces 20 times, stays in contact from t = 16.44 s, and its normal oscillation 
 out; it is at rest by t = 29.4 s.  The seed scene itself never rests: it rolls.
 """
 import math
-import sys
 
 import numpy as np
 import pytest
 
 import ballc
-from ballc import resting
+from ballc import loop_constants, resting
 
 Z = ballc.STATE_NAMES.index("z")
 
@@ -108,7 +107,7 @@ def test_the_first_rest_check_comes_after_the_seed_s_first_5_seconds():
 
 def test_observer_free_seed_rolls_in_closed_form():
     """The seed's throw without the observer rolls uniformly from t ~ 31 s: entered by
-    resting.rolls, then exact (ballc.flight.FreeFlight with g = 0).  Oracle: the
+    the C loop's uniform check, then exact (ballc.flight.FreeFlight with g = 0).  Oracle: the
     integrated run (rest=False), which keeps v and omega to 10 digits."""
     scene = ballc.Scene().replace(observer_mass=0.0)
     closed = ballc.simulate(scene, 2000)
@@ -133,7 +132,7 @@ def test_observer_free_seed_rolls_in_closed_form():
 
 def test_the_seed_observer_keeps_the_rolling_out_of_the_uniform_closed_form():
     """With the seed's observer (1e-4 kg off centre) rolling is not uniform (its
-    direction wanders): resting.rolls refuses it, and up to 60 s (before ballc.orbit's
+    direction wanders): the uniform check refuses it, and up to 60 s (before ballc.orbit's
     first trial ends, tests/test_orbit.py) the run integrates on."""
     run = ballc.simulate(ballc.Scene(), 60)
     assert "rolls" not in run.message and math.isnan(run.contacts[-1].t_rolling)
@@ -160,32 +159,15 @@ def documented_bound(scene, rtol, atol):
 
 
 def test_at_rest_is_the_documented_energy_bound(drop):
-    """resting.at_rest, and the bound the C loop is given, at states built here whose
-    energy above rest is a known fraction of the documented bound: 1/2 m vz^2 exactly
-    (a vertical velocity at the equilibrium), or 1/2 k_lin dz^2 to ~dz / rho_eq (a
-    displacement from it: the Hertz spring's cubic term).  0.9 of the bound is at rest,
-    1.1 is not."""
+    """The rest checks' bound the C loop is given is the documented one, written out
+    here from the docstring (min(1/2 k_lin dx^2, 1/2 m dv^2), k0 by hand); the C loop's
+    decisions against it at its check times: the next test."""
     rtol, atol = 1e-10, 1e-10
     bound = documented_bound(drop, rtol, atol)
-    m = drop.mass
-    k0 = hertz_k0(drop)
-    rho_eq = (m * drop.gravity / k0) ** (2 / 3)
-    k_lin = 1.5 * k0 * math.sqrt(rho_eq)
-    period = 2 * math.pi * math.sqrt(m / k_lin)
-    t_start, t = 0.0, 25 * period          # the contact old enough (criterion 2)
-    rest = drop.initial_state()
-    rest[Z] = drop.radius - rho_eq
-    for share, expected in ((0.9, True), (1.1, False)):
-        moving = rest.copy()
-        moving[VZ] = math.sqrt(2 * share * bound / m)
-        assert bool(resting.at_rest(drop, moving, "floor", t_start, t, rtol, atol)) is expected
-        pressed = rest.copy()
-        pressed[Z] -= math.sqrt(2 * share * bound / k_lin)
-        assert bool(resting.at_rest(drop, pressed, "floor", t_start, t, rtol, atol)) is expected
-    # the bound the C loop compares with
-    config = sys.modules["ballc.simulate"]._c_config(
-        drop, ballc.options.check_options(drop, 100.0, rtol=rtol, atol=atol), False, True)
+    options = ballc.options.check_options(drop, 100.0, rtol=rtol, atol=atol)
+    config = loop_constants.run_constants(drop, options, True)
     assert config["rest_threshold"] == pytest.approx(bound, rel=1e-12)
+    assert config["checks_rest"] == 1
 
 
 @pytest.mark.parametrize("height, c_tau", [(5.0, None), (0.5, 0.9)])

@@ -70,17 +70,12 @@ def test_t_eval_is_honoured():
     np.testing.assert_array_equal(result.t, t_eval)
 
 
-@pytest.mark.parametrize("driver", ["c", "python"])
-def test_t_eval_is_honoured_across_the_compliant_step_bound(driver, monkeypatch):
+def test_t_eval_is_honoured_across_the_compliant_step_bound():
     """A compliant contact's step bound ends segments before t_end; each segment must
     get only the t_eval times within it (before the fix: ValueError "t_eval must be ...
     within t_span", found by tests/test_properties.py's mirror test).  A ball starting
-    at rest on the floor, so the contact is open from t = 0.  Both drivers (the C loop
-    takes each segment's points as a range; the Python driver hands them over)."""
-    if driver == "python":
-        monkeypatch.setenv("BALLC_PYTHON_DRIVER", "1")
-    else:
-        monkeypatch.delenv("BALLC_PYTHON_DRIVER", raising=False)
+    at rest on the floor, so the contact is open from t = 0.  The C loop
+    takes each segment's points as a range."""
     scene = ballc.Scene(observer_mass=0.0, ceiling_height=3.0, ball_youngs_modulus=1e7,
                         c_tau=1.0, friction_coefficient=1.0, tangential_model="compliant",
                         tangential_stiffness_ratio=1.0, position=(0.0, 0.0, 1.0),
@@ -88,7 +83,6 @@ def test_t_eval_is_honoured_across_the_compliant_step_bound(driver, monkeypatch)
     t_eval = np.linspace(0, 0.3, 31)
     result = ballc.simulate(scene, 0.3, rtol=1e-10, atol=1e-12, t_eval=t_eval)
     assert result.status == 0, result.message
-    assert result._driver == driver
     np.testing.assert_array_equal(result.t, t_eval)
 
 
@@ -195,3 +189,24 @@ def test_an_absolute_tolerance_below_the_contact_depth_rounding_is_named():
     assert "regularised" not in stuck.message
     fine = ballc.simulate(scene, 3.0, rtol=1e-12, atol=1e-10, max_nfev=200_000, rest=False)
     assert fine.status == 0
+
+
+@pytest.mark.parametrize("method", ["dop853", "radau5", "RK45"])
+def test_a_user_event_that_raises_stops_the_run_with_its_exception(method):
+    """The C loop calls a user's event back: an exception it raises reaches the caller
+    as it is, and a NaN it returns is a ValueError naming the event and the time."""
+    def bad(t, y):
+        if t > 0.5:
+            raise KeyError("boom")
+        return 1.0
+
+    def never(t, y):
+        return 1.0
+
+    def nan(t, y):
+        return float("nan") if t > 0.5 else 1.0
+    with pytest.raises(KeyError, match="boom"):
+        ballc.simulate(ballc.Scene(), 2.0, method=method, events=[bad], progress=False)
+    with pytest.raises(ValueError, match=r"events\[1\] returned nan at t = "):
+        ballc.simulate(ballc.Scene(), 2.0, method=method, events=[never, nan], rtol=1e-6,
+                       atol=1e-6, progress=False)

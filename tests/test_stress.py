@@ -206,7 +206,7 @@ def _at_most_segments(result, limit):
         f"no progress: {len(segments)} segments, t = {segments['t_end'][-1]!r}")
 
 
-@stress   # radau5 evaluates the events in C; events.contact_threshold keeps segments off zero
+@stress   # the C loop's contact thresholds (events.threshold_base) keep segments off zero
 def test_radau5_leaving_slowly_does_not_loop_at_the_contact_boundary():
     scene = ballc.Scene(position=(0.0, 0.0, 1.0), velocity=(0.0, 0.0, 0.004),
                         ball_youngs_modulus=2e11, plane_youngs_modulus=2e11,

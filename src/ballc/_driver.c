@@ -1,10 +1,12 @@
-/* See _driver.h.  Each step names the Python it reproduces (file:function); the
- * floating-point operations are those of the Python, in its order.  Compiled with the
- * rest of the extension: -std=c99, so no FP contraction (never -ffast-math). */
+/* See _driver.h: the segment loop, the one driver of ballc.simulate (docs/driver.md).
+ * Each handler is named after the row of ballc.automaton.TRANSITIONS it applies.
+ * Compiled with the rest of the extension: -std=c99, so no FP contraction (never
+ * -ffast-math). */
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
 #include <time.h>
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,120 +21,23 @@
 #define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
 #define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
 
-/* stickslip.py constants */
-#define CLEAR_FACTOR 100.0
-#define PASS_FACTOR 3.0
-#define STOP_FACTOR 10.0
-#define APPROACH_FRACTION 0.5
-#define MAX_RELATCH 1000
-#define MAX_TRANSITIONS 100000
-#define MAX_STALLED 100
-#define MIN_IMPACT_RATE 1e-9
+#define CLEAR_FACTOR BALLC_CLEAR_FACTOR
+#define PASS_FACTOR BALLC_PASS_FACTOR
+#define STOP_FACTOR BALLC_STOP_FACTOR
+#define APPROACH_FRACTION BALLC_APPROACH_FRACTION
+#define MAX_RELATCH BALLC_MAX_RELATCH
+#define MAX_TRANSITIONS BALLC_MAX_TRANSITIONS
+#define MAX_STALLED BALLC_MAX_STALLED
+#define MIN_IMPACT_RATE BALLC_MIN_IMPACT_RATE
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
 
-/* ---- numerics that must match CPython and numpy ---- */
+/* |v| of 3 values, the unit in the last place of |x| */
+static double norm3(const double *v) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+static double ulp(double x) { x = fabs(x); return nextafter(x, INFINITY) - x; }
 
-/* CPython 3.11 Modules/mathmodule.c: vector_norm, verbatim (asserts dropped). */
-static double vector_norm(long n, double *vec, double max, int found_nan)
-{
-    const double T27 = 134217729.0;     /* ldexp(1.0, 27) + 1.0) */
-    double x, scale, oldcsum, csum = 1.0, frac1 = 0.0, frac2 = 0.0, frac3 = 0.0;
-    double t, hi, lo, h;
-    int max_e;
-    long i;
-
-    if (isinf(max)) {
-        return max;
-    }
-    if (found_nan) {
-        return NAN;
-    }
-    if (max == 0.0 || n <= 1) {
-        return max;
-    }
-    frexp(max, &max_e);
-    if (max_e < -1023) {
-        /* When max_e < -1023, ldexp(1.0, -max_e) would overflow. */
-        for (i = 0; i < n; i++) {
-            vec[i] /= DBL_MIN;          /* convert subnormals to normals */
-        }
-        return DBL_MIN * vector_norm(n, vec, max / DBL_MIN, found_nan);
-    }
-    scale = ldexp(1.0, -max_e);
-    for (i = 0; i < n; i++) {
-        x = vec[i];
-        x *= scale;
-        t = x * T27;
-        hi = t - (t - x);
-        lo = x - hi;
-        x = hi * hi;
-        oldcsum = csum;
-        csum += x;
-        frac1 += (oldcsum - csum) + x;
-        x = 2.0 * hi * lo;
-        oldcsum = csum;
-        csum += x;
-        frac2 += (oldcsum - csum) + x;
-        frac3 += lo * lo;
-    }
-    h = sqrt(csum - 1.0 + (frac1 + frac2 + frac3));
-    x = h;
-    t = x * T27;
-    hi = t - (t - x);
-    lo = x - hi;
-    x = -hi * hi;
-    oldcsum = csum;
-    csum += x;
-    frac1 += (oldcsum - csum) + x;
-    x = -2.0 * hi * lo;
-    oldcsum = csum;
-    csum += x;
-    frac2 += (oldcsum - csum) + x;
-    x = -lo * lo;
-    oldcsum = csum;
-    csum += x;
-    frac3 += (oldcsum - csum) + x;
-    x = csum - 1.0 + (frac1 + frac2 + frac3);
-    return (h + x / (2.0 * h)) / scale;
-}
-
-/* CPython math_hypot (n <= 8 here). */
-double ballc_py_hypot(int n, const double *values)
-{
-    double coordinates[8], max = 0.0;
-    int found_nan = 0;
-    for (int i = 0; i < n; i++) {
-        double x = fabs(values[i]);
-        coordinates[i] = x;
-        found_nan |= isnan(x);
-        if (x > max) max = x;
-    }
-    return vector_norm(n, coordinates, max, found_nan);
-}
-
-/* CPython math_ulp_impl. */
-double ballc_py_ulp(double x)
-{
-    if (isnan(x)) return x;
-    x = fabs(x);
-    if (isinf(x)) return x;
-    double x2 = nextafter(x, INFINITY);
-    if (isinf(x2)) {
-        x2 = nextafter(x, -INFINITY);
-        return x - x2;
-    }
-    return x2 - x;
-}
-
-/* numpy float64 v.dot(v), length 3 (OpenBLAS ddot with FMA on this machine). */
-double ballc_dot3_fma(const double *v)
-{
-    return fma(v[2], v[2], fma(v[1], v[1], v[0] * v[0]));
-}
-
-/* Python max(a, b) / min(a, b) on floats: the first unless the second is larger/smaller. */
+/* max(a, b) / min(a, b): the first unless the second is larger/smaller */
 static double py_max(double a, double b) { return b > a ? b : a; }
 static double py_min(double a, double b) { return b < a ? b : a; }
 
@@ -159,7 +64,7 @@ void ballc_drive_free(ballc_drive_output *o)
     o->block_count = NULL; o->block_flags = NULL; o->contacts = NULL; o->phases = NULL;
 }
 
-/* ---- the run (simulate.py: _Run) ---- */
+/* ---- the run: contacts, modes and latches between segments ---- */
 
 typedef struct {
     const ballc_drive_config *c;
@@ -175,7 +80,8 @@ typedef struct {
     double dissipated_at_start[2][2];
     double rest_check[2];
     int status, stop_code, stop_plane;
-    int failed_kernel;          /* a C kernel failed where Python raises: fall back */
+    int failed_kernel;          /* a C kernel failed: the run is aborted */
+    const char *why;            /* why the run was aborted (BALLC_DRIVE_ABORTED) */
     /* this segment's re-arms: (t, latch before) */
     long n_rearmed, cap_rearmed;
     double *rearmed_t, *rearmed_latch;
@@ -190,10 +96,10 @@ typedef struct {
     double *flight_s;                /* exact flight's hits (s, event), 2 per event, */
     int *flight_e, *flight_seen;     /*   and their counts */
     int seg_flags;
-    /* the user's events (stage 4): occurrences so far, a callback's error */
+    /* the user's events: occurrences so far, a callback's error */
     long *user_seen;
     int user_failed;
-    /* the compliant law's modes (stage 3): per plane */
+    /* the compliant law's modes: per plane */
     int compliant[2], armed[2], capacity_row[2];   /* COMPLIANT_*, bool, -1 or 4/5 */
     int has_step[2];
     double step_bound[2], step_until[2];           /* contact_step: (bound, until) */
@@ -201,12 +107,12 @@ typedef struct {
     /* the bridge's _ball_event cache: the last compliant margins computed */
     double margins_y[N], margins_out[6];
     int margins_plane, margins_solved;
-    /* ballc.orbit: the trial under way (_Run.orbit_trial: its plane, span, period guess
+    /* ballc.orbit: the trial under way (its plane, span, period guess
      * and segments; broken by an event), and whether the last one was just refused */
     int trial_on, trial_plane, trial_broken, trial_failed;
     double trial_from, trial_to, trial_guess;
     ballc_dense trial;
-    /* issue 29b: the last poll (wall time, s), whether one stopped the run, and the
+    /* the last poll (wall time, s), whether one stopped the run, and the
      * segment integrator's own interpolant (-1: its dense steps are in the result) */
     double polled;
     int interrupted;
@@ -240,7 +146,7 @@ const char *const ballc_segment_end_names[BALLC_N_SEGMENT_ENDS] = {
     "yield", "restick", "capacity", "user", "t_end", "rest check", "uniform check",
     "orbit check", "step bound", "failed"};
 
-/* _Run.mode: plane p's mode now (BALLC_PLANE_*) */
+/* plane p's mode now (BALLC_PLANE_*, ballc.automaton.MODES) */
 static int plane_mode(const run_t *r, int p)
 {
     if (!r->in_contact[p])
@@ -299,14 +205,15 @@ static int log_close(run_t *r, int end, int plane, double t_end)
     return 0;
 }
 
-/* _Run.flags */
+/* the segment's right-hand-side flags: the observer's kernels (when it has mass), each
+ * contact's laws and, ``with_coulomb``, its exact Coulomb mode or compliant mode */
 static int run_flags(const run_t *r, int with_coulomb)
 {
     const ballc_drive_config *c = r->c;
     int flags = c->observer_bits;
     for (int p = 0; p < 2; p++) {
         if (!r->in_contact[p]) continue;
-        if (c->compliant_modes) {   /* compliantmodes.mode_flags */
+        if (c->compliant_modes) {   /* the law's mode: sliding, elastic once armed */
             if (r->compliant[p] == COMPLIANT_SLIDING) flags |= c->sliding_bits[p];
             else if (r->compliant[p] == COMPLIANT_ELASTIC && r->armed[p])
                 flags |= c->elastic_bits[p];
@@ -323,13 +230,13 @@ static int run_flags(const run_t *r, int with_coulomb)
     return flags;
 }
 
-/* events.LinearEvent.__call__ of the plane's penetration: scale * y[z] + offset */
+/* the plane's penetration rho (m): scale * y[z] + offset */
 static double rho_of(const run_t *r, int p, const double *y)
 {
     return r->c->rho_scale[p] * y[BALLC_STATE_Z] + r->c->rho_offset[p];
 }
 
-/* simulate.record_depth */
+/* keep a contact's deepest penetration and where it happened */
 static void record_depth(ballc_contact_rec *k, double depth, const double *y)
 {
     if (depth >= k->max_penetration) {
@@ -339,36 +246,43 @@ static void record_depth(ballc_contact_rec *k, double depth, const double *y)
     }
 }
 
-/* stickslip.speed_scale */
+/* |v| + r |omega| (m/s): the scale slip speeds are compared with */
 static double speed_scale(const run_t *r, const double *y)
 {
-    double s = ballc_py_hypot(3, y + BALLC_STATE_VX)
-               + r->c->radius * ballc_py_hypot(3, y + BALLC_STATE_OMEGA_X);
+    double s = norm3(y + BALLC_STATE_VX) + r->c->radius * norm3(y + BALLC_STATE_OMEGA_X);
     return s + 1e-300;
 }
 
-/* stickslip.error_speed */
+/* the slip velocity's integration error scale: rtol (|v| + r |omega|) + atol */
 static double error_speed(const run_t *r, const double *y)
 {
     return r->c->rtol * speed_scale(r, y) + r->c->atol;
 }
 
-/* _Run.slip: u, |u|, error, clear */
+/* u = du/dy . y, plane p's slip velocity (u is linear in the state: slip_map's rows) */
+static void slip_velocity(const run_t *r, int p, const double *y, double u[2])
+{
+    for (int row = 0; row < 2; row++) {
+        const double *m = r->c->slip_map[p][row];
+        double s = 0.0;
+        for (int j = 0; j < N; j++)
+            if (m[j] != 0.0) s += m[j] * y[j];
+        u[row] = s;
+    }
+}
+
+/* plane p's slip: u, |u|, its error scale and the clear speed */
 static void slip(const run_t *r, int p, const double *y, double u[2], double *speed,
                  double *error, double *clear)
 {
-    for (int row = 0; row < 2; row++) {
-        double s = 0.0;   /* sum(): int 0 + the first float, then float adds */
-        for (int k = 0; k < r->c->n_terms[p][row]; k++)
-            s += r->c->term_coef[p][row][k] * y[r->c->term_index[p][row][k]];
-        u[row] = s;
-    }
-    *speed = ballc_py_hypot(2, u);
+    slip_velocity(r, p, y, u);
+    *speed = hypot(u[0], u[1]);
     *error = error_speed(r, y);
     *clear = CLEAR_FACTOR * *error;
 }
 
-/* stickslip.passes_by_zero, with the latched direction */
+/* at an approach: whether the slip is clear of zero, or passes by it -- its part
+ * across the latched direction beyond PASS_FACTOR times the error -- and stays free */
 static int slips_on_freely(const run_t *r, int p, const double u[2], double speed,
                            double error, double clear)
 {
@@ -388,7 +302,7 @@ static int record_phase(run_t *r, int p, int phase)
         if (o->phases[i].contact == k) { last = i; break; }
     if (last >= 0 && o->phases[last].phase == phase) return 0;
     if (grow((void **)&o->phases, &o->cap_phases, o->n_phases + 1, sizeof(ballc_phase_rec)))
-        return -1;
+        return -2;
     o->phases[o->n_phases].contact = k;
     o->phases[o->n_phases].t = r->t;
     o->phases[o->n_phases].phase = phase;
@@ -396,7 +310,7 @@ static int record_phase(run_t *r, int p, int phase)
     return 0;
 }
 
-/* _Run.set_mode; direction may be NULL */
+/* enter Coulomb ``mode`` on plane p now (direction may be NULL: kept) */
 static int set_mode(run_t *r, int p, int mode, const double *direction,
                     int has_approach, double approach)
 {
@@ -411,13 +325,14 @@ static int set_mode(run_t *r, int p, int mode, const double *direction,
     return record_phase(r, p, mode == BALLC_MODE_STICK ? 1 : 0);
 }
 
-/* stickslip.force_scale */
+/* a force at rounding level of the stick force: 64 eps (weight + |load|) */
 static double force_scale(const run_t *r, double load)
 {
     return (64 * DBL_EPSILON) * (r->c->weight + fabs(load));
 }
 
-/* _Run.settle -> stickslip.settle */
+/* at zero slip: the slip projected to exactly zero, then stick when the constraint
+ * force lies in the friction cone, else slip from rest along -lambda */
 static int settle(run_t *r, int p)
 {
     int base = run_flags(r, 0);
@@ -431,7 +346,7 @@ static int settle(run_t *r, int p)
         r->failed_kernel = 1;
         return -1;
     }
-    double size = hypot(out[0], out[1]);   /* np.hypot: libm */
+    double size = hypot(out[0], out[1]);
     memcpy(r->y, y0, sizeof y0);
     if (out[3] >= -force_scale(r, out[2]) || size == 0)
         return set_mode(r, p, BALLC_MODE_STICK, NULL, 0, 0.0);
@@ -439,7 +354,8 @@ static int settle(run_t *r, int p)
     return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
 }
 
-/* _Run.start_coulomb */
+/* a contact's first Coulomb mode: free slip clear of zero, a held direction below
+ * that, settle at zero slip */
 static int start_coulomb(run_t *r, int p)
 {
     double u[2], speed, error, clear;
@@ -452,14 +368,14 @@ static int start_coulomb(run_t *r, int p)
     return settle(r, p);
 }
 
-/* ---- the compliant law's modes (ballc.compliantmodes; stage 3) ---- */
+/* ---- the compliant law's modes (ballc.compliantmodes) ---- */
 
 static int deflection_x(int p)
 {
     return p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X;
 }
 
-/* compliantmodes.margins (_core.compliant_margins); -1 where Python raises */
+/* the law's margins (ballc_compliant_margins); -1 when the kernel failed */
 static int margins_of(run_t *r, int p, const double *y, double *m)
 {
     if (ballc_compliant_margins(y, r->c->params, r->latch, p, m) != BALLC_OK) {
@@ -469,13 +385,14 @@ static int margins_of(run_t *r, int p, const double *y, double *m)
     return 0;
 }
 
-/* compliantmodes.at_cap: out = y with |s| = s_cap (only_down: not raised to it) */
+/* out = y with |s| = s_cap, the spring energy released booked as tangential work
+ * (only_down: a spring below the cap is left as it is) */
 static int at_cap(run_t *r, int p, const double *y, int only_down, double *out)
 {
     int sx = deflection_x(p);
     memcpy(out, y, N * sizeof(double));
     double s[2] = {out[sx], out[sx + 1]};
-    double size = ballc_py_hypot(2, s);
+    double size = hypot(s[0], s[1]);
     if (!(size > 0)) return 0;
     double m[BALLC_COMPLIANT_MARGINS];
     if (margins_of(r, p, out, m)) return -1;
@@ -488,17 +405,13 @@ static int at_cap(run_t *r, int p, const double *y, int only_down, double *out)
     return 0;
 }
 
-/* compliantmodes._along_slip: 1 and along (2), 0 without slip, -1 on failure */
+/* the deflection at the cap along the slip velocity: 1 and along (2), 0 without
+ * slip, -1 on failure */
 static int along_slip(run_t *r, int p, const double *y, double *along)
 {
     double u[2];
-    for (int row = 0; row < 2; row++) {   /* stickslip.slip_velocity_of */
-        double s = 0.0;
-        for (int k = 0; k < r->c->n_terms[p][row]; k++)
-            s += r->c->term_coef[p][row][k] * y[r->c->term_index[p][row][k]];
-        u[row] = s;
-    }
-    double speed = ballc_py_hypot(2, u);
+    slip_velocity(r, p, y, u);
+    double speed = hypot(u[0], u[1]);
     if (!(speed > 0)) return 0;
     double m[BALLC_COMPLIANT_MARGINS];
     if (margins_of(r, p, y, m)) return -1;
@@ -508,14 +421,15 @@ static int along_slip(run_t *r, int p, const double *y, double *along)
     return 1;
 }
 
-/* compliantmodes.decide (start: arming = 1): *mode and the new state */
+/* where the elastic spring meets the cap (a yield; arming = 1: a contact's start or
+ * its arming): *mode (sliding when the re-stick margin there is >= 0) and the state */
 static int decide(run_t *r, int p, const double *y, int arming, int *mode, double *out)
 {
     int sx = deflection_x(p);
     double trial[N];
     if (at_cap(r, p, y, 0, trial)) return -1;
     double s[2] = {y[sx], y[sx + 1]};
-    int relaxed = arming || !(ballc_py_hypot(2, s) > 0);
+    int relaxed = arming || !(hypot(s[0], s[1]) > 0);
     if (relaxed) {
         double along[2];
         int got = along_slip(r, p, y, along);
@@ -539,7 +453,7 @@ static int decide(run_t *r, int p, const double *y, int arming, int *mode, doubl
     return at_cap(r, p, y, 1, out);
 }
 
-/* _Run.set_compliant */
+/* enter the compliant ``mode`` on plane p now */
 static int set_compliant(run_t *r, int p, int mode)
 {
     r->compliant[p] = mode;
@@ -548,7 +462,8 @@ static int set_compliant(run_t *r, int p, int mode)
     return record_phase(r, p, mode == COMPLIANT_SLIDING ? 0 : 1);
 }
 
-/* _Run.begin_contact's compliant part (after the latch) */
+/* a compliant contact's start (after the latch): armed or not, its first mode, and
+ * its step bound (t_c / BALLC_STEPS_PER_CONTACT for BALLC_IMPACT_SPAN t_c) */
 static int start_compliant(run_t *r, int p, double rate)
 {
     const ballc_drive_config *c = r->c;
@@ -558,14 +473,14 @@ static int start_compliant(run_t *r, int p, double rate)
     if (decide(r, p, r->y, 1, &mode, y)) return -1;
     memcpy(r->y, y, sizeof y);
     if (set_compliant(r, p, mode)) return -1;
-    double t_c = c->contact_time_base * pow(rate, -0.2);   /* compliantmodes.step_bound */
+    double t_c = c->contact_time_base * pow(rate, -0.2);   /* Hertz's contact time */
     r->has_step[p] = 1;
-    r->step_bound[p] = t_c / 16;
-    r->step_until[p] = r->t + 4 * t_c;
+    r->step_bound[p] = t_c / BALLC_STEPS_PER_CONTACT;
+    r->step_until[p] = r->t + BALLC_IMPACT_SPAN * t_c;
     return 0;
 }
 
-/* _Run.max_step */
+/* the next segment's largest step: the user's, and a compliant impact's bound */
 static double run_max_step(const run_t *r)
 {
     double step = r->c->max_step;
@@ -574,7 +489,7 @@ static double run_max_step(const run_t *r)
     return step;
 }
 
-/* _Run.step_bound_end */
+/* when the next compliant step bound ends (inf: none) */
 static double step_bound_end(const run_t *r)
 {
     double end = INFINITY;
@@ -587,7 +502,8 @@ static double step_bound_end(const run_t *r)
     return end;
 }
 
-/* _Run.begin_contact (with modes.latch_values) */
+/* the automaton's "enter": latch rhodot^- and the dig-in direction (ballc.modes), relax
+ * the tangential spring, open the contact's record, pick its first mode */
 static int begin_contact(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
@@ -604,7 +520,7 @@ static int begin_contact(run_t *r, int p)
         rate = sqrt(rate * rate + stored);
         kernel_rate = 0;
     }
-    double speed = sqrt(ballc_dot3_fma(v)), direction[3];
+    double speed = norm3(v), direction[3];
     if (speed > 0) {
         for (int i = 0; i < 3; i++) direction[i] = v[i] / speed;
     } else {
@@ -620,7 +536,7 @@ static int begin_contact(run_t *r, int p)
     r->in_contact[p] = 1;
     if (grow((void **)&o->contacts, &o->cap_contacts, o->n_contacts + 1,
              sizeof(ballc_contact_rec)))
-        return -1;
+        return -2;
     ballc_contact_rec *rec = &o->contacts[o->n_contacts];
     memset(rec, 0, sizeof *rec);
     rec->plane = p;
@@ -645,7 +561,7 @@ static int begin_contact(run_t *r, int p)
     return 0;
 }
 
-/* _Run.end_contact */
+/* the automaton's "leave": close the contact's record */
 static void end_contact(run_t *r, int p)
 {
     ballc_drive_output *o = r->o;
@@ -666,7 +582,22 @@ static void end_contact(run_t *r, int p)
     rec->lost[1] = r->y[BALLC_STATE_DISSIPATED_TANGENTIAL] - r->dissipated_at_start[p][1];
 }
 
-/* _Run.stalled_at / unsettled / settles */
+/* the automaton's "through": the ball passed through plane p (rho reached r), the run
+ * stops with status 1; the contact's record is left open, its depth the radius */
+static void pass_through(run_t *r, int p)
+{
+    ballc_drive_output *o = r->o;
+    ballc_contact_rec *rec = &o->contacts[o->open[p]];
+    o->open[p] = -1;
+    rec->passed_through = 1;
+    rec->max_penetration = r->c->radius;
+    r->in_contact[p] = 0;
+    r->status = 1;
+    r->stop_code = BALLC_DRIVE_THROUGH;
+    r->stop_plane = p;
+}
+
+/* mode changes in a row at one time, and the limits on them */
 static long stalled_at(const run_t *r, double t)
 {
     return (r->has_last_transition && t == r->last_transition) ? r->stalled + 1 : 0;
@@ -677,7 +608,7 @@ static int unsettled(const run_t *r, int p, long stalled)
     return r->transitions[p] >= MAX_TRANSITIONS || stalled >= MAX_STALLED;
 }
 
-/* _Run.settles: count a mode change of plane p now; 0 (and the run stopped, status -1)
+/* count a mode change of plane p now; 0 (and the run stopped, status -1)
  * when its transitions have reached a limit, else 1. */
 static int settles(run_t *r, int p)
 {
@@ -691,7 +622,7 @@ static int settles(run_t *r, int p)
     return 0;
 }
 
-/* _Run.coulomb_event */
+/* the automaton's approach, stop, clear and release: the next exact-Coulomb mode */
 static int coulomb_event(run_t *r, int kind, int p)
 {
     if (!settles(r, p)) return 0;
@@ -740,7 +671,7 @@ static int coulomb_event(run_t *r, int kind, int p)
     }
 }
 
-/* _Run.compliant_event */
+/* the automaton's arm, yield, capacity and restick: the compliant law's next mode */
 static int compliant_event(run_t *r, int kind, int p)
 {
     if (!settles(r, p)) {
@@ -753,7 +684,7 @@ static int compliant_event(run_t *r, int kind, int p)
     }
     double y[N];
     if (kind == K_ARM) r->armed[p] = 1;
-    else if (kind == K_YIELD) {   /* compliantmodes.load_vanished */
+    else if (kind == K_YIELD) {   /* the load vanished, the spring far below the cap */
         double m[BALLC_COMPLIANT_MARGINS];
         if (margins_of(r, p, r->y, m)) return -1;
         if (!(m[2] > 0) || m[0] > 0.5) {
@@ -772,7 +703,7 @@ static int compliant_event(run_t *r, int kind, int p)
     return set_compliant(r, p, COMPLIANT_ELASTIC);
 }
 
-/* stickslip.slip_stop_coefficients */
+/* the row c of u . d = c . y (u is linear in the state) */
 static void stop_coefficients(const run_t *r, int p, const double *d, double *row)
 {
     const double *a = r->c->slip_map[p][0], *b = r->c->slip_map[p][1];
@@ -826,7 +757,7 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     return status;
 }
 
-/* A re-arm at t: (t, the latch before) for the samples' blocks (Samples.add_later);
+/* A re-arm at t: (t, the latch before) for the samples' blocks (add_later_rows);
  * -1 out of memory */
 static int note_rearm(run_t *r, double t)
 {
@@ -859,7 +790,9 @@ static int user_rearm(run_t *r, int e, double t, const double *y)
     return 1;
 }
 
-/* _Run.rearm_approach's closure */
+/* a terminal event's re-arm inside the segment: the capacity guard turns; a free
+ * slip's approach that passes by zero re-latches its direction (the right-hand side is
+ * the same on both sides) and goes on; a user's LinearEvent asks its ``rearm`` */
 static int drv_rearm(void *ctx, int e, double t, const double *y)
 {
     run_t *r = (run_t *)ctx;
@@ -892,7 +825,7 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
     return 1;
 }
 
-/* ---- one segment's events (events.SegmentEvents.__call__) ---- */
+/* ---- one segment's events (the automaton's guards, then the user's) ---- */
 
 static int add_event(run_t *r, int kind, int p, const double *coef, int state, double scale,
                      double offset, int terminal, int direction)
@@ -953,7 +886,7 @@ static int segment_events(run_t *r, int flags)
                 int k = add_event(r, K_APPROACH, p, along, -1, 0, -speed, 1, -1);
                 r->ev_rearm[k] = 1;
             } else {
-                double margin = 4 * ballc_py_ulp(speed_scale(r, y0));
+                double margin = 4 * ulp(speed_scale(r, y0));
                 add_event(r, K_STOP, p, along, -1, 0, margin, 1, -1);
                 add_event(r, K_CLEAR, p, along, -1, 0, -2 * clear, 1, 1);
             }
@@ -967,7 +900,7 @@ static int segment_events(run_t *r, int flags)
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = p;
         }
-        if (r->compliant[p] != COMPLIANT_NONE) {   /* compliantmodes.guard */
+        if (r->compliant[p] != COMPLIANT_NONE) {   /* the mode's guard */
             if (!r->armed[p]) {   /* the penetration rising through the arming depth */
                 add_event(r, K_ARM, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
                           c->rho_offset[p] + (-c->arm_depth[p]), 1, 1);
@@ -980,7 +913,7 @@ static int segment_events(run_t *r, int flags)
             int k = add_event(r, elastic ? K_YIELD : K_RESTICK, p, NULL, -1, 0, offset, 1, -1);
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = 2 + 2 * (elastic ? 0 : 1) + p;
-            if (elastic && c->damping_positive) {   /* compliantmodes.capacity_guard */
+            if (elastic && c->damping_positive) {   /* the viscous capacity's kink */
                 double m[BALLC_COMPLIANT_MARGINS];
                 if (margins_of(r, p, y0, m)) return -1;
                 int row = r->capacity_row[p] >= 0 ? r->capacity_row[p] : (m[4] >= 0 ? 4 : 5);
@@ -993,7 +926,7 @@ static int segment_events(run_t *r, int flags)
             }
         }
     }
-    /* the user's (UserEvents.for_segment): terminal = the occurrences left */
+    /* the user's: terminal = the occurrences left */
     for (int u = 0; u < c->n_user; u++) {
         int left = c->user_count[u] ? (int)(c->user_count[u] - r->user_seen[u]) : 0;
         double offset = c->user_offset[u];
@@ -1003,7 +936,7 @@ static int segment_events(run_t *r, int flags)
         r->ev_index[k] = c->user_linear[u] ? c->user_index[u] : -1;
         r->ev_scale[k] = c->user_linear[u] ? c->user_scale[u] : 0.0;
         r->ev_rearm[k] = c->user_rearm && c->user_linear[u] && c->user_rearm[u];
-        if (!c->user_linear[u]) {   /* a callable: evaluated in Python, through the bridge */
+        if (!c->user_linear[u]) {   /* a callable: called back through the bridge */
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = -2 - u;
         }
@@ -1011,7 +944,7 @@ static int segment_events(run_t *r, int flags)
     return 0;
 }
 
-/* ---- samples (samples.Samples) ---- */
+/* ---- samples: per block of a segment, its flags and latch ---- */
 
 static int add_block(run_t *r, const double *t, const double *y, long count, int flags,
                      const double *latch)
@@ -1044,7 +977,8 @@ static int add_block(run_t *r, const double *t, const double *y, long count, int
     return 0;
 }
 
-/* Samples.add_later (first = 1: a segment's first sample is its start) */
+/* a segment's samples later than ``after`` (without t_eval its first sample is its start,
+ * stored already), in blocks split where a re-arm changed the latch */
 static int add_later_rows(run_t *r, long n, const double *t, const double *y_out,
                           double after, int flags)
 {
@@ -1069,15 +1003,12 @@ static int add_later(run_t *r, const radau5_result *res, double after, int flags
     return add_later_rows(r, res->n_out, res->t_out, res->y_out, after, flags);
 }
 
-/* ---- exact free flight (ballc.flight; stage 2c) ---- */
+/* ---- exact free flight (ballc.flight) ---- */
 
-#define FLIGHT_MIN_INTERVALS 32          /* flight.MIN_INTERVALS */
-#define FLIGHT_MAX_SAMPLES 100000000L    /* more: fall back (Python would allocate them) */
-
-typedef struct { double t0, rate, c[5][N]; } flight_t;
-
-/* flight.FreeFlight.__init__ */
-static void flight_init(flight_t *f, double t0, const double *y0, double gravity)
+/* The exact solution's coefficients (ballc.flight's docstring): omega, the dissipated
+ * work and the deflections constant, the centre a parabola, the quaternion turning at
+ * omega, q(s) = cos(|omega| s / 2) q0 + sin(|omega| s / 2) [0, n] (x) q0 */
+void ballc_flight_init(ballc_flight *f, double t0, const double *y0, double gravity)
 {
     f->t0 = t0;
     double wx = y0[BALLC_STATE_OMEGA_X], wy = y0[BALLC_STATE_OMEGA_Y], wz = y0[BALLC_STATE_OMEGA_Z];
@@ -1100,9 +1031,8 @@ static void flight_init(flight_t *f, double t0, const double *y0, double gravity
     f->c[2][BALLC_STATE_Z] = -0.5 * gravity;
 }
 
-/* FreeFlight.__call__ at an array of times, one time: basis 1, s, s*s, cos, sin and
- * np.einsum("kn,km->nm"), which sums the 5 products in order from +0.0 */
-static void flight_at(const flight_t *f, double t, double *y)
+/* y(t): the 5 products of coefficients and basis (1, s, s^2, cos, sin), summed in order */
+void ballc_flight_at(const ballc_flight *f, double t, double *y)
 {
     double s = t - f->t0;
     double half = 0.5 * f->rate * s;
@@ -1114,10 +1044,11 @@ static void flight_at(const flight_t *f, double t, double *y)
     }
 }
 
-/* flight.crossings: the roots in [0, s_max] where it changes sign in ``direction``, in
+/* the roots of c0 + c1 s + c2 s^2 in [0, s_max] where it changes sign in ``direction``
+ * (cancellation-free), in
  * increasing order (at most 2) */
-static int crossings(double c0, double c1, double c2, int direction, double s_max,
-                     double *out)
+int ballc_flight_crossings(double c0, double c1, double c2, int direction, double s_max,
+                           double *out)
 {
     double roots[2];
     int rising[2], m, n = 0;
@@ -1145,28 +1076,31 @@ static int crossings(double c0, double c1, double c2, int direction, double s_ma
 }
 
 
-/* flight.propagate of a segment from (r->t, r->y) to t1 whose events are all linear in
+/* the exact free flight of a segment from (r->t, r->y) to t1 whose events are all linear in
  * one state that is not the quaternion (the contact starts, the user's LinearEvents):
  * its samples (t_eval's points from ev, n_eval of them, or the even grid) and its hits,
  * in ``res`` as the integrator would give them (freed by radau5_free).  Returns 0,
- * -1 (fall back) or -2 (memory). */
+ * -1 (aborted: r->why) or -2 (memory). */
 static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
                           radau5_result *res)
 {
     const ballc_drive_config *c = r->c;
     double t0 = r->t, g = c->gravity;
-    flight_t f;
-    flight_init(&f, t0, r->y, g);
+    ballc_flight f;
+    ballc_flight_init(&f, t0, r->y, g);
     memset(res, 0, sizeof *res);
     res->stiff_at = NAN;
     res->method_end = -1;
     double span = t1 - t0;
-    /* the hits (s, event), at most 2 per event, sorted as Python sorts the tuples */
+    /* the hits (s, event), at most 2 per event, sorted by s, then event */
     double *hs = r->flight_s;
     int *he = r->flight_e, nh = 0;
     for (int e = 0; e < r->n_ev; e++) {   /* FreeFlight.event_polynomial, crossings */
         int k = r->ev_index[e];
-        if (r->ev_nonlinear[e]) return -1;
+        if (r->ev_nonlinear[e]) {
+            r->why = "an exact flight met an event that is not linear";
+            return -1;
+        }
         double c0, c1, c2;
         if (k >= 0) {
             double scale = r->ev_scale[e], y0k = r->y[k];
@@ -1185,7 +1119,7 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
             c2 = -0.5 * row[BALLC_STATE_Z] * g;
         }
         double roots[2];
-        int n = crossings(c0, c1, c2, r->ev_direction[e], span, roots);
+        int n = ballc_flight_crossings(c0, c1, c2, r->ev_direction[e], span, roots);
         if (r->ev_terminal[e] > 0 && n > r->ev_terminal[e]) n = r->ev_terminal[e];
         for (int i = 0; i < n; i++) {
             int at = nh++;   /* insertion by (s, event) */
@@ -1231,10 +1165,15 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
         if (n) memcpy(times, ev, (size_t)n * sizeof(double));
     } else {
         double max_step = run_max_step(r);
-        double turn = f.rate * (t_end - t0) / (M_PI / 16);
+        double turn = f.rate * (t_end - t0) / BALLC_FLIGHT_MAX_TURN;
         double longest = max_step < INFINITY ? (t_end - t0) / max_step : 0.0;
-        if (!(fabs(turn) < 1e8) || !(fabs(longest) < 1e8)) return -1;
-        double m = py_max(py_max((double)FLIGHT_MIN_INTERVALS, ceil(turn)), ceil(longest));
+        if (!(fabs(turn) < BALLC_FLIGHT_MAX_SAMPLES)
+                || !(fabs(longest) < BALLC_FLIGHT_MAX_SAMPLES)) {
+            r->why = "an exact flight would store more than 1e8 samples (give t_eval, or "
+                     "exact_flight=False)";
+            return -1;
+        }
+        double m = py_max(py_max((double)BALLC_FLIGHT_MIN_INTERVALS, ceil(turn)), ceil(longest));
         long intervals = (long)m;
         n = intervals + 1;
         times = malloc((size_t)n * sizeof(double));
@@ -1251,21 +1190,21 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
     res->hit_t = malloc((size_t)(kept ? kept : 1) * sizeof(double));
     res->hit_y = malloc((size_t)(kept ? kept : 1) * N * sizeof(double));
     if (!res->y_out || !res->hit_event || !res->hit_t || !res->hit_y) return -2;
-    for (long i = 0; i < n; i++) flight_at(&f, times[i], res->y_out + (size_t)i * N);
+    for (long i = 0; i < n; i++) ballc_flight_at(&f, times[i], res->y_out + (size_t)i * N);
     for (int h = 0, m = 0; h < nh && m < kept; h++) {
         if (stop >= 0 && !(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])))
             continue;
         double when = h == stop ? t_end : py_min(t0 + hs[h], t1);
         res->hit_event[m] = he[h];
         res->hit_t[m] = when;
-        flight_at(&f, when, res->hit_y + (size_t)m * N);
+        ballc_flight_at(&f, when, res->hit_y + (size_t)m * N);
         m++;
     }
     res->n_hits = kept;
     return 0;
 }
 
-/* ---- the rest checks (ballc.resting; stage 2a) ---- */
+/* ---- the rest checks (ballc.resting) ---- */
 
 /* _core.energies of one state row */
 static void energy_of(const run_t *r, const double *y, double *e)
@@ -1273,7 +1212,7 @@ static void energy_of(const run_t *r, const double *y, double *e)
     ballc_energy(y, &r->prepared, e);
 }
 
-/* resting._booked: the energy y has above ``new`` added to dissipated_normal */
+/* the energy y has above ``new`` added to new's dissipated_normal */
 static void booked(const run_t *r, const double *y, double *new_y)
 {
     double a[BALLC_ENERGY_NOUT], b[BALLC_ENERGY_NOUT];
@@ -1284,23 +1223,23 @@ static void booked(const run_t *r, const double *y, double *new_y)
     new_y[BALLC_STATE_DISSIPATED_NORMAL] += before - after;
 }
 
-/* the Hertz spring plus gravity above rho_eq (resting.energy_above_rest, rolls); x > -1 */
+/* the Hertz spring plus gravity above rho_eq, x = (rho - rho_eq) / rho_eq > -1 */
 static double normal_above(const ballc_drive_config *c, double x)
 {
-    return c->rest_weight * c->rho_eq * (0.4 * expm1(2.5 * (x == 0.0 ? x : log1p(x))) - x);
+    return c->rest_weight * c->rho_eq * (0.4 * expm1(2.5 * log1p(x)) - x);
 }
 
-/* resting.at_rest (criteria 2-4); -1 where Python would raise */
+/* whether the contact is at rest (ballc.resting's criteria 2-4) */
 static int at_rest(const run_t *r, const double *y, double t_start, double t)
 {
     const ballc_drive_config *c = r->c;
     if (t - t_start < c->rest_period) return 0;
     double across = 0.0, up = 0.0;
-    if (c->observer_massive) {   /* resting._observer_offset */
+    if (c->observer_massive) {   /* the observer's offset from the centre */
         double where[BALLC_OBSERVER_POSITION_NOUT], d[3];
         ballc_observer_position(y, c->params, r->prepared.constants, NULL, where);
         for (int i = 0; i < 3; i++) d[i] = where[i] - y[BALLC_STATE_X + i];
-        across = ballc_py_hypot(2, d);
+        across = hypot(d[0], d[1]);
         up = d[2];
         if (up >= 0) return 0;
     }
@@ -1310,21 +1249,17 @@ static int at_rest(const run_t *r, const double *y, double t_start, double t)
     double rho = c->radius - y[BALLC_STATE_Z];
     double x = (rho - c->rho_eq) / c->rho_eq;
     double normal = INFINITY;
-    if (x > -1) {
-        normal = normal_above(c, x);
-        if (!isfinite(normal) && isfinite(x)) return -1;   /* math.expm1 overflow */
-    }
+    if (x > -1) normal = normal_above(c, x);   /* deep: inf, not at rest */
     double observer = 0.0;
     if (c->observer_massive) {
-        double pair[2] = {across, up};
-        double reach = ballc_py_hypot(2, pair);
+        double reach = hypot(across, up);
         observer = reach > 0 ? c->observer_weight * across * across / (reach + fabs(up)) : 0.0;
     }
     double above = kinetic + py_max(normal, 0.0) + spring + observer;
     return above <= c->rest_threshold;
 }
 
-/* np.max(np.abs(v)) of n values: NaN when one is NaN */
+/* the largest |v| of n values: NaN when one is NaN */
 static double max_abs(const double *v, int n)
 {
     double m = fabs(v[0]);
@@ -1335,9 +1270,9 @@ static double max_abs(const double *v, int n)
     return m;
 }
 
-/* resting.rolls: BALLC_END_ROLLING / SLIDING with ``roll`` the uniform state, 0 none,
- * -1 where Python would raise */
-static int rolls(const run_t *r, const double *y, double t_start, double t,
+/* uniform rolling or sliding (ballc.resting): BALLC_END_ROLLING / SLIDING with ``roll``
+ * the uniform state, 0 none, -1 when a kernel failed */
+static int rolls(run_t *r, const double *y, double t_start, double t,
                  double slip_speed, double *roll)
 {
     const ballc_drive_config *c = r->c;
@@ -1347,18 +1282,20 @@ static int rolls(const run_t *r, const double *y, double t_start, double t,
     double x = (c->radius - y[BALLC_STATE_Z] - c->rho_eq) / c->rho_eq;
     if (!(x > -1)) return 0;
     double normal = normal_above(c, x);
-    if (!isfinite(normal) && isfinite(x)) return -1;
-    double above = c->half_mass * pow(y[BALLC_STATE_VZ], 2.0) + (e[4] + e[5])
+    double above = c->half_mass * (y[BALLC_STATE_VZ] * y[BALLC_STATE_VZ]) + (e[4] + e[5])
                    + py_max(normal, 0.0);
     if (!(above <= c->rest_threshold)) return 0;
-    memcpy(roll, y, N * sizeof(double));   /* resting.rolling_state */
+    memcpy(roll, y, N * sizeof(double));   /* the uniform state, energy booked */
     roll[BALLC_STATE_Z] = c->z_eq;
     roll[BALLC_STATE_VZ] = 0.0;
     roll[BALLC_STATE_FLOOR_DEFLECTION_X] = roll[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
     roll[BALLC_STATE_CEILING_DEFLECTION_X] = roll[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
     booked(r, y, roll);
     double rate[N];
-    if (ballc_rhs(roll, c->params, r->latch, run_flags(r, 1), rate) != BALLC_OK) return -1;
+    if (ballc_rhs(roll, c->params, r->latch, run_flags(r, 1), rate) != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
     double level = c->rolls_level;
     if (max_abs(rate + BALLC_STATE_VX, 3) > level
             || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level
@@ -1383,7 +1320,7 @@ static int log_trial(run_t *r)
     return 0;
 }
 
-/* _Run.plan_orbit_trial: at a rest check that found no end state, with no trial under
+/* at a rest check that found no end state, with no trial under
  * way, start one (criteria 1-2) when it ends before t_end; the next rest check is then
  * at the latest at its end.  Not at once after a refused trial.  0, or -2 (memory) */
 static int plan_orbit_trial(run_t *r, int p)
@@ -1394,7 +1331,7 @@ static int plan_orbit_trial(run_t *r, int p)
         r->trial_failed = 0;
         return 0;
     }
-    double rate = sqrt(ballc_dot3_fma(r->y + BALLC_STATE_OMEGA_X));
+    double rate = norm3(r->y + BALLC_STATE_OMEGA_X);
     if (!(rate > 0)) return 0;
     double guess = 2 * M_PI / rate;
     double t_to = r->t + BALLC_ORBIT_TRIAL_PERIODS * guess;
@@ -1413,7 +1350,7 @@ static int plan_orbit_trial(run_t *r, int p)
     return log_trial(r);
 }
 
-/* orbit.Trial.add: the segment [t0, t1] of the trial under way, or (an event ended it,
+/* the segment [t0, t1] of the trial under way, or (an event ended it,
  * or it was flown) the trial broken.  0, or -2 (memory) */
 static int trial_add(run_t *r, const radau5_result *res, double t0, double t1, int reached,
                      int flown)
@@ -1430,7 +1367,7 @@ static int trial_add(run_t *r, const radau5_result *res, double t0, double t1, i
                            res->dense_kind, res->dense_terms, N) ? -2 : 0;
 }
 
-/* _Run.check_orbit: when this check ends the trial under way, the relative periodic
+/* when this check ends the trial under way, the relative periodic
  * orbit if criteria 3-5 hold (BALLC_END_ROLLING or SLIDING, o->orbit and its base),
  * else 0 (and the trial is over); before the trial's end, 0 and the next check at the
  * latest at its end.  -1 when the trial's solution failed, -2 out of memory. */
@@ -1451,7 +1388,7 @@ static int check_orbit(run_t *r, int p)
     const ballc_piecewise *solution = ballc_dense_view(d);
     if (!solution) return -2;
     double atol[N];
-    for (int i = 0; i < N; i++) atol[i] = c->atol;
+    for (int i = 0; i < N; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
     ballc_orbit_tolerances tol = {c->rtol, atol, c->rest_factor, c->rest_threshold,
                                   c->params};
     ballc_orbit orbit;
@@ -1472,10 +1409,11 @@ static int check_orbit(run_t *r, int p)
     return sticking || speed <= c->rest_factor * error ? BALLC_END_ROLLING : BALLC_END_SLIDING;
 }
 
-/* _Run.end_state at a rest check on plane p at (r->t, r->y): BALLC_END_* when the run
+/* a rest check on plane p at (r->t, r->y): BALLC_END_* when the run
  * finishes in closed form from here (r->y the new state, or the state of the orbit's
- * start), 0 to go on (the next check scheduled), -1 to fall back (where Python would
- * raise), -2 out of memory */
+ * start), 0 to go on (the next check scheduled), -1 when a kernel failed, -2 out of
+ * memory.  Its checks are the automaton's "rest check" (at_rest), "uniform check"
+ * (rolls) and "orbit check" (check_orbit), each when the one before found nothing */
 static int end_state(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
@@ -1483,7 +1421,7 @@ static int end_state(run_t *r, int p)
     int rest = at_rest(r, r->y, k->t_start, r->t);
     if (rest < 0) return -1;
     r->seg.end = rest ? BALLC_SEG_REST_CHECK : BALLC_SEG_UNIFORM_CHECK;   /* the log */
-    if (rest) {   /* resting.rest_state */
+    if (rest) {   /* the rest state: static equilibrium, energy booked */
         double new_y[N];
         memcpy(new_y, r->y, sizeof new_y);
         for (int i = 0; i < 3; i++) new_y[BALLC_STATE_VX + i] = new_y[BALLC_STATE_OMEGA_X + i] = 0.0;
@@ -1494,8 +1432,8 @@ static int end_state(run_t *r, int p)
         memcpy(r->y, new_y, sizeof new_y);
         return BALLC_END_REST;
     }
-    /* resting.next_check */
-    r->rest_check[p] = r->t + py_max(c->rest_period, 0.25 * (r->t - k->t_start));
+    /* the next check */
+    r->rest_check[p] = r->t + py_max(c->rest_period, BALLC_CHECK_GROWTH * (r->t - k->t_start));
     double u[2], speed, error, clear, roll[N];
     slip(r, p, r->y, u, &speed, &error, &clear);
     int kind = rolls(r, r->y, k->t_start, r->t, speed, roll);
@@ -1510,8 +1448,65 @@ static int end_state(run_t *r, int p)
     return plan_orbit_trial(r, p);
 }
 
-/* pieces.append((t0, t1, sol.interpolant)): the segment's steps kept (stage 2b), or an
- * exact flight's FreeFlight from (t0, r->y) */
+/* The closed-form end state ``kind`` found at (r->t, r->y) on plane p, to t_end: its
+ * samples (rest: t_end alone; uniform motion: the free flight without gravity, the turn
+ * at most BALLC_FLIGHT_MAX_TURN per interval; an orbit: 32 per period; at least 32
+ * intervals and at most BALLC_MAX_ROLL_SAMPLES samples, evenly spaced after r->t) in a
+ * block with the last one's flags and latch, and the contact's record of its end.
+ * 0, -1 (the orbit's base could not be evaluated), -2 out of memory. */
+static int end_samples(run_t *r, int kind, int p)
+{
+    const ballc_drive_config *c = r->c;
+    ballc_drive_output *o = r->o;
+    double t0 = r->t, t1 = c->t_end, span = t1 - t0;
+    long n = 1;
+    if (kind != BALLC_END_REST) {
+        double wanted = o->end_orbit
+            ? ceil(32 * span / o->orbit.period)
+            : ceil(norm3(r->y + BALLC_STATE_OMEGA_X) * span / BALLC_FLIGHT_MAX_TURN);
+        wanted = py_max((double)BALLC_FLIGHT_MIN_INTERVALS, wanted);
+        n = (long)py_min((double)BALLC_MAX_ROLL_SAMPLES, wanted);
+    }
+    double *t = malloc((size_t)n * sizeof(double));
+    double *y = malloc((size_t)n * N * sizeof(double));
+    int rc = t && y ? 0 : -2;
+    if (!rc) {
+        for (long k = 1; k <= n; k++) t[k - 1] = t0 + span * (double)k / (double)n;
+        t[n - 1] = t1;
+        if (kind == BALLC_END_REST) {
+            memcpy(y, r->y, N * sizeof(double));
+        } else if (o->end_orbit) {
+            const ballc_piecewise *base = ballc_dense_view(&o->orbit_base);
+            rc = !base ? -2 : ballc_orbit_states(&o->orbit, ballc_piecewise_states,
+                                                 (void *)base, n, t, y);
+            if (rc == -1) r->why = "the orbit's base solution could not be evaluated";
+        } else {
+            ballc_flight f;
+            ballc_flight_init(&f, t0, r->y, 0.0);
+            for (long k = 0; k < n; k++) ballc_flight_at(&f, t[k], y + (size_t)k * N);
+        }
+    }
+    if (!rc) {
+        long last = o->n_blocks - 1;
+        rc = add_block(r, t, y, n, o->block_flags[last], o->block_latch + (size_t)last * NL)
+             ? -2 : 0;
+    }
+    free(t);
+    free(y);
+    if (!rc) {   /* the contact's record: its end state from t0 on */
+        if (grow((void **)&o->phases, &o->cap_phases, o->n_phases + 1,
+                 sizeof(ballc_phase_rec)))
+            return -2;
+        ballc_phase_rec *k = &o->phases[o->n_phases++];
+        k->contact = o->open[p];
+        k->t = t0;
+        k->phase = 1 + kind;   /* BALLC_PHASE_REST, _ROLLING, _FREE_SLIDING */
+    }
+    return rc;
+}
+
+/* the segment's dense output: its steps kept, the integrator's own interpolant (its
+ * id), or an exact flight's (t0, r->y) */
 static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, int flown)
 {
     ballc_drive_output *o = r->o;
@@ -1600,7 +1595,7 @@ static int drv_poll(void *ctx, double t)
     return r->interrupted;
 }
 
-/* ---- the loop (simulate.simulate) ---- */
+/* ---- the loop ---- */
 
 /* The segment's event arrays, for the driver's events and n_user of the user's; -1 out
  * of memory (free_events frees what was allocated) */
@@ -1671,7 +1666,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     r->seg_interpolant = -1;
     int rc = 0;
     for (int i = 0; i < BALLC_N_PARAMETERS; i++)
-        if (!isfinite(c->params[i])) rc = -1;   /* solve_system would raise */
+        if (!isfinite(c->params[i])) { rc = -1; r->why = "a parameter is not finite"; }
     for (int p = 0; p < 2 && !rc; p++)
         if (rho_of(r, p, r->y) > 0) rc = begin_contact(r, p);
     double t0 = 0.0;
@@ -1725,11 +1720,12 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             if (!isfinite(r->y[i])) rc = -1;
         for (int i = 0; i < NL; i++)
             if (!isfinite(r->latch[i])) rc = -1;
+        if (rc) r->why = "the state or the latched values are not finite";
         if (rc) break;
         log_open(r);
         radau5_result res;
         int solved = RADAU5_DONE, flown = 0;
-        if (c->exact_flight && flags == 0 && c->user_flight) {   /* flight.applies */
+        if (c->exact_flight && flags == 0 && c->user_flight) {   /* exact flight applies */
             long n_eval = 0;
             const double *ev = NULL;
             if (c->t_eval) {
@@ -1757,9 +1753,13 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.atol = atol;
         pr.max_step = max_step;
         pr.first_step = 0.0;
-        if (has_first) {   /* integrate.integrate_segment, then the bridge's check */
+        if (has_first) {   /* a carried step fits what is left */
             double f = py_min(first, t_stop - r->t);
-            if (!(isfinite(f) && 0 < f && f <= fabs(t_stop - r->t))) { rc = -1; break; }
+            if (!(isfinite(f) && 0 < f && f <= fabs(t_stop - r->t))) {
+                r->why = "first_step does not fit the segment";
+                rc = -1;
+                break;
+            }
             pr.first_step = f;
         }
         pr.max_nfev = c->max_nfev ? (c->max_nfev - nfev > 1 ? c->max_nfev - nfev : 1) : 0;
@@ -1812,7 +1812,14 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             r->stop_code = BALLC_DRIVE_USER_ERROR;
             break;
         }
-        if (solved != RADAU5_DONE) { radau5_free(&res); rc = -1; break; }
+        if (solved != RADAU5_DONE) {   /* the integrator refused the segment */
+            rc = solved == RADAU5_OUT_OF_MEMORY ? -2 : -1;
+            memcpy(o->message, res.message, sizeof o->message);
+            o->message[sizeof o->message - 1] = 0;
+            r->why = o->message;
+            radau5_free(&res);
+            break;
+        }
         nfev += res.nfev;
         njev += res.njev;
         nlu += res.nlu;
@@ -1909,7 +1916,12 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             }
             r->t = t_stop;
             if (t_stop < c->t_end) {   /* a rest check (ballc.resting) or a step bound's end */
-                if (!res.n_out) { radau5_free(&res); rc = -1; break; }
+                if (!res.n_out) {
+                    r->why = "a segment stopped at a rest check stored no sample";
+                    radau5_free(&res);
+                    rc = -1;
+                    break;
+                }
                 memcpy(r->y, res.y_out + (size_t)(res.n_out - 1) * N, sizeof r->y);
                 radau5_free(&res);
                 if (t_stop != t_check) {   /* only a step bound ended: a fresh step */
@@ -1920,12 +1932,13 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 int p = c->resting_plane;
                 int kind = end_state(r, p);
                 if (kind < 0) { rc = kind; break; }
-                if (kind) {   /* to t_end in closed form: the samples are Python's */
+                if (kind) {   /* to t_end in closed form */
                     o->end_kind = kind;
                     o->end_plane = p;
                     o->end_t = r->t;
                     memcpy(o->end_y, r->y, sizeof r->y);
-                    if (log_close(r, r->seg.end, p, r->t)) rc = -2;
+                    rc = end_samples(r, kind, p);
+                    if (!rc && log_close(r, r->seg.end, p, r->t)) rc = -2;
                     break;
                 }
                 implicit = ended_implicit;   /* auto keeps the method it ended with */
@@ -1936,7 +1949,12 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             if (log_close(r, BALLC_SEG_T_END, -1, r->t)) rc = -2;
             break;
         }
-        if (fired < 0) { radau5_free(&res); rc = -1; break; }
+        if (fired < 0) {
+            r->why = "the integrator stopped on a terminal event but reported no hit";
+            radau5_free(&res);
+            rc = -1;
+            break;
+        }
         if (c->dense_output && add_piece(r, &res, r->t, t_fired, flown)) {
             radau5_free(&res); rc = -2; break;
         }
@@ -1944,7 +1962,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         r->t = t_fired;
         memcpy(r->y, res.hit_y + (size_t)fired_hit * N, sizeof r->y);
         radau5_free(&res);
-        double h = ballc_py_hypot(4, r->y + BALLC_STATE_QW);
+        const double *q = r->y + BALLC_STATE_QW;
+        double h = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
         for (int i = 0; i < 4; i++) r->y[BALLC_STATE_QW + i] /= h;
         int kind = r->ev_kind[fired], p = r->ev_plane[fired];
         if (kind == K_USER) {   /* a terminal user event: the run stops, status 1 */
@@ -1959,23 +1978,13 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         switch (kind) {
         case K_ENTER: handled = begin_contact(r, p); break;
         case K_LEAVE: end_contact(r, p); break;
-        case K_THROUGH: {
-            ballc_contact_rec *rec = &o->contacts[o->open[p]];
-            o->open[p] = -1;
-            rec->passed_through = 1;
-            rec->max_penetration = c->radius;
-            r->in_contact[p] = 0;
-            r->status = 1;
-            r->stop_code = BALLC_DRIVE_THROUGH;
-            r->stop_plane = p;
-            break;
-        }
+        case K_THROUGH: pass_through(r, p); break;
         case K_ARM: case K_YIELD: case K_RESTICK: case K_CAPACITY:
             handled = compliant_event(r, kind, p);
             break;
         default: handled = coulomb_event(r, kind, p); break;
         }
-        if (handled) { rc = -1; break; }
+        if (handled) { rc = handled == -2 ? -2 : -1; break; }
         if (log_close(r, kind, p, r->t)) { rc = -2; break; }
         if (kind >= K_APPROACH && h_next > 0) {   /* CARRY_STEP */
             first = py_min(h_next, run_max_step(r));
@@ -1983,7 +1992,23 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             implicit = ended_implicit;
         }
     }
-    if (rc) r->stop_code = rc == -2 ? BALLC_DRIVE_NO_MEMORY : BALLC_DRIVE_FALLBACK;
+    if (rc != -2 && o->n_blocks && o->block_count[o->n_blocks - 1]) {
+        /* the contacts still open at the end: their depth at the last sample */
+        const double *last = o->y + (size_t)(o->n - 1) * N;
+        for (int p = 0; p < 2; p++)
+            if (o->open[p] >= 0) record_depth(&o->contacts[o->open[p]], rho_of(r, p, last), last);
+    }
+    if (rc == -1) {   /* aborted where it cannot go on: status -1, and why */
+        r->stop_code = BALLC_DRIVE_ABORTED;
+        r->status = -1;
+        if (r->failed_kernel)
+            r->why = "a C kernel failed (non-finite inputs or outputs)";
+        if (r->why != o->message)
+            snprintf(o->message, sizeof o->message, "%s",
+                     r->why ? r->why : "an internal step failed (out of memory?)");
+    } else if (rc) {
+        r->stop_code = BALLC_DRIVE_NO_MEMORY;
+    }
     o->stop_code = r->stop_code;
     o->status = r->status;
     o->stop_plane = r->stop_plane;

@@ -1,23 +1,15 @@
-/* The segment loop of ballc.simulate in C (docs/c_loop_plan.md, stages 0, 1, 2a -- the
- * rest checks of ballc.resting, and ballc.orbit's trial in _orbit.c --, 2b: t_eval
- * and dense output, 2c: method "auto" and exact flight, ballc.flight, 3: the compliant
- * law's exact modes, ballc.compliantmodes, and 4: user events).
+/* The segment loop of ballc.simulate: the one driver (docs/driver.md).
  *
- * ballc_drive runs a whole simulation of the subset -- exact Coulomb friction, the
- * compliant law or no friction, user events (callables called back through the
- * bridge), every method through the integrator interface (below), the progress bar and
- * Ctrl-C polled from C -- and reproduces the Python driver (simulate.py with
- * events.py, stickslip.py, modes.py, samples.py) bit for bit: the same floating-point
- * operations in the same order.  What it does not port ends the run with
- * BALLC_DRIVE_FALLBACK, and simulate() then runs the Python driver from the start.
- *
- * Numerics that must match CPython / numpy exactly (see docs/c_loop_plan.md, 1.5):
- *   ballc_py_hypot: CPython 3.11's math.hypot (vector_norm), verbatim;
- *   ballc_py_ulp:   CPython's math.ulp;
- *   ballc_dot3_fma: numpy's float64 dot of length 3 (OpenBLAS ddot on this machine:
- *                   fma(c, c, fma(b, b, a * a)), checked by tests/test_c_driver.py).
- * This file must be compiled as the rest of the extension: -std=c99 (no FP contraction),
- * never -ffast-math or -march=native.
+ * ballc_drive runs a whole simulation -- the hybrid automaton of ballc.automaton: contacts
+ * and their latches, exact Coulomb friction's slip/stick modes (ballc.stickslip), the
+ * compliant law's elastic/sliding modes (ballc.compliantmodes), the rest checks and the
+ * closed-form end states (ballc.resting, ballc.orbit in _orbit.c), exact free flight
+ * (ballc.flight), user events (callables called back through the bridge), every method
+ * through the integrator interface (below), the progress report and Ctrl-C polled from
+ * C, and the segment log.  Python validates the inputs, computes the per-scene constants
+ * (ballc_drive_config) and builds the Result from ballc_drive_output; it holds no copy of
+ * this logic.  Plain C99 numerics (hypot, sqrt, nextafter, sums in index order); compiled
+ * as the rest of the extension: -std=c99 (no FP contraction), never -ffast-math.
  */
 #ifndef BALLC_DRIVER_H
 #define BALLC_DRIVER_H
@@ -26,9 +18,34 @@
 #include "_orbit.h"
 #include "_integrator.h"
 
-double ballc_py_hypot(int n, const double *values);
-double ballc_py_ulp(double x);
-double ballc_dot3_fma(const double *v);
+/* The automaton's constants (ballc.stickslip, ballc.compliantmodes, ballc.resting,
+ * ballc.flight and ballc.modes document them; Python reads them from ballc._core) */
+#define BALLC_CLEAR_FACTOR 100.0      /* clear speed: 100 x the slip's error scale */
+#define BALLC_PASS_FACTOR 3.0         /* a miss beyond 3 x the error passes by zero */
+#define BALLC_STOP_FACTOR 10.0        /* a stop's leftover slip removed up to 10 x */
+#define BALLC_APPROACH_FRACTION 0.5   /* a re-latched slip's next approach: |u| / 2 */
+#define BALLC_MAX_RELATCH 1000        /* re-latches per contact before a stop is forced */
+#define BALLC_MAX_TRANSITIONS 100000  /* mode changes per contact: more do not settle */
+#define BALLC_MAX_STALLED 100         /* mode changes in a row without time moving on */
+#define BALLC_MIN_IMPACT_RATE 1e-9    /* the smallest latched penetration rate (m/s) */
+#define BALLC_STEPS_PER_CONTACT 16    /* compliant impact: steps of at most t_c / 16 */
+#define BALLC_IMPACT_SPAN 4           /* ... for its first 4 t_c */
+#define BALLC_CHECK_GROWTH 0.25       /* rest checks: the next at age a + max(20 T0, a / 4) */
+#define BALLC_FLIGHT_MIN_INTERVALS 32 /* closed-form samples: at least 32 intervals, */
+#define BALLC_FLIGHT_MAX_TURN (3.14159265358979323846 / 16)  /* a turn of pi/16 at most */
+#define BALLC_MAX_ROLL_SAMPLES 4096   /* at most 4096 samples of a closed-form end state */
+#define BALLC_FLIGHT_MAX_SAMPLES 100000000L   /* an exact flight's samples, at most */
+
+/* The exact free-flight solution from (t0, y0) under ``gravity`` (ballc.flight): y(t)
+ * = c0 + c1 s + c2 s^2 + c3 cos(|omega| s / 2) + c4 sin(|omega| s / 2), s = t - t0 */
+typedef struct { double t0, rate, c[5][BALLC_N_STATES]; } ballc_flight;
+void ballc_flight_init(ballc_flight *f, double t0, const double *y0, double gravity);
+void ballc_flight_at(const ballc_flight *f, double t, double *y);
+/* the roots of c0 + c1 s + c2 s^2 in [0, s_max] where it changes sign in ``direction``
+ * (> 0 rising, < 0 falling, 0 either; a tangency is none), increasing, cancellation-
+ * free: at most 2 into out, their number returned */
+int ballc_flight_crossings(double c0, double c1, double c2, int direction, double s_max,
+                           double *out);
 
 /* ballc_drive_config.method of a run with one of scipy's methods (its integrator is the
  * bridge's callback), and the segment log's method of its segments */
@@ -40,7 +57,8 @@ enum {
     BALLC_DRIVE_FAILED = 1,      /* integrator failure (status -1); message, fail_end */
     BALLC_DRIVE_UNSETTLED = 2,   /* stick-slip did not settle (status -1); stop_plane */
     BALLC_DRIVE_THROUGH = 3,     /* passed through stop_plane (status 1) */
-    BALLC_DRIVE_FALLBACK = 4,    /* not ported here: run the Python driver */
+    BALLC_DRIVE_ABORTED = 4,     /* stopped where it cannot go on (status -1): message
+                                  * (a kernel failed, a non-finite state, ...) */
     BALLC_DRIVE_NO_MEMORY = 5,
     BALLC_DRIVE_TERMINATED = 6,  /* a terminal user event (status 1) */
     BALLC_DRIVE_USER_ERROR = 7   /* a user event raised, an integrator raised, or Ctrl-C:
@@ -105,18 +123,15 @@ typedef struct {                       /* constants of one run, filled by the br
     double radius, weight, hertz_k, total_mass, rest_period;   /* rest: 20 T0 */
     int resting_plane, checks_rest;    /* -1: none */
     double rho_scale[2], rho_offset[2], through_offset[2], threshold_base[2];
-    int n_terms[2][2];                 /* slip_terms: plane, row -> at most 2 terms */
-    int term_index[2][2][2];
-    double term_coef[2][2][2];
-    double slip_map[2][2][BALLC_N_STATES];
-    /* stage 2b: t_eval (sorted, within [0, t_end]; NULL: none) and dense output */
+    double slip_map[2][2][BALLC_N_STATES];   /* du/dy of each plane's slip velocity */
+    /* t_eval (sorted, within [0, t_end]; NULL: none) and dense output */
     const double *t_eval;
     long n_eval;
     int dense_output;
-    /* stage 2c: exact flight (options.exact_flight and flight.scene_allows) */
+    /* exact flight (options.exact_flight and flight.scene_allows) */
     int exact_flight;
     double gravity;                    /* params[gravity] */
-    /* stage 4: the user's events (UserEvents), in order: LinearEvents (a row, offset;
+    /* the user's events, in order: LinearEvents (a row, offset;
      * index and scale when one state) or callables (called back through user_fun,
      * the bridge's, with user_ctx: it keeps an exception for the bridge to raise) */
     int n_user;
@@ -129,9 +144,9 @@ typedef struct {                       /* constants of one run, filled by the br
     /* asked before each segment (may be NULL): nonzero when the run is to stop now (the
      * bridge's: a pending Ctrl-C, kept with user_ctx's exceptions for it to raise) */
     int (*interrupted)(void *ctx);
-    /* stage 3: the compliant law's exact modes (ballc.compliantmodes) */
+    /* the compliant law's exact modes (ballc.compliantmodes) */
     int compliant_modes;               /* compliantmodes.uses_modes */
-    int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* mode_flags per plane */
+    int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* the modes' bits per plane */
     int compliant_any;                 /* FLOOR_COMPLIANT | CEILING_COMPLIANT */
     int compliant_sliding_any;         /* FLOOR_COMPLIANT_SLIDING | CEILING_COMPLIANT_SLIDING */
     double arm_depth[2];               /* arm_penetration; 0: contacts begin at rho = 0 (compliantmodes.starts_armed) */
@@ -139,7 +154,7 @@ typedef struct {                       /* constants of one run, filled by the br
     double restick_factor;             /* max(1, mu / max(tangential_stiffness_ratio, 1e-300)) */
     int damping_positive;              /* tangential_damping_ratio > 0: capacity guards */
     double contact_time_base;          /* 3.2145 (m_total / k0)^0.4: contact_time */
-    /* the rest checks (ballc.resting; stage 2a), constants computed by Python */
+    /* the rest checks (ballc.resting): the scene's constants */
     int observer_massive;              /* observer_mass > 0 */
     int rolls_allowed;                 /* flight.scene_allows: uniform motion possible */
     int orbit_applies;                 /* orbit.applies: a check finding nothing tries an orbit */
@@ -151,7 +166,7 @@ typedef struct {                       /* constants of one run, filled by the br
     /* ballc.orbit, run at the rest checks when orbit_applies (_orbit.c) */
     double orbit_axis[3];              /* orbit.body_axis */
     double rest_factor;                /* resting.REST_FACTOR */
-    /* issue 29b: the integrator, per-state atol, progress, polling, the user's rearm */
+    /* the integrator, per-state atol, progress, polling, the user's rearm */
     ballc_integrator integrate;        /* NULL: ballc_compiled_integrator */
     void *integrate_ctx;
     ballc_interpolant_fn interpolant;  /* its own interpolants (NULL: none) */
@@ -180,7 +195,10 @@ typedef struct {
     double rate, digin[3], max_penetration, contact_point[2], lost[2];
 } ballc_contact_rec;
 
-typedef struct { long contact; double t; int phase; } ballc_phase_rec;  /* 0 slip, 1 stick */
+/* a contact's phases: when each starts (slip, stick) and its closed-form end state */
+enum { BALLC_PHASE_SLIP = 0, BALLC_PHASE_STICK, BALLC_PHASE_REST, BALLC_PHASE_ROLLING,
+       BALLC_PHASE_FREE_SLIDING };
+typedef struct { long contact; double t; int phase; } ballc_phase_rec;
 
 /* dense output: one piece (t0, t1) per segment, its steps [step0, step0 + n_steps) of
  * dense_t / dense_kind and their coefficients from dense_c[coef0], (1 + terms) N each */
@@ -264,7 +282,7 @@ typedef struct {
     long n_switches, cap_switches;      /* method "auto": (t, method switched to) */
     double *switch_t;
     int *switch_to;
-    long n_pieces, cap_pieces;          /* dense output (stage 2b) */
+    long n_pieces, cap_pieces;          /* dense output */
     ballc_piece_rec *pieces;
     long n_steps, cap_steps, n_coef, cap_coef;
     double *dense_t, *dense_c;
@@ -278,9 +296,11 @@ typedef struct {
     int unsettled_compliant;            /* UNSETTLED: the compliant law's modes */
     long nfev, njev, nlu;
     double stiff_at;                    /* NaN: none */
-    char message[240];                  /* FAILED: the integrator's message */
+    char message[240];                  /* FAILED: the integrator's message; ABORTED:
+                                         * why the run could not go on */
     long segments;
-    int end_kind, end_plane;            /* BALLC_END_*: rest / uniform motion found */
+    int end_kind, end_plane;            /* BALLC_END_*: rest / uniform motion found;
+                                         * its closed-form samples are the last block */
     double end_t, end_y[BALLC_N_STATES];
     /* a -DRADAU5_PROFILE build: thread CPU time (ns) inside radau5_solve, summed over
      * the segments, and in the whole of ballc_drive; zeros otherwise */

@@ -1,18 +1,27 @@
 # Included by _core.pyx after _radau5_bridge.pxi.  Bridge to the segment loop in C
-# (``_driver.c``, ballc_drive): the constants of one run in, the run's buffers out as
-# arrays.  Only converts: simulate.py decides what runs here (simulate._c_config) and
-# builds the Result; _driver.c computes.
+# (``_driver.c``, ballc_drive), the one driver of ballc.simulate: the scene's constants
+# (converted once per scene: DriveScene) and the run's in, the run's buffers out (Drive,
+# read on demand).  Only converts: ballc.loop_constants computes the constants,
+# ballc.loop_result builds the Result; _driver.c computes.
 
 from cpython.exc cimport PyErr_CheckSignals
 from libc.stdlib cimport free
 
 cdef extern from "_driver.h":
-    double ballc_py_hypot(int n, const double *values) nogil
-    double ballc_py_ulp(double x) nogil
-    double ballc_dot3_fma(const double *v) nogil
+    double BALLC_CLEAR_FACTOR, BALLC_PASS_FACTOR, BALLC_STOP_FACTOR, BALLC_APPROACH_FRACTION
+    double BALLC_MIN_IMPACT_RATE, BALLC_CHECK_GROWTH, BALLC_FLIGHT_MAX_TURN
+    long BALLC_FLIGHT_MAX_SAMPLES
+    int BALLC_MAX_RELATCH, BALLC_MAX_TRANSITIONS, BALLC_MAX_STALLED
+    int BALLC_STEPS_PER_CONTACT, BALLC_IMPACT_SPAN, BALLC_FLIGHT_MIN_INTERVALS
+    int BALLC_MAX_ROLL_SAMPLES
+    ctypedef struct ballc_flight:
+        double t0, rate
+    void ballc_flight_init(ballc_flight *, double, const double *, double) nogil
+    void ballc_flight_at(const ballc_flight *, double, double *) nogil
+    int ballc_flight_crossings(double, double, double, int, double, double *) nogil
     enum:
         BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
-        BALLC_DRIVE_FALLBACK, BALLC_DRIVE_NO_MEMORY, BALLC_DRIVE_TERMINATED,
+        BALLC_DRIVE_ABORTED, BALLC_DRIVE_NO_MEMORY, BALLC_DRIVE_TERMINATED,
         BALLC_DRIVE_USER_ERROR
     ctypedef struct ballc_drive_config:
         const double *params
@@ -33,9 +42,6 @@ cdef extern from "_driver.h":
         double rho_offset[2]
         double through_offset[2]
         double threshold_base[2]
-        int n_terms[2][2]
-        int term_index[2][2][2]
-        double term_coef[2][2][2]
         double slip_map[2][2][19]
         const double *t_eval
         long n_eval
@@ -167,9 +173,22 @@ cdef extern from "_driver.h":
     void ballc_drive_free(ballc_drive_output *) nogil
 
 
-DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH, DRIVE_TERMINATED = (
+DRIVE_OK, DRIVE_FAILED, DRIVE_UNSETTLED, DRIVE_THROUGH, DRIVE_TERMINATED, DRIVE_ABORTED = (
     BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
-    BALLC_DRIVE_TERMINATED)
+    BALLC_DRIVE_TERMINATED, BALLC_DRIVE_ABORTED)
+
+#: The automaton's constants, from _driver.h (ballc.stickslip, compliantmodes, resting,
+#: flight and modes name them)
+CLEAR_FACTOR, PASS_FACTOR, STOP_FACTOR = BALLC_CLEAR_FACTOR, BALLC_PASS_FACTOR, BALLC_STOP_FACTOR
+APPROACH_FRACTION, MAX_RELATCH = BALLC_APPROACH_FRACTION, BALLC_MAX_RELATCH
+MAX_TRANSITIONS, MAX_STALLED = BALLC_MAX_TRANSITIONS, BALLC_MAX_STALLED
+MIN_IMPACT_RATE = BALLC_MIN_IMPACT_RATE
+STEPS_PER_CONTACT, IMPACT_SPAN = BALLC_STEPS_PER_CONTACT, BALLC_IMPACT_SPAN
+CHECK_GROWTH = BALLC_CHECK_GROWTH
+FLIGHT_MIN_INTERVALS, FLIGHT_MAX_TURN = BALLC_FLIGHT_MIN_INTERVALS, BALLC_FLIGHT_MAX_TURN
+FLIGHT_MAX_SAMPLES, MAX_ROLL_SAMPLES = BALLC_FLIGHT_MAX_SAMPLES, BALLC_MAX_ROLL_SAMPLES
+#: A contact's phases in Drive.phases(): slip, stick, then its closed-form end state
+PHASE_NAMES = ("slip", "stick", "rest", "rolling", "free_sliding")
 
 
 #: The names of the segment log's codes (_driver.c): a plane's mode (ballc.automaton.MODES),
@@ -214,7 +233,7 @@ cdef int _check_signals() except -1:
 cdef int _drive_interrupted(void *ctx) noexcept nogil:
     """Before each segment: a pending signal's exception (Ctrl-C: KeyboardInterrupt) is
     kept with the user events' exceptions (ctx[1]) for drive to raise, and the run
-    stops (the Python driver could be interrupted between segments: so can this)."""
+    stops."""
     with gil:
         try:
             _check_signals()
@@ -295,92 +314,135 @@ cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
             return -1
 
 
-def _py_hypot(values):
-    """The C port of math.hypot (tests)."""
-    cdef double v[8]
-    cdef int i, n = len(values)
-    if n > 8:
-        raise ValueError("at most 8 values")
-    for i in range(n):
-        v[i] = values[i]
-    return ballc_py_hypot(n, v)
-
-
-def _py_ulp(double x):
-    """The C port of math.ulp (tests)."""
-    return ballc_py_ulp(x)
-
-
-def _dot3_fma(const double[::1] v):
-    """The C helper that reproduces numpy's float64 v.dot(v) of length 3 (tests)."""
-    return ballc_dot3_fma(&v[0])
-
-
-def _dot3_fma_many(const double[:, ::1] v):
-    """_dot3_fma per row (tests)."""
-    out = np.empty(v.shape[0])
-    cdef double[::1] o = out
+def flight_states(double t0, const double[::1] y0, double gravity, t):
+    """The exact free flight from (t0, y0) under ``gravity`` (m/s^2) at the times t
+    (_driver.c's ballc_flight): (N_STATES,) for a scalar t, (N_STATES, len(t)) for a 1-D
+    array."""
+    cdef ballc_flight f
     cdef Py_ssize_t i
-    for i in range(v.shape[0]):
-        o[i] = ballc_dot3_fma(&v[i, 0])
-    return out
+    if y0.shape[0] != BALLC_N_STATES:
+        raise ValueError(f"y0 must have length {BALLC_N_STATES}")
+    times = np.asarray(t, dtype=float)
+    cdef const double[::1] tv = np.ascontiguousarray(times.ravel())
+    out = np.empty((tv.shape[0], BALLC_N_STATES))
+    cdef double[:, ::1] o = out
+    ballc_flight_init(&f, t0, &y0[0], gravity)
+    for i in range(tv.shape[0]):
+        ballc_flight_at(&f, tv[i], &o[i, 0])
+    return out[0] if times.ndim == 0 else out.T
 
 
-def _hypot_many(const double[:, ::1] v):
-    """_py_hypot per row (tests)."""
-    out = np.empty(v.shape[0])
-    cdef double[::1] o = out
-    cdef Py_ssize_t i
-    for i in range(v.shape[0]):
-        o[i] = ballc_py_hypot(<int>v.shape[1], &v[i, 0])
-    return out
+def flight_crossings(double c0, double c1, double c2, int direction, double s_max):
+    """The roots of c0 + c1 s + c2 s^2 in [0, s_max] where it changes sign in
+    ``direction``, increasing (_driver.c's, which locates an exact flight's events)."""
+    cdef double out[2]
+    cdef int n = ballc_flight_crossings(c0, c1, c2, direction, s_max, out)
+    return [out[i] for i in range(n)]
 
 
-def drive(const double[::1] params, const double[::1] y0, dict k, progress=None):
-    """Run the segment loop in C with the constants ``k`` (simulate._c_config), each
-    segment integrated by ``k["method"]``: a compiled one, or one of scipy's (through
-    _scipy_integrate).  ``progress``: None, or a tqdm bar advanced to the simulated time
-    (at most every ``k["poll_interval"]`` s of wall time, default 0.1).
-    Returns None when the run needs the Python driver (nothing of it is kept), else a
-    dict of the run's samples, contacts, phases and end."""
+cdef class DriveScene:
+    """The constants of the C loop that depend on the scene alone (ballc_drive_config's
+    scene part), converted once from ``k`` (ballc.loop_constants); ``params`` (the
+    parameter vector, N_PARAMETERS) is kept for the runs, ``python`` for Python's own."""
     cdef ballc_drive_config c
-    cdef ballc_drive_output o
-    cdef int p, row, j, rc
-    cdef double[::1] tv
-    cdef double[:, ::1] rv, lv
-    cdef ballc_contact_rec rec
-    cdef Py_ssize_t i
-    cdef const double[:, :, ::1] smap = k["slip_map"]
+    cdef readonly object params
+    cdef public dict python   # what Python keeps of the scene's constants (loop_constants)
+
+    def __init__(self, params, dict k):
+        cdef int p, row, j
+        cdef const double[:, :, ::1] smap = k["slip_map"]
+        cdef const double[::1] pv
+        self.params = np.array(params, dtype=float)
+        self.params.flags.writeable = False
+        self.python = {}
+        pv = self.params
+        if pv.shape[0] != BALLC_N_PARAMETERS:
+            raise ValueError("params of the wrong length")
+        memset(&self.c, 0, sizeof(ballc_drive_config))
+        self.c.params = &pv[0]
+        self.c.observer_bits = k["observer_bits"]
+        self.c.exact = k["exact"]
+        self.c.radius = k["radius"]
+        self.c.weight = k["weight"]
+        self.c.hertz_k = k["hertz_k"]
+        self.c.total_mass = k["total_mass"]
+        self.c.rest_period = k["rest_period"]
+        self.c.resting_plane = k["resting_plane"]
+        self.c.gravity = k["gravity"]
+        self.c.compliant_modes = k["compliant_modes"]
+        self.c.compliant_any = k["compliant_any"]
+        self.c.compliant_sliding_any = k["compliant_sliding_any"]
+        self.c.restick_factor = k["restick_factor"]
+        self.c.damping_positive = k["damping_positive"]
+        self.c.contact_time_base = k["contact_time_base"]
+        self.c.observer_massive = k["observer_massive"]
+        self.c.rolls_allowed = k["rolls_allowed"]
+        self.c.orbit_applies = k["orbit_applies"]
+        self.c.rho_eq = k["rho_eq"]
+        self.c.z_eq = k["z_eq"]
+        self.c.rest_weight = k["rest_weight"]
+        self.c.observer_weight = k["observer_weight"]
+        self.c.rolls_level = k["rolls_level"]
+        self.c.half_mass = k["half_mass"]
+        self.c.rest_factor = k["rest_factor"]
+        for j in range(3):
+            self.c.orbit_axis[j] = k["orbit_axis"][j]
+        for p in range(2):
+            self.c.compliant_bits[p] = k["compliant_bits"][p]
+            self.c.elastic_bits[p] = k["elastic_bits"][p]
+            self.c.sliding_bits[p] = k["sliding_bits"][p]
+            self.c.arm_depth[p] = k["arm_depth"][p]
+            self.c.ulp8[p] = k["ulp8"][p]
+            self.c.contact_bits[p] = k["contact_bits"][p]
+            self.c.slip_bits[p] = k["slip_bits"][p]
+            self.c.slip_fixed_bits[p] = k["slip_fixed_bits"][p]
+            self.c.stick_bits[p] = k["stick_bits"][p]
+            self.c.rho_scale[p] = k["rho_scale"][p]
+            self.c.rho_offset[p] = k["rho_offset"][p]
+            self.c.through_offset[p] = k["through_offset"][p]
+            self.c.threshold_base[p] = k["threshold_base"][p]
+            for row in range(2):
+                for j in range(BALLC_N_STATES):
+                    self.c.slip_map[p][row][j] = smap[p, row, j]
+
+
+def drive(DriveScene scene, const double[::1] y0, dict k, progress=None):
+    """Run the segment loop in C for ``scene``'s constants and the run's ``k``
+    (ballc.loop_constants.run_constants), each segment integrated by ``k["method"]``: a
+    compiled one, or one of scipy's (through _scipy_integrate).  ``progress``: None, or a
+    tqdm bar advanced to the simulated time (at most every ``k["poll_interval"]`` s of
+    wall time).  Returns the run (a Drive); raises what a user's event, an integrator
+    or Ctrl-C raised."""
+    cdef ballc_drive_config c = scene.c   # the scene's part, copied; the run's below
+    cdef Drive run = Drive.__new__(Drive)
+    cdef int rc
     cdef const double[::1] t_eval = k["t_eval"]   # None: no t_eval
-    cdef const double[:, ::1] ucoef = k["user_coef"]
-    cdef const double[::1] uoffset = k["user_offset"], uscale = k["user_scale"]
-    cdef const int[::1] ulinear = k["user_linear"], uindex = k["user_index"]
-    cdef const int[::1] ucount = k["user_count"], udirection = k["user_direction"]
-    cdef list user_ctx = [k["user_events"], [], k["user_rearms"], progress]
-    cdef const int[::1] urearm = k["user_rearm"]
+    cdef const double[:, ::1] ucoef
+    cdef const double[::1] uoffset, uscale
+    cdef const int[::1] ulinear, uindex, ucount, udirection, urearm
     cdef const double[::1] atol_states = k["atol_states"]   # None: one atol
-    cdef _ScipyRun scipy_run = None
-    cdef ballc_piece_rec piece
-    cdef double[:, ::1] dtv, dcv
-    cdef int[::1] dkv
-    if params.shape[0] != BALLC_N_PARAMETERS or y0.shape[0] != BALLC_N_STATES:
-        raise ValueError("params or y0 of the wrong length")
-    c.params = &params[0]
+    users = k["users"]   # None: no user events
+    cdef list user_ctx = [users["user_events"] if users else None, [],
+                          users["user_rearms"] if users else None, progress]
+    if y0.shape[0] != BALLC_N_STATES:
+        raise ValueError("y0 of the wrong length")
     c.rtol = k["rtol"]
     c.atol = k["atol"]
     c.t_end = k["t_end"]
     c.max_step = k["max_step"]
-    c.has_first_step = k["first_step"] is not None
-    c.first_step = k["first_step"] if c.has_first_step else 0.0
-    c.max_nfev = 0 if k["max_nfev"] is None else k["max_nfev"]
+    first_step = k["first_step"]
+    c.has_first_step = first_step is not None
+    c.first_step = first_step if c.has_first_step else 0.0
+    max_nfev = k["max_nfev"]
+    c.max_nfev = 0 if max_nfev is None else max_nfev
     c.integrate = NULL   # the compiled integrators (radau5_solve)
     c.integrate_ctx = NULL
     c.interpolant = NULL
     if k["scipy"]:   # one of scipy's methods, called back segment by segment
-        scipy_run = _ScipyRun(k["method"], k["scipy_atol"], np.asarray(params), user_ctx[1])
+        run.scipy_run = _ScipyRun(k["method"], k["scipy_atol"], scene.params, user_ctx[1])
         c.method = BALLC_METHOD_SCIPY
         c.integrate = _scipy_integrate
-        c.integrate_ctx = <void *>scipy_run
+        c.integrate_ctx = <void *>run.scipy_run
         c.interpolant = _scipy_interpolant
     else:
         c.method = _method_code(k["method"])
@@ -390,18 +452,12 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
     c.progress = NULL
     if progress is not None:
         c.progress = _drive_progress
-    c.poll_interval = k.get("poll_interval", 0.1)
+    c.poll_interval = k["poll_interval"]
     c.rearm_fun = _drive_user_rearm
     c.controller = _controller[0]
-    c.observer_bits = k["observer_bits"]
-    c.exact = k["exact"]
-    c.radius = k["radius"]
-    c.weight = k["weight"]
-    c.hertz_k = k["hertz_k"]
-    c.total_mass = k["total_mass"]
-    c.rest_period = k["rest_period"]
-    c.resting_plane = k["resting_plane"]
     c.checks_rest = k["checks_rest"]
+    c.rest_threshold = k["rest_threshold"]
+    c.rolls_dv = k["rolls_dv"]
     c.t_eval = NULL
     c.n_eval = 0
     if t_eval is not None:
@@ -409,16 +465,25 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
         c.t_eval = &t_eval[0] if c.n_eval else &y0[0]   # non-NULL: t_eval given
     c.dense_output = k["dense_output"]
     c.exact_flight = k["exact_flight"]
-    c.gravity = k["gravity"]
-    c.n_user = ucount.shape[0]
-    c.user_flight = k["user_flight"]
     c.user_fun = _drive_user_event
     c.user_ctx = <void *>user_ctx
     c.interrupted = _drive_interrupted
+    c.n_user = 0
+    c.user_flight = 1
     c.user_coef = c.user_offset = c.user_scale = NULL
     c.user_linear = c.user_index = c.user_count = c.user_direction = NULL
     c.user_rearm = NULL
-    if c.n_user:
+    if users:
+        ucoef = users["user_coef"]
+        uoffset = users["user_offset"]
+        uscale = users["user_scale"]
+        ulinear = users["user_linear"]
+        uindex = users["user_index"]
+        ucount = users["user_count"]
+        udirection = users["user_direction"]
+        urearm = users["user_rearm"]
+        c.n_user = ucount.shape[0]
+        c.user_flight = users["user_flight"]
         c.user_rearm = &urearm[0]
         c.user_coef = &ucoef[0, 0]
         c.user_offset = &uoffset[0]
@@ -427,103 +492,214 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
         c.user_index = &uindex[0]
         c.user_count = &ucount[0]
         c.user_direction = &udirection[0]
-    c.compliant_modes = k["compliant_modes"]
-    c.compliant_any = k["compliant_any"]
-    c.compliant_sliding_any = k["compliant_sliding_any"]
-    c.restick_factor = k["restick_factor"]
-    c.damping_positive = k["damping_positive"]
-    c.contact_time_base = k["contact_time_base"]
-    for p in range(2):
-        c.compliant_bits[p] = k["compliant_bits"][p]
-        c.elastic_bits[p] = k["elastic_bits"][p]
-        c.sliding_bits[p] = k["sliding_bits"][p]
-        c.arm_depth[p] = k["arm_depth"][p]
-        c.ulp8[p] = k["ulp8"][p]
-    c.observer_massive = k["observer_massive"]
-    c.rolls_allowed = k["rolls_allowed"]
-    c.orbit_applies = k["orbit_applies"]
-    c.rest_threshold = k["rest_threshold"]
-    c.rho_eq = k["rho_eq"]
-    c.z_eq = k["z_eq"]
-    c.rest_weight = k["rest_weight"]
-    c.observer_weight = k["observer_weight"]
-    c.rolls_dv = k["rolls_dv"]
-    c.rolls_level = k["rolls_level"]
-    c.half_mass = k["half_mass"]
-    for j in range(3):
-        c.orbit_axis[j] = k["orbit_axis"][j]
-    c.rest_factor = k["rest_factor"]
-    for p in range(2):
-        c.contact_bits[p] = k["contact_bits"][p]
-        c.slip_bits[p] = k["slip_bits"][p]
-        c.slip_fixed_bits[p] = k["slip_fixed_bits"][p]
-        c.stick_bits[p] = k["stick_bits"][p]
-        c.rho_scale[p] = k["rho_scale"][p]
-        c.rho_offset[p] = k["rho_offset"][p]
-        c.through_offset[p] = k["through_offset"][p]
-        c.threshold_base[p] = k["threshold_base"][p]
-        terms = k["slip_terms"][p]
-        for row in range(2):
-            c.n_terms[p][row] = len(terms[row])
-            for j in range(len(terms[row])):
-                c.term_index[p][row][j] = terms[row][j][0]
-                c.term_coef[p][row][j] = terms[row][j][1]
-            for j in range(BALLC_N_STATES):
-                c.slip_map[p][row][j] = smap[p, row, j]
     with nogil:
-        rc = ballc_drive(&c, &y0[0], &o)
-    try:
-        if rc == BALLC_DRIVE_NO_MEMORY:
-            raise MemoryError("ballc_drive: out of memory")
-        if rc == BALLC_DRIVE_FALLBACK:
-            return None
-        if rc == BALLC_DRIVE_USER_ERROR:   # as solve_system: the user's exception
-            raise user_ctx[1][0]
-        user_event = np.array([o.user_hit_event[i] for i in range(o.n_user_hits)],
-                              dtype=np.intc)
-        user_t = np.array([o.user_hit_t[i] for i in range(o.n_user_hits)], dtype=float)
-        user_y = np.empty((o.n_user_hits, BALLC_N_STATES))
-        if o.n_user_hits:
-            rv = user_y
-            memcpy(&rv[0, 0], o.user_hit_y, o.n_user_hits * BALLC_N_STATES * sizeof(double))
-        n = o.n
+        rc = ballc_drive(&c, &y0[0], &run.o)
+    run.owns = 1
+    if rc == BALLC_DRIVE_NO_MEMORY:
+        raise MemoryError("ballc_drive: out of memory")
+    if rc == BALLC_DRIVE_USER_ERROR:   # the user's exception, an integrator's, Ctrl-C
+        raise user_ctx[1][0]
+    run._samples()
+    return run
+
+
+cdef class Drive:
+    """One run of the C loop (ballc_drive_output): its samples ``t`` (n,) and ``rows``
+    (n, N_STATES), its scalars as attributes, the rest read on demand (the C buffers
+    are freed with it)."""
+    cdef ballc_drive_output o
+    cdef int owns
+    cdef _ScipyRun scipy_run
+    cdef readonly object t, rows
+
+    def __dealloc__(self):
+        if self.owns:
+            ballc_drive_free(&self.o)
+
+    cdef _samples(self):
+        """t and rows copied out; the C buffers of the samples freed at once."""
+        cdef long n = self.o.n
+        cdef double[::1] tv
+        cdef double[:, ::1] rv
         t = np.empty(n)
         rows = np.empty((n, BALLC_N_STATES))
         if n:
             tv = t
             rv = rows
-            memcpy(&tv[0], o.t, n * sizeof(double))
-            memcpy(&rv[0, 0], o.y, n * BALLC_N_STATES * sizeof(double))
-        counts = np.array([o.block_count[i] for i in range(o.n_blocks)], dtype=np.intp)
-        block_flags = np.array([o.block_flags[i] for i in range(o.n_blocks)], dtype=np.int32)
-        latches = np.empty((o.n_blocks, BALLC_N_LATCH))
-        if o.n_blocks:
+            memcpy(&tv[0], self.o.t, n * sizeof(double))
+            memcpy(&rv[0, 0], self.o.y, n * BALLC_N_STATES * sizeof(double))
+        free(self.o.t)
+        free(self.o.y)
+        self.o.t = self.o.y = NULL
+        self.t, self.rows = t, rows
+
+    @property
+    def stop_code(self): return self.o.stop_code
+    @property
+    def status(self): return self.o.status
+    @property
+    def stop_plane(self): return self.o.stop_plane
+    @property
+    def t_run(self): return self.o.t_run
+    @property
+    def fail_end(self): return self.o.fail_end
+    @property
+    def message(self): return self.o.message.decode()
+    @property
+    def in_contact(self): return (bool(self.o.in_contact[0]), bool(self.o.in_contact[1]))
+    @property
+    def transitions(self): return (self.o.transitions[0], self.o.transitions[1])
+    @property
+    def stalled(self): return self.o.stalled
+    @property
+    def unsettled_compliant(self): return bool(self.o.unsettled_compliant)
+    @property
+    def nfev(self): return self.o.nfev
+    @property
+    def njev(self): return self.o.njev
+    @property
+    def nlu(self): return self.o.nlu
+    @property
+    def stiff_at(self): return self.o.stiff_at
+    @property
+    def segments(self): return self.o.segments
+    @property
+    def end_kind(self): return self.o.end_kind
+    @property
+    def end_plane(self): return self.o.end_plane
+    @property
+    def end_t(self): return self.o.end_t
+    @property
+    def end_y(self):
+        return np.array([self.o.end_y[j] for j in range(BALLC_N_STATES)])
+    @property
+    def profiled(self): return bool(self.o.profiled)
+    @property
+    def integrator_ns(self): return self.o.integrator_ns
+    @property
+    def drive_ns(self): return self.o.drive_ns
+    @property
+    def integrator_prof(self):
+        """A -DRADAU5_PROFILE build's integrator counters, summed; else None."""
+        if not self.o.profiled:
+            return None
+        return dict(zip(("fun", "jac", "factor", "solve", "events", "total", "total_ns"),
+                        [self.o.integrator_prof[j] for j in range(7)]))
+
+    def blocks(self):
+        """(counts (blocks,), flags (blocks,) int32, latches (blocks, N_LATCH)): the
+        samples' blocks, each computed with one segment's flags and latch."""
+        cdef long m = self.o.n_blocks
+        cdef double[:, ::1] lv
+        counts = np.array([self.o.block_count[i] for i in range(m)], dtype=np.intp)
+        flags = np.array([self.o.block_flags[i] for i in range(m)], dtype=np.int32)
+        latches = np.empty((m, BALLC_N_LATCH))
+        if m:
             lv = latches
-            memcpy(&lv[0, 0], o.block_latch, o.n_blocks * BALLC_N_LATCH * sizeof(double))
-        contacts = []
-        for i in range(o.n_contacts):
-            rec = o.contacts[i]
-            contacts.append(dict(
-                plane=rec.plane, ended=rec.ended, passed_through=rec.passed_through,
-                rate_is_kernel_value=rec.rate_is_kernel_value,
-                t_start=rec.t_start, t_end=rec.t_end,
-                v_before=[rec.v_before[j] for j in range(3)],
-                w_before=[rec.w_before[j] for j in range(3)],
-                v_after=[rec.v_after[j] for j in range(3)],
-                w_after=[rec.w_after[j] for j in range(3)],
-                rate=rec.rate, digin=[rec.digin[j] for j in range(3)],
-                max_penetration=rec.max_penetration,
-                contact_point=[rec.contact_point[0], rec.contact_point[1]],
-                lost=(rec.lost[0], rec.lost[1])))
-        phases = [(o.phases[i].contact, o.phases[i].t, o.phases[i].phase)
-                  for i in range(o.n_phases)]
-        # the segment log, the bytes C wrote (SEGMENT_RECORD each): read when asked for
-        segments = (<char *>o.log)[:o.n_log * sizeof(ballc_segment_rec)] if o.n_log else b""
-        pieces = []   # dense output: (t0, t1, dense_t, dense_c, terms, dense_kind), or
-        for i in range(o.n_pieces):   # (t0, t1, y0) of an exact flight
-            piece = o.pieces[i]
-            if piece.own:   # the integrator's own interpolant (scipy's OdeSolution)
-                pieces.append((piece.t0, piece.t1, scipy_run.interpolants[piece.interpolant]))
+            memcpy(&lv[0, 0], self.o.block_latch, m * BALLC_N_LATCH * sizeof(double))
+        return counts, flags, latches
+
+    def contacts(self):
+        """The contacts' records as arrays, one row per contact: "plane", "ended",
+        "passed_through", "kernel_rate" (ints), "t_start", "t_end", "rate",
+        "max_penetration" (n,), "v_before", "w_before", "v_after", "w_after", "digin"
+        (n, 3), "contact_point", "lost" (normal, tangential) (n, 2); a contact that did
+        not end has NaN for t_end, v_after, w_after and lost."""
+        cdef long n = self.o.n_contacts, i
+        cdef int j
+        cdef ballc_contact_rec *rec
+        ints = np.empty((4, n), dtype=np.intc)
+        scalars = np.empty((4, n))
+        vectors = np.empty((5, n, 3))
+        pairs = np.empty((2, n, 2))
+        cdef int[:, ::1] iv = ints
+        cdef double[:, ::1] sv = scalars
+        cdef double[:, :, ::1] vv = vectors, pv = pairs
+        for i in range(n):
+            rec = &self.o.contacts[i]
+            iv[0, i], iv[1, i] = rec.plane, rec.ended
+            iv[2, i], iv[3, i] = rec.passed_through, rec.rate_is_kernel_value
+            sv[0, i], sv[1, i], sv[2, i], sv[3, i] = (rec.t_start, rec.t_end, rec.rate,
+                                                      rec.max_penetration)
+            for j in range(3):
+                vv[0, i, j] = rec.v_before[j]
+                vv[1, i, j] = rec.w_before[j]
+                vv[2, i, j] = rec.v_after[j]
+                vv[3, i, j] = rec.w_after[j]
+                vv[4, i, j] = rec.digin[j]
+            for j in range(2):
+                pv[0, i, j] = rec.contact_point[j]
+                pv[1, i, j] = rec.lost[j]
+            if not rec.ended:
+                sv[1, i] = NAN
+                for j in range(3):
+                    vv[2, i, j] = NAN
+                    vv[3, i, j] = NAN
+                pv[1, i, 0] = pv[1, i, 1] = NAN
+        return dict(plane=ints[0], ended=ints[1], passed_through=ints[2], kernel_rate=ints[3],
+                    t_start=scalars[0], t_end=scalars[1], rate=scalars[2],
+                    max_penetration=scalars[3], v_before=vectors[0], w_before=vectors[1],
+                    v_after=vectors[2], w_after=vectors[3], digin=vectors[4],
+                    contact_point=pairs[0], lost=pairs[1])
+
+    def phases(self):
+        """[(contact index, t, phase code: PHASE_NAMES)], in order."""
+        return [(self.o.phases[i].contact, self.o.phases[i].t, self.o.phases[i].phase)
+                for i in range(self.o.n_phases)]
+
+    def open_contacts(self):
+        """The open contact's index per plane (floor, ceiling), -1 none."""
+        return (self.o.open[0], self.o.open[1])
+
+    def user_hits(self):
+        """(event index (m,) intc, t (m,), states (m, N_STATES)): the user's events' hits."""
+        cdef long m = self.o.n_user_hits
+        cdef double[:, ::1] rv
+        event = np.array([self.o.user_hit_event[i] for i in range(m)], dtype=np.intc)
+        times = np.array([self.o.user_hit_t[i] for i in range(m)], dtype=float)
+        states = np.empty((m, BALLC_N_STATES))
+        if m:
+            rv = states
+            memcpy(&rv[0, 0], self.o.user_hit_y, m * BALLC_N_STATES * sizeof(double))
+        return event, times, states
+
+    def switches(self):
+        """method "auto": [(t, method switched to)]."""
+        return [(self.o.switch_t[i], _METHOD_NAMES[self.o.switch_to[i]])
+                for i in range(self.o.n_switches)]
+
+    def trials(self):
+        """ballc.orbit's trials: [(t_from, t_to, accepted)]."""
+        return [(self.o.trials[3 * i], self.o.trials[3 * i + 1], bool(self.o.trials[3 * i + 2]))
+                for i in range(self.o.n_trials)]
+
+    def segment_log(self):
+        """The segment log: the bytes C wrote (SEGMENT_RECORD each)."""
+        if not self.o.n_log:
+            return b""
+        return (<char *>self.o.log)[:self.o.n_log * sizeof(ballc_segment_rec)]
+
+    def orbit(self):
+        """ballc.orbit's end: (c0, period, G, rate, its base's pieces), or None."""
+        if not self.o.end_orbit:
+            return None
+        return (self.o.orbit.c0, self.o.orbit.period, _motion_tuple(&self.o.orbit.g),
+                self.o.orbit.rate, _dense_pieces(&self.o.orbit_base))
+
+    def pieces(self):
+        """Dense output, per segment: (t0, t1, dense_t, dense_c, terms, dense_kind) the
+        compiled integrators' steps, (t0, t1, y0) an exact flight, (t0, t1, interpolant)
+        an integrator's own (scipy's OdeSolution)."""
+        cdef ballc_piece_rec *piece
+        cdef double[:, ::1] dtv, dcv
+        cdef int[::1] dkv
+        cdef long i
+        pieces = []
+        for i in range(self.o.n_pieces):
+            piece = &self.o.pieces[i]
+            if piece.own:
+                pieces.append((piece.t0, piece.t1,
+                               self.scipy_run.interpolants[piece.interpolant]))
                 continue
             if piece.flight:
                 pieces.append((piece.t0, piece.t1,
@@ -536,40 +712,13 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
                 dtv = dense_t
                 dcv = dense_c
                 dkv = dense_kind
-                memcpy(&dtv[0, 0], o.dense_t + 2 * piece.step0,
+                memcpy(&dtv[0, 0], self.o.dense_t + 2 * piece.step0,
                        piece.n_steps * 2 * sizeof(double))
-                memcpy(&dcv[0, 0], o.dense_c + piece.coef0,
+                memcpy(&dcv[0, 0], self.o.dense_c + piece.coef0,
                        piece.n_steps * (1 + piece.terms) * BALLC_N_STATES * sizeof(double))
-                memcpy(&dkv[0], o.dense_kind + piece.step0, piece.n_steps * sizeof(int))
+                memcpy(&dkv[0], self.o.dense_kind + piece.step0, piece.n_steps * sizeof(int))
             pieces.append((piece.t0, piece.t1, dense_t, dense_c, piece.terms, dense_kind))
-        orbit = None   # ballc.orbit's end: (c0, period, G, rate) and its base's pieces
-        if o.end_orbit:
-            orbit = (o.orbit.c0, o.orbit.period, _motion_tuple(&o.orbit.g), o.orbit.rate,
-                     _dense_pieces(&o.orbit_base))
-        return dict(orbit=orbit,
-                    trials=[(o.trials[3 * i], o.trials[3 * i + 1], bool(o.trials[3 * i + 2]))
-                            for i in range(o.n_trials)],
-                    t=t, rows=rows, counts=counts, block_flags=block_flags, latches=latches,
-                    contacts=contacts, phases=phases, pieces=pieces,
-                    user_hits=(user_event, user_t, user_y),
-                    switches=[(o.switch_t[i], _METHOD_NAMES[o.switch_to[i]])
-                              for i in range(o.n_switches)], open=(o.open[0], o.open[1]),
-                    stop_code=o.stop_code, status=o.status, stop_plane=o.stop_plane,
-                    t_run=o.t_run, fail_end=o.fail_end, message=o.message.decode(),
-                    in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),
-                    transitions=(o.transitions[0], o.transitions[1]), stalled=o.stalled,
-                    unsettled_compliant=bool(o.unsettled_compliant),
-                    nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
-                    segments=o.segments, end_kind=o.end_kind, end_plane=o.end_plane,
-                    end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(BALLC_N_STATES)]),
-                    profiled=bool(o.profiled), segment_log=segments,
-                    integrator_prof=dict(zip(("fun", "jac", "factor", "solve", "events",
-                                              "total", "total_ns"),
-                                             [o.integrator_prof[j] for j in range(7)]))
-                    if o.profiled else None,
-                    integrator_ns=o.integrator_ns, drive_ns=o.drive_ns)
-    finally:
-        ballc_drive_free(&o)
+        return pieces
 
 
 cdef list _dense_pieces(const ballc_dense *d):

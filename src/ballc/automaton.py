@@ -1,8 +1,9 @@
 """ballc's hybrid automaton, in one table: the modes of a plane, the guards that end a
 segment, and the resets that start the next.
 
-A run is a sequence of smooth segments (simulate.py integrates one at a time).  Each
-plane is in one *mode* at a time:
+A run is a sequence of smooth segments, integrated one at a time by the segment loop
+in C (``_driver.c``, ``ballc_drive``: the one driver, docs/driver.md).  Each plane is
+in one *mode* at a time:
 
 * ``flight``: not in contact;
 * with exact Coulomb friction (ballc.stickslip; the friction and mixture models):
@@ -15,17 +16,18 @@ plane is in one *mode* at a time:
   with the wobble of an eccentric observer: ballc.orbit); ``passed_through`` (the ball
   left through the plane: status 1).
 
-:data:`TRANSITIONS` lists every transition: the event kind (the name
-events.segment_events gives its guard), the modes it leaves from, the modes it may lead
-to, the guard (event function and direction), the reset, and the method of
-simulate._Run that applies it.  :data:`SIMULTANEOUS` is how simultaneous events are
+:data:`TRANSITIONS` lists every transition: the event kind (the name the C loop's
+segment log gives its guard, ``_core.SEGMENT_ENDS``), the modes it leaves from, the
+modes it may lead to, the guard (event function and direction), the reset, and the C
+function of ``_driver.c`` that applies it.  :data:`SIMULTANEOUS` is how simultaneous events are
 ordered.  One scheduled segment end changes no mode and is not a row: a compliant
 contact's step bound (steps of at most t_c/16 for its first 4 t_c,
-compliantmodes.step_bound) ends a segment where it ends, and the next goes on in the
-same modes with the tolerance's steps.  ``simulate`` dispatches every event through
-:func:`handler_of`, and
-tests/test_automaton.py runs scenes that take every transition and checks each one it
-sees against this table.  docs/architecture.md draws it.
+ballc.compliantmodes.STEPS_PER_CONTACT) ends a segment where it ends, and the next goes
+on in the same modes with the tolerance's steps.  The C loop reports each segment's
+modes before and after its end (``Result.segments``); tests/test_automaton.py runs
+scenes that take every transition, checks each one the C loop reports against this
+table, and that each row's handler is the C function that applies it.
+docs/architecture.md draws it.
 """
 from __future__ import annotations
 
@@ -43,12 +45,12 @@ MODES = ("flight",) + CONTACT_MODES + END_MODES
 class Transition:
     """One row of the automaton."""
 
-    event: str           # the event kind (events.segment_events), or a scheduled check
+    event: str           # the event kind (_core.SEGMENT_ENDS), or a scheduled check
     sources: tuple       # modes of the plane it leaves from
     targets: tuple       # modes it may lead to
     guard: str           # the event function g and its direction (terminal events)
     reset: str           # what is latched or reset, and how the next mode is chosen
-    handler: str         # the simulate._Run method that applies it
+    handler: str         # the function of _driver.c that applies it
 
 
 TRANSITIONS = (
@@ -102,12 +104,12 @@ TRANSITIONS = (
                "scheduled (not an event): 20 small-oscillation periods into a floor "
                "contact, then at growing intervals, and at the end of an orbit's trial",
                "the rest state, in closed form to t_end; else the next check",
-               "check_rest"),
+               "at_rest"),
     Transition("uniform check", CONTACT_MODES, ("rolling", "free_sliding") + CONTACT_MODES,
                "at a rest check that found no rest",
                "uniform rolling or sliding (massless observer, isotropic inertia; "
                "ballc.resting), in closed form to t_end; else go on",
-               "check_rolling"),
+               "rolls"),
     Transition("orbit check", CONTACT_MODES, ("rolling", "free_sliding") + CONTACT_MODES,
                "at a rest check that found neither rest nor uniform motion, when it ends "
                "an orbit's trial (TRIAL_PERIODS periods integrated in one mode)",
@@ -118,9 +120,10 @@ TRANSITIONS = (
 
 #: How simultaneous events are handled: the earliest terminal event that fired ends the
 #: segment (an event at the segment's start is kept off by its threshold or offset);
-#: at equal times the first in events.segment_events' order, which is per plane (floor,
-#: then ceiling): leave / enter, through, deepest (not terminal), the Coulomb event, the
-#: compliant guard; the user's events come after the driver's.  A mode change at the
+#: at equal times the first in the C loop's order of a segment's events (_driver.c:
+#: segment_events), which is per plane (floor, then ceiling): leave / enter, through,
+#: deepest (not terminal), the Coulomb event, the compliant guard; the user's events come
+#: after the loop's own.  A mode change at the
 #: time of the last one counts as stalled, and 100 in a row stop the run (status -1).
 SIMULTANEOUS = ("leave", "enter", "through", "deepest", "approach", "stop", "clear",
                 "release", "arm", "yield", "capacity", "restick", "user")
@@ -129,7 +132,7 @@ _HANDLERS = {transition.event: transition.handler for transition in TRANSITIONS}
 
 
 def handler_of(kind: str) -> str:
-    """The simulate._Run method that applies the event ``kind``."""
+    """The function of ``_driver.c`` that applies the event ``kind``."""
     try:
         return _HANDLERS[kind]
     except KeyError:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -31,11 +31,10 @@ DEFAULT_MAX_NFEV = 20_000_000
 
 #: scipy raises any rtol below 100 machine epsilons to that value (with a warning);
 #: ballc rejects such an rtol instead of silently integrating with another one.
-MIN_RTOL = 100 * np.finfo(float).eps
+MIN_RTOL = float(100 * np.finfo(float).eps)
 
 
-@dataclass(frozen=True)
-class Options:
+class Options(NamedTuple):
     """Validated options of one simulate call."""
 
     t_end: float
@@ -62,6 +61,10 @@ def _is_number_like(value) -> bool:
 
 
 def _positive_number(name, value, allow_inf=False, hint="a number > 0") -> float:
+    if type(value) is float or type(value) is int:   # the common case, without numpy
+        if value > 0 and (value < math.inf or allow_inf and value == math.inf):
+            return float(value)
+        raise SceneError(f"{name} = {plain(value)} is not allowed: must be {hint}")
     if not _is_number_like(value) or np.ndim(value) != 0:
         raise SceneError(f"{name} = {plain(value)} is not allowed: must be {hint}")
     number = float(value)
@@ -81,6 +84,9 @@ def check_method(method) -> str:
 
 def check_tolerances(rtol, atol):
     """(rtol, atol) as float and float-or-array, or SceneError naming the bad one."""
+    if (type(rtol) is float and type(atol) is float and MIN_RTOL <= rtol < math.inf
+            and 0 < atol < math.inf):   # the common case, without numpy
+        return rtol, atol
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not _is_number_like(value):
             raise SceneError(f"{name} = {plain(value)} is not allowed: must be a number "

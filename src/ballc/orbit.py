@@ -25,8 +25,10 @@ closed form (:class:`RelativePeriodicOrbit`):
     dissipated work:              + k (its increase over one period)
 
 The computation is in C (``_orbit.c``): the C loop (``_driver.c``) runs the trial and
-the measurement at its rest checks, and this module reaches the same functions through
-the bridge (``_core.orbit_*``); it keeps no second copy of G or of the criteria.
+the measurement at its rest checks, and samples the orbit to t_end (32 samples per
+period, at most ballc.resting.MAX_ROLL_SAMPLES); this module gives it the scene's
+constants and reaches the same functions through the bridge (``_core.orbit_*``: the
+dense output, and tests); it keeps no second copy of G or of the criteria.
 
 **Criterion** (:func:`measure`), at a rest check that found neither rest nor uniform
 motion (ballc.resting), all of:
@@ -73,18 +75,9 @@ TRIAL_PERIODS = _core.ORBIT_TRIAL_PERIODS
 TILT_SAMPLES = _core.ORBIT_TILT_SAMPLES
 
 
-def sample_times(t0, t1, period):
-    """Sample times of an orbit's closed-form stretch after t0 up to t1: 32 per period,
-    at most ballc.resting.MAX_ROLL_SAMPLES (sol(t) is exact anywhere)."""
-    n = min(resting.MAX_ROLL_SAMPLES, max(32, math.ceil(32 * (t1 - t0) / period)))
-    t = t0 + (t1 - t0) * np.arange(1, n + 1) / n
-    t[-1] = t1
-    return t
-
-
 def applies(scene) -> bool:
     """Routh's sphere on the floor: g > 0, isotropic inertia, a massive observer."""
-    p = scene.parameter_vector()
+    p = scene._parameters   # (read only)
     return bool(scene.gravity > 0 and scene.observer_mass > 0
                 and p[_PARAMETER["inertia_xx"]] == p[_PARAMETER["inertia_yy"]]
                 == p[_PARAMETER["inertia_zz"]])
@@ -137,33 +130,6 @@ def equivariant(params, latch, flags, y, axis) -> bool:
                                    np.ascontiguousarray(latch, dtype=float), int(flags),
                                    np.ascontiguousarray(y, dtype=float),
                                    np.ascontiguousarray(axis, dtype=float))
-
-
-class Trial:
-    """The segments integrated to measure an orbit on ``plane``: from t_from, in one
-    mode, to t_to (TRIAL_PERIODS times the ``guess`` of its period).  The Python
-    driver's; the C loop keeps its own in C."""
-
-    def __init__(self, plane, t_from, t_to, guess):
-        self.plane, self.t_from, self.t_to, self.guess = plane, t_from, t_to, guess
-        self.pieces = []
-        self.broken = False
-
-    def add(self, t0, t1, interpolant):
-        """One more segment [t0, t1] and its interpolant; a segment ended by an event
-        (t1 None), without dense output, or not continuing the last breaks the trial."""
-        end = self.pieces[-1][1] if self.pieces else self.t_from
-        if t1 is None or interpolant is None or t0 != end:
-            self.broken = True
-        else:
-            self.pieces.append((t0, t1, interpolant))
-
-    def solution(self, t):
-        """y(t') over [t_from, t] from the trial's segments, or None when it broke."""
-        if self.broken or not self.pieces or self.pieces[-1][1] != t:
-            return None
-        from .dense import PiecewiseSolution
-        return PiecewiseSolution(self.pieces)
 
 
 class RelativePeriodicOrbit:

@@ -93,7 +93,7 @@ def format_summary(result) -> str:
     return "\n".join(lines)
 
 
-# ---- post-processing of a finished run (simulate calls these) ----
+# ---- post-processing of a finished run (its Result calls these on first access) ----
 
 #: The loosest tolerance ballc is tested at (the stress matrix, the come-back maps'
 #: rtol = atol = 1e-3): with a looser rtol or atol the result is not to be trusted,
@@ -108,9 +108,10 @@ MAX_BALANCE_DRIFT = 1e-2
 def tolerance_warning(rtol, atol) -> str:
     """A warning for the message when rtol or atol is looser than the loosest
     tolerance ballc is tested at (LOOSEST_TRUSTED_TOLERANCE); "" otherwise."""
-    loose = [f"{name} = {float(np.max(value)):g}" for name, value in (("rtol", rtol),
-                                                                     ("atol", atol))
-             if float(np.max(value)) > LOOSEST_TRUSTED_TOLERANCE]
+    largest = [(name, value if type(value) is float else float(np.max(value)))
+               for name, value in (("rtol", rtol), ("atol", atol))]
+    loose = [f"{name} = {value:g}" for name, value in largest
+             if value > LOOSEST_TRUSTED_TOLERANCE]
     if not loose:
         return ""
     return (f" Warning: {' and '.join(loose)} is looser than "
@@ -151,13 +152,21 @@ def summarize_contact_forces(result):
     """Peak normal force and sticking / slipping time of every contact, from the
     stored samples (solver steps, or t_eval: the resolution is that of the samples);
     with exact Coulomb friction the sticking and slipping times come from the
-    transition events instead."""
-    contacts = result.contacts
+    transition events instead.  NaN for a contact without samples."""
+    summarize_contacts(result.contacts, result.t, result.y, result.latch, result.flags,
+                       result.scene)
+
+
+def summarize_contacts(contacts, t, y, latch, flags, scene):
+    """:func:`summarize_contact_forces` of ``contacts`` over a run's samples: times
+    ``t``, states ``y`` (N_STATES, n), and each sample's segment's ``latch`` and
+    ``flags`` (a run's contacts call it on first access to one of them)."""
+    for contact in contacts:
+        contact._summary = None
+        contact.peak_normal_force = contact.time_sticking = contact.time_slipping = math.nan
     if not contacts:
         return
-    scene = result.scene
     mu = scene.friction_coefficient
-    t = result.t
     ends = [c.t_end if np.isfinite(c.t_end) else t[-1] for c in contacts]
     # each contact's samples, t_start <= t <= end: one run of them (t is increasing)
     firsts = np.searchsorted(t, [c.t_start for c in contacts], side="left").tolist()
@@ -169,9 +178,8 @@ def summarize_contact_forces(result):
     # (rows of result.y and latch: views, they are Fortran-ordered)
     rows = np.concatenate([np.arange(first, stop) for first, stop in runs])
     forces = _core.contact_forces_per_sample(
-        np.ascontiguousarray(result.y.T[rows]), scene.parameter_vector(),
-        np.ascontiguousarray(result.latch.T[rows]),
-        np.ascontiguousarray(result.flags[rows], dtype=np.int32))
+        np.ascontiguousarray(y.T[rows]), scene.parameter_vector(),
+        np.ascontiguousarray(latch.T[rows]), np.ascontiguousarray(flags[rows], dtype=np.int32))
     offset = 0
     for contact, end, first, stop in zip(contacts, ends, firsts, stops):
         if stop <= first:

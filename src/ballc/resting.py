@@ -2,19 +2,21 @@
 
 A bouncing ball whose bounces die out stays in contact with the floor, and its normal
 oscillation about the static Hertz equilibrium decays (Hunt-Crossley or viscoelastic
-damping).  Integrating that state to a long t_end costs steps for nothing.  The driver
-(ballc.simulate) checks, at times of a persistent contact, whether the ball is at rest
-by the criterion below, and if it is finishes the run analytically: the state is the
-static equilibrium from then on.
+damping).  Integrating that state to a long t_end costs steps for nothing.  The C loop
+(``_driver.c``: end_state, at_rest, rolls) checks, at times of a persistent contact --
+20 small-oscillation periods into it, then each time its age has grown by a quarter
+(CHECK_GROWTH) or 20 periods, whichever is more -- whether the ball is at rest by the
+criterion below, and if it is finishes the run analytically: the state is the static
+equilibrium from then on.  This module gives it the per-scene constants.
 
-**Criterion** (:func:`at_rest`), at a check time t, all of:
+**Criterion**, at a check time t, all of:
 
 1. the ball is in contact with the plane gravity presses it against (the floor, for
    g > 0; a scene has g >= 0, so never the ceiling) and not with the other one;
 2. the contact has lasted at least REST_PERIODS periods of small normal oscillation
    about the equilibrium, T0 = 2 pi / sqrt(k_lin / m_total), k_lin = 3/2 k0
    rho_eq^(1/2) (:func:`oscillation_period`);
-3. the mechanical energy above the rest state (:func:`energy_above_rest`: kinetic
+3. the mechanical energy above the rest state (kinetic
    energy of ball and observer, spin about the normal included; Hertz spring plus
    gravity above their minimum at rho_eq; the compliant law's tangential spring; the
    observer's height above its lowest point) is at most the energy of an oscillation
@@ -27,7 +29,7 @@ static equilibrium from then on.
 4. a massive observer sits below the centre (a ball whose observer is above it is
    in unstable equilibrium at best).
 
-**The rest state** (:func:`rest_state`): velocities and angular velocity zero, the
+**The rest state**: velocities and angular velocity zero, the
 centre at the static Hertz equilibrium rho_eq = (m_total g / k0)^(2/3)
 (:func:`equilibrium_penetration`), the orientation as it is, the tangential
 deflections zero, and the energy above it added to ``dissipated_normal`` so that the
@@ -38,11 +40,23 @@ friction: the spin never decays, and its energy is counted in criterion 3), a ba
 rolling on the plane (no rolling resistance: it rolls for ever -- the seed scene
 does, at ~0.8 m/s, from t = 30.94 s), a ball rocked by an eccentric observer.
 
-**Uniform rolling or sliding** (:func:`rolls`): when the scene's free rotation is exact
+**Uniform rolling or sliding**: when the scene's free rotation is exact
 (massless observer, isotropic inertia), a contact that has settled at the equilibrium
 and rolls, or slides with no force opposing its slip (mu = 0), is continued in closed
-form (see :func:`rolls` for the criterion).  With the seed's observer the rolling is
-not uniform: ballc.orbit continues it as a relative periodic orbit.
+form: the contact has lasted REST_PERIODS T0; the energy above the uniform state
+(vertical kinetic energy, Hertz spring plus gravity above rho_eq, tangential spring) is
+below :func:`energy_threshold`; and the uniform state (the centre at the equilibrium,
+vz = 0, the deflections zero, the energy booked) is a steady state of the segment's
+equations -- its accelerations, linear and angular (times r), and the deflection rates
+at rounding level (:func:`steady_level`).  Then v and omega are constant, the centre
+moves on a straight line at z_eq and the orientation turns at omega (ballc.flight's
+exact solution with g = 0).  It is *rolling* when the slip speed is at most REST_FACTOR
+dv (:func:`speed_tolerance`), else *free sliding* (a slip that no force opposes: mu = 0,
+or a tangential law without friction).  With the seed's observer the rolling is not
+uniform: ballc.orbit continues it as a relative periodic orbit.  A closed-form end
+state is sampled evenly to t_end: the turn at most ballc.flight.MAX_TURN per interval
+(an orbit: 32 samples per period), at least 32 intervals, at most MAX_ROLL_SAMPLES
+samples (sol(t) is exact anywhere).
 """
 from __future__ import annotations
 
@@ -50,7 +64,7 @@ import math
 
 import numpy as np
 
-from . import _core, layout
+from . import _core
 
 #: A contact must have lasted this many small-oscillation periods before a rest check.
 REST_PERIODS = 20.0
@@ -60,11 +74,11 @@ REST_FACTOR = 10.0
 
 #: After a failed check at contact age a, the next is at age a + max(REST_PERIODS T0,
 #: CHECK_GROWTH a): a few dozen checks over any run, a detection at most 25 % late.
-CHECK_GROWTH = 0.25
+CHECK_GROWTH = _core.CHECK_GROWTH
 
-_STATE = layout.INDEX
-_Z, _VELOCITY, _ANGULAR = _STATE["z"], layout.VELOCITY, layout.ANGULAR_VELOCITY
-_DEFLECTION = layout.DEFLECTION
+#: At most this many samples of a closed-form end state (sol(t) is exact anywhere).
+MAX_ROLL_SAMPLES = _core.MAX_ROLL_SAMPLES
+_EPS = float(np.finfo(float).eps)
 
 
 def resting_plane(scene) -> str | None:
@@ -91,161 +105,28 @@ def oscillation_period(scene) -> float:
     return 2 * math.pi * math.sqrt(total_mass(scene) / linear_stiffness(scene))
 
 
-def first_check(scene, t_start) -> float:
-    return t_start + REST_PERIODS * oscillation_period(scene)
-
-
-def next_check(scene, t_start, t) -> float:
-    return t + max(REST_PERIODS * oscillation_period(scene), CHECK_GROWTH * (t - t_start))
+def _largest(atol) -> float:
+    """atol, or its largest value when given per state."""
+    return atol if type(atol) is float else float(np.max(atol))
 
 
 def speed_tolerance(scene, rtol, atol) -> float:
     """dv = REST_FACTOR (atol + rtol sqrt(g r)) (m/s): REST_FACTOR integration
     tolerances of a speed."""
-    return REST_FACTOR * (float(np.max(atol)) + rtol * math.sqrt(scene.gravity * scene.radius))
+    return REST_FACTOR * (_largest(atol) + rtol * math.sqrt(scene.gravity * scene.radius))
 
 
 def steady_level(scene) -> float:
     """The rounding level (1e3 eps g, m/s^2) below which a state's accelerations count as
-    zero (:func:`rolls`' steady state)."""
-    return 1e3 * np.finfo(float).eps * scene.gravity
+    zero (uniform motion's steady state)."""
+    return 1e3 * _EPS * scene.gravity
 
 
 def energy_threshold(scene, rtol, atol) -> float:
     """The energy (J) of an oscillation of REST_FACTOR integration tolerances."""
-    dx = REST_FACTOR * (float(np.max(atol)) + rtol * scene.radius)
+    dx = REST_FACTOR * (_largest(atol) + rtol * scene.radius)
     dv = speed_tolerance(scene, rtol, atol)
     return min(0.5 * linear_stiffness(scene) * dx * dx, 0.5 * total_mass(scene) * dv * dv)
-
-
-def _observer_offset(scene, y):
-    """(horizontal, vertical) offset (m) of the observer from the centre."""
-    params = scene.parameter_vector()
-    where = _core.observer_positions(np.ascontiguousarray(y[None, :]), params)[0]
-    d = where - y[layout.rows("x", 3)]
-    return math.hypot(d[0], d[1]), float(d[2])
-
-
-def energy_above_rest(scene, y, plane="floor") -> float:
-    """The mechanical energy (J) of state y above the rest state on ``plane``, each
-    term computed without cancellation (see the module docstring)."""
-    e = _core.energies(np.ascontiguousarray(y[None, :]), scene.parameter_vector())[0]
-    kinetic, tangential_spring = float(e[0]), float(e[4] + e[5])
-    rho_eq = equilibrium_penetration(scene)
-    rho = scene.radius - y[_Z]
-    x = (rho - rho_eq) / rho_eq
-    weight = total_mass(scene) * scene.gravity
-    # (2/5) k0 (rho^(5/2) - rho_eq^(5/2)) - m g (rho - rho_eq), k0 rho_eq^(3/2) = m g
-    normal = weight * rho_eq * (0.4 * math.expm1(2.5 * math.log1p(x)) - x) if x > -1 else \
-        math.inf
-    observer = 0.0
-    if scene.observer_mass > 0:
-        across, up = _observer_offset(scene, y)
-        reach = math.hypot(across, up)
-        observer = scene.observer_mass * scene.gravity * across * across / (
-            reach + abs(up)) if reach > 0 else 0.0
-    return kinetic + max(normal, 0.0) + tangential_spring + observer
-
-
-def at_rest(scene, y, plane, t_start, t, rtol, atol) -> bool:
-    """Whether the contact with ``plane`` (since ``t_start``) has come to rest at state
-    y and time t (criteria 2-4 of the module docstring; the caller checks 1)."""
-    if plane != resting_plane(scene) or t - t_start < REST_PERIODS * oscillation_period(scene):
-        return False
-    if scene.observer_mass > 0 and _observer_offset(scene, y)[1] >= 0:
-        return False
-    return energy_above_rest(scene, y, plane) <= energy_threshold(scene, rtol, atol)
-
-
-def rest_state(scene, y, plane="floor"):
-    """The rest state for state y (see the module docstring): a new array."""
-    rest = np.array(y, dtype=float)
-    rest[_VELOCITY] = 0.0
-    rest[_ANGULAR] = 0.0
-    rest[_Z] = scene.radius - equilibrium_penetration(scene)
-    rest[_DEFLECTION["floor"]] = 0.0
-    rest[_DEFLECTION["ceiling"]] = 0.0
-    return _booked(scene, y, rest)
-
-
-def _booked(scene, y, new):
-    """``new`` with the mechanical energy y has above it added to dissipated_normal."""
-    both = _core.energies(np.ascontiguousarray(np.stack([y, new])), scene.parameter_vector())
-    before, after = (float(row[0] + row[1] + row[2] + row[3] + row[4] + row[5])
-                     for row in both)
-    new[_STATE["dissipated_normal"]] += before - after
-    return new
-
-
-# ---- uniform rolling ----
-
-#: At most this many samples of a closed-form rolling stretch (sol(t) is exact anywhere).
-MAX_ROLL_SAMPLES = 4096
-
-
-def rolling_state(scene, y):
-    """The uniform rolling state for y: the centre at the static equilibrium, vz = 0,
-    tangential deflections zero, the rest as it is; energy booked (see rest_state)."""
-    roll = np.array(y, dtype=float)
-    roll[_Z] = scene.radius - equilibrium_penetration(scene)
-    roll[_STATE["vz"]] = 0.0
-    roll[_DEFLECTION["floor"]] = 0.0
-    roll[_DEFLECTION["ceiling"]] = 0.0
-    return _booked(scene, y, roll)
-
-
-def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, flags):
-    """(the uniform state, "rolling" or "free_sliding") when the contact with ``plane``
-    (since ``t_start``) moves uniformly at state y and time t, else None.
-
-    Criterion: the scene has an exact free rotation (ballc.flight.scene_allows:
-    massless observer, isotropic inertia); the contact has lasted REST_PERIODS T0;
-    the energy above the uniform state (vertical kinetic energy, Hertz spring plus
-    gravity above rho_eq, tangential spring) is below :func:`energy_threshold`; and the
-    uniform state is a steady state of the segment's equations (flags, latch): its
-    accelerations, linear and angular (times r), and the deflection rates are at
-    rounding level (1e3 eps g).  Then the motion is exact: v and omega constant, the
-    centre on a straight line at z_eq, the orientation turning at omega
-    (ballc.flight.FreeFlight with g = 0).  It is *rolling* when the slip speed
-    ``slip_speed`` is at most REST_FACTOR dv, else *free sliding* (a slip that no
-    force opposes: mu = 0, or a tangential law without friction)."""
-    from . import flight
-    if plane != resting_plane(scene) or t - t_start < REST_PERIODS * oscillation_period(scene):
-        return None
-    if not flight.scene_allows(params):
-        return None
-    dv = speed_tolerance(scene, rtol, atol)
-    e = _core.energies(np.ascontiguousarray(y[None, :]), params)[0]
-    rho_eq = equilibrium_penetration(scene)
-    x = (scene.radius - y[_Z] - rho_eq) / rho_eq
-    if not x > -1:
-        return None
-    weight = total_mass(scene) * scene.gravity
-    above = (0.5 * total_mass(scene) * y[_STATE["vz"]] ** 2 + float(e[4] + e[5])
-             + max(weight * rho_eq * (0.4 * math.expm1(2.5 * math.log1p(x)) - x), 0.0))
-    if not above <= energy_threshold(scene, rtol, atol):
-        return None
-    roll = rolling_state(scene, y)
-    rate = _core.rhs(np.ascontiguousarray(roll), np.ascontiguousarray(params, dtype=float),
-                     np.ascontiguousarray(latch, dtype=float), int(flags))
-    level = steady_level(scene)
-    if (np.max(np.abs(rate[_VELOCITY])) > level
-            or scene.radius * np.max(np.abs(rate[_ANGULAR])) > level
-            or np.max(np.abs(rate[_DEFLECTION["floor"]])) > level
-            or np.max(np.abs(rate[_DEFLECTION["ceiling"]])) > level):
-        return None
-    return roll, ("rolling" if slip_speed <= dv else "free_sliding")
-
-
-def rolling_samples(t0, t1, rate):
-    """Sample times of a closed-form rolling stretch after t0 up to t1: the turn at most
-    ballc.flight.MAX_TURN per interval, at least 32 and at most MAX_ROLL_SAMPLES."""
-    from . import flight
-    n = min(MAX_ROLL_SAMPLES, max(flight.MIN_INTERVALS,
-                                  math.ceil(rate * (t1 - t0) / flight.MAX_TURN)))
-    t = t0 + (t1 - t0) * np.arange(1, n + 1) / n
-    t[-1] = t1
-    return t
 
 
 class Constant:

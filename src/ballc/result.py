@@ -86,6 +86,22 @@ class Contact:
     t_rolling: float = np.nan
     #: likewise for a contact sliding with no force opposing the slip (mu = 0) (s)
     t_sliding: float = np.nan
+    #: a run's contacts: computes peak_normal_force, time_sticking and time_slipping of
+    #: every contact of the run on first access (ballc.outcome.summarize_contact_forces)
+    _summary: object = field(default=None, init=False, repr=False, compare=False)
+
+    def __getattr__(self, name):
+        summary = self.__dict__.get("_summary")
+        if summary is not None and name in _SUMMARY_FIELDS:
+            summary()
+            return self.__dict__[name]
+        raise AttributeError(f"'Contact' object has no attribute {name!r}")
+
+    def __getstate__(self):
+        """Pickled (copied) with its force summaries computed."""
+        if self.__dict__.get("_summary") is not None:
+            self._summary()
+        return dict(self.__dict__)
 
     @property
     def duration(self) -> float:
@@ -125,6 +141,12 @@ class Contact:
             for axis, value in zip("xyz", getattr(self, name)):
                 row[f"{name}_{axis}"] = float(value)
         return row
+
+
+#: A Contact's fields that a run computes on first access (Contact._summary).
+_SUMMARY_FIELDS = ("peak_normal_force", "time_sticking", "time_slipping")
+for _name in _SUMMARY_FIELDS:
+    delattr(Contact, _name)   # the dataclass's default: read through __getattr__ instead
 
 
 #: Unit of each column of :meth:`Contact.as_dict` (the contact CSV's header says them).
@@ -182,8 +204,13 @@ class Result:
         The latched contact values of that segment (SI units).
     segments : ndarray or None
         The segment log: one row per smooth segment the run integrated, in order (see
-        :data:`SEGMENT_FIELDS`); None for a run of the Python driver or one read from a
-        file.
+        :data:`SEGMENT_FIELDS`); None for a run read from a file.
+
+    A run's Result builds what it is asked for: the arrays ``t`` and ``y`` and the
+    scalars are there at once; the contacts (and their force summaries), ``flags``,
+    ``latch``, the user events' hits, ``sol``, the segment log and the ``message``
+    (with its energy-balance check) are built from the C loop's output on first access,
+    each once -- the same values whenever they are read.
     """
 
     t: np.ndarray
@@ -213,12 +240,28 @@ class Result:
     #: the C loop's segment log, the bytes it wrote (ballc._core.SEGMENT_RECORD each);
     #: read it as ``segments``
     _segment_log: bytes | None = field(default=None, repr=False)
+    #: what a run builds on first access (ballc.loop_result): attribute name -> a
+    #: function of the result
+    _pending: dict | None = field(default=None, init=False, repr=False, compare=False)
+
+    def __getattr__(self, name):
+        pending = self.__dict__.get("_pending")
+        if pending and name in pending:
+            value = self.__dict__[name] = pending.pop(name)(self)
+            return value
+        raise AttributeError(f"'Result' object has no attribute {name!r}")
+
+    def __getstate__(self):
+        """Pickled (copied) with everything built."""
+        for name in list(self.__dict__.get("_pending") or ()):
+            getattr(self, name)
+        return dict(self.__dict__, _pending=None)
 
     @property
     def segments(self) -> np.ndarray | None:
         """The segment log (a read-only numpy structured array, one row per segment,
-        fields and units in :data:`SEGMENT_FIELDS`), or None for a run of the Python
-        driver or one read from a file.  Built on first access."""
+        fields and units in :data:`SEGMENT_FIELDS`), or None for a run read from a
+        file.  Built on first access."""
         found = self.__dict__.get("_segments")
         if found is None and self._segment_log is not None:
             found = self.__dict__["_segments"] = segment_table(self._segment_log)
@@ -479,12 +522,18 @@ class Result:
                 f"contacts={len(self.contacts)}, nfev={self.nfev}, njev={self.njev})")
 
 
+#: The fields a run builds on first access (Result._pending): the dataclass's defaults
+#: are read through __getattr__ instead.
+for _name in ("flags", "latch", "t_events", "y_events", "sol", "_segment_log"):
+    delattr(Result, _name)
+
+
 #: What ``result[key]`` reads: the items of scipy's OdeResult (a dict).
 ODE_RESULT_KEYS = ("t", "y", "sol", "t_events", "y_events", "nfev", "njev", "nlu",
                    "status", "message", "success")
 
 #: Contact fields, in the order files store them.
-CONTACT_FIELDS = [f.name for f in fields(Contact)]
+CONTACT_FIELDS = [f.name for f in fields(Contact) if f.init]
 
 
 #: The columns of ``Result.segments``: name -> (unit, meaning).  The modes are

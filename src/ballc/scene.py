@@ -236,7 +236,8 @@ class Scene:
     def __post_init__(self):
         for name in self.VECTOR_FIELDS:
             value = getattr(self, name)
-            if value is None:
+            if value is None or (type(value) is tuple and len(value) == 3 and all(
+                    type(v) is float for v in value)):   # a vector already (a replace)
                 continue
             try:
                 if isinstance(value, (str, bytes)) or any(
@@ -274,7 +275,7 @@ class Scene:
         # every field is a number, a string, None or a tuple of floats (__post_init__):
         # immutable, so a shallow copy is asdict's (whose deep copy cost a sweep of the
         # 100 x 100 map ~1 s in its parent process)
-        values = {field.name: getattr(self, field.name) for field in fields(self)}
+        values = {name: getattr(self, name) for name in _FIELD_NAMES}
         for name in getattr(self, "_derived", ()):
             values[name] = None     # computed from another field: not an input
         return values
@@ -300,6 +301,13 @@ class Scene:
                   if value is not None]
         with open(path, "w", encoding="utf-8") as stream:
             stream.write("\n".join(lines) + "\n")
+
+    def __getstate__(self):
+        """The fields and what they derive, without the C loop's converted constants
+        (ballc.loop_constants keeps them on the scene; rebuilt where it runs)."""
+        state = dict(self.__dict__)
+        state.pop("_drive_scene", None)
+        return state
 
     def replace(self, **changes) -> "Scene":
         """A copy with some fields changed (validated).  Giving one of c_tau,
@@ -379,11 +387,26 @@ class Scene:
         return np.array([float(values[name]) for name in _core.PARAMETER_NAMES])
 
     def initial_state(self) -> np.ndarray:
-        """State vector in the generated layout order (``ballc._core.STATE_NAMES``)."""
-        mechanical = np.concatenate([_quaternion_of(*map(float, self.angles)), self.position,
-                                     self.angular_velocity, self.velocity])
-        auxiliary = np.zeros(_core.N_STATES - mechanical.size)   # dissipated work, deflections
-        return np.concatenate([mechanical, auxiliary])
+        """State vector in the generated layout order (``ballc._core.STATE_NAMES``); a
+        fresh copy each call."""
+        return self._initial.copy()
+
+    @functools.cached_property
+    def _initial(self) -> np.ndarray:
+        """The initial state, built once (read-only: every run starts from it)."""
+        at = _core.STATE_INDEX
+        state = np.zeros(_core.N_STATES)   # the dissipated work and deflections: zero
+        state[at["qw"]:at["qw"] + 4] = _quaternion_of(*self.angles)
+        for name, first in (("position", "x"), ("angular_velocity", "omega_x"),
+                            ("velocity", "vx")):
+            state[at[first]:at[first] + 3] = getattr(self, name)
+        state.flags.writeable = False
+        return state
+
+
+#: The Scene fields' names, in order (dataclasses.fields is slow to ask every time).
+_FIELD_NAMES = tuple(f.name for f in fields(Scene))
+_FIELD_SET = frozenset(_FIELD_NAMES)
 
 
 def _plane_entries(plane: str, point, normal) -> dict:
@@ -476,8 +499,8 @@ def mindlin_stiffness_ratio(nu_ball, nu_plane, e_ball, e_plane):
 
 
 def _reject_unknown_fields(values) -> None:
-    reject_unknown_keys(values, [f.name for f in fields(Scene)], "scene field",
-                        "the Scene fields")
+    if not (hasattr(values, "keys") and values.keys() <= _FIELD_SET):   # else: all known
+        reject_unknown_keys(values, _FIELD_NAMES, "scene field", "the Scene fields")
 
 
 def reject_unknown_keys(values, known, what: str, allowed: str) -> None:

@@ -49,12 +49,13 @@ class SweepInterrupted(KeyboardInterrupt):
         self.table, self.finished, self.total = table, finished, total
 
 
-def _run_one(changes: dict, scene: dict, t_end: float, options: dict, outputs: dict) -> dict:
-    """One simulation -> one row (runs in a worker; module-level so it pickles)."""
+def _run_one(changes: dict, scene: Scene, t_end: float, options: dict, outputs: dict) -> dict:
+    """One simulation -> one row (runs in a worker; module-level so it pickles).  The
+    scene is the one validated before any run: a worker does not validate it again."""
     from .simulate import simulate
     row = dict(changes)
     try:
-        result = simulate(Scene.from_dict(scene), t_end, progress=False, **options)
+        result = simulate(scene, t_end, progress=False, **options)
     except Exception as error:    # one failed scene must not lose the sweep
         row.update({name: float("nan") for name in SUMMARY_COLUMNS})
         row.update(status=-1, message=f"{type(error).__name__}: {error}",
@@ -205,8 +206,7 @@ def sweep(base_scene: Scene, parameters: dict, t_end: float, *, outputs=None,
     t_end = check_simulate_options(base_scene, t_end, simulate_options)
     workers = check_workers(workers)
     named = _named_outputs(outputs)
-    tasks = [(changes, scene.to_dict(), t_end, simulate_options, named)
-             for changes, scene in cases]
+    tasks = [(changes, scene, t_end, simulate_options, named) for changes, scene in cases]
     if progress is None:
         progress = sys.stderr.isatty()
     rows = [None] * len(tasks)       # filled in as the runs finish
@@ -316,9 +316,10 @@ def _stop_workers(pool):
 def _on_local_pool(tasks, workers, rows, progress):
     from concurrent.futures import ProcessPoolExecutor, as_completed
     workers = min(workers or os.cpu_count() or 1, len(tasks))   # None: all cores
-    # ~16 batches per worker: a map's runs cost milliseconds each, so submitting them
-    # one by one spent as much time in inter-process traffic as in simulating
-    size = max(1, math.ceil(len(tasks) / (16 * workers)))
+    # ~48 batches per worker: a map's runs cost a fraction of a millisecond each, so
+    # submitting them one by one spent as much time in inter-process traffic as in
+    # simulating; and the last batches, when a worker may wait for the other, are short
+    size = max(1, math.ceil(len(tasks) / (48 * workers)))
     batches = [(start, tasks[start:start + size]) for start in range(0, len(tasks), size)]
     bar = _bar(None, progress, len(tasks)) if progress else None
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_start_worker)
@@ -326,6 +327,7 @@ def _on_local_pool(tasks, workers, rows, progress):
     try:
         with _sigint_held():       # the workers start (are forked) in these submits
             futures = {pool.submit(_run_batch, batch): start for start, batch in batches}
+        import pandas   # noqa: F401 (the table's, imported while the workers run)
         for future in as_completed(futures):
             _keep(future.result(), futures[future], rows, bar)
     except BaseException:
