@@ -12,12 +12,15 @@
 #include "_integrator.h"
 #include "_system.h"
 
-#define N BALLC_N_STATES
-#define NL BALLC_N_LATCH
+#define N BALLC_MAX_STATES   /* room for a state; the run's are r->ns (params' planes) */
+#define NL BALLC_MAX_LATCH   /* room for a latch; the run's is r->nl */
 #define NLP BALLC_N_LATCH_PER_PLANE
-#define DRIVER_EVENTS 12  /* the driver's own events of a segment, at most */
-#define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
-#define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
+#define MAXP BALLC_MAX_PLANES
+#define EVENTS_PER_PLANE 6   /* the driver's own events of a segment per plane, at most */
+#define SLIP_D BALLC_LATCH_SLIP_DIRECTION_X   /* within a plane's latch block */
+#define KIN_PER_PLANE BALLC_CONTACT_KINEMATICS_PER_PLANE
+/* compliantmodes.py constants: the arming depth's ulps of the plane's position */
+#define ARM_ULPS 1048576.0
 
 /* stickslip.py constants */
 #define CLEAR_FACTOR 100.0
@@ -171,19 +174,37 @@ void ballc_drive_free(ballc_drive_output *o)
 
 /* ---- the run (simulate.py: _Run) ---- */
 
+/* A plane's penetration as the driver's events take it: rho = coef . (x, y, z) + offset
+ * with coef = -n, offset = r + n . p (n the unit normal, p the plane's point); with
+ * ``axis`` >= 0 the normal is along that coordinate axis and rho = scale * y[axis] +
+ * offset (the event of one state: the seed's floor and ceiling, and exact flight's
+ * quadratic in one coordinate).  ``position``: the centre's coordinate where it touches
+ * an axis-aligned plane (compliantmodes.plane_position), whose ulps set the thresholds;
+ * a tilted plane's are set per segment from the state (plane_position below). */
+typedef struct {
+    double coef[3], offset, scale, position;
+    int axis;
+} plane_geometry;
+
 typedef struct {
     const ballc_drive_config *c;
     ballc_drive_output *o;
     ballc_parameters_t prepared;
+    int np, ns, nl;             /* the run's planes, states and latched values */
+    plane_geometry geometry[MAXP];
+    double gravity[3];          /* params' gravity vector (m/s^2) */
+    /* each plane's slip velocity as its nonzero terms (the slip map's, in index order) */
+    int n_terms[MAXP][2], term_index[MAXP][2][N];
+    double term_coef[MAXP][2][N];
     double t, y[N], latch[NL];
-    int in_contact[2], coulomb[2];
-    double approach[2];
-    int has_approach[2];
-    long relatches[2], transitions[2], stalled;
+    int in_contact[MAXP], coulomb[MAXP];
+    double approach[MAXP];
+    int has_approach[MAXP];
+    long relatches[MAXP], transitions[MAXP], stalled;
     double last_transition;
     int has_last_transition;
-    double dissipated_at_start[2][2];
-    double rest_check[2];
+    double dissipated_at_start[MAXP][2];
+    double rest_check[MAXP];
     int status, stop_code, stop_plane;
     int failed_kernel;          /* a C kernel failed where Python raises: fall back */
     /* this segment's re-arms: (t, latch before) */
@@ -199,14 +220,14 @@ typedef struct {
     double *ev_scale;                /*   and its coefficient */
     double *flight_s;                /* exact flight's hits (s, event), 2 per event, */
     int *flight_e, *flight_seen;     /*   and their counts */
-    int seg_flags;
+    ballc_flags seg_flags;
     /* the user's events (stage 4): occurrences so far, a callback's error */
     long *user_seen;
     int user_failed;
     /* the compliant law's modes (stage 3): per plane */
-    int compliant[2], armed[2], capacity_row[2];   /* COMPLIANT_*, bool, -1 or 4/5 */
-    int has_step[2];
-    double step_bound[2], step_until[2];           /* contact_step: (bound, until) */
+    int compliant[MAXP], armed[MAXP], capacity_row[MAXP];   /* COMPLIANT_*, bool, -1 or 4/5 */
+    int has_step[MAXP];
+    double step_bound[MAXP], step_until[MAXP];              /* contact_step: (bound, until) */
     int fired_row;
     /* the bridge's _ball_event cache: the last compliant margins computed */
     double margins_y[N], margins_out[6];
@@ -225,8 +246,12 @@ typedef struct {
 } run_t;
 
 enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
-#define CAPACITY_FIRST (2 + 2 * 4)    /* the capacity guards' event codes (rows 4, 5) */
-#define CAPACITY_SECOND (2 + 2 * 5)
+/* A compliant guard's event code: MARGIN_CODE + row * MAXP + plane (its margins' row);
+ * the capacity guards are rows 4 and 5.  Codes 0 .. MAXP - 1: a plane's stick release;
+ * <= -2: the user's callable -2 - k. */
+#define MARGIN_CODE MAXP
+#define CAPACITY_FIRST (MARGIN_CODE + 4 * MAXP)
+#define CAPACITY_SECOND (MARGIN_CODE + 5 * MAXP)
 
 enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE,
        K_ARM, K_YIELD, K_RESTICK, K_CAPACITY, K_USER };   /* from K_APPROACH on: CARRY_STEP */
@@ -279,7 +304,8 @@ static void log_open(run_t *r)
     g->t_start = r->t;
     g->plane = -1;
     g->rearm_kind = g->rearm_plane = g->rearm_before = g->rearm_after = -1;
-    for (int p = 0; p < 2; p++) g->before[p] = (signed char)plane_mode(r, p);
+    for (int p = 0; p < MAXP; p++)
+        g->before[p] = p < r->np ? (signed char)plane_mode(r, p) : (signed char)-1;
 }
 
 /* An event of plane p re-armed inside the segment, leaving it in mode ``before``. */
@@ -304,39 +330,123 @@ static int log_close(run_t *r, int end, int plane, double t_end)
     g->end = end;
     g->plane = plane;
     g->t_end = t_end;
-    for (int p = 0; p < 2; p++) g->after[p] = (signed char)plane_mode(r, p);
+    for (int p = 0; p < MAXP; p++)
+        g->after[p] = p < r->np ? (signed char)plane_mode(r, p) : (signed char)-1;
     o->log[o->n_log++] = *g;
     return 0;
 }
 
 /* _Run.flags */
-static int run_flags(const run_t *r, int with_coulomb)
+static ballc_flags run_flags(const run_t *r, int with_coulomb)
 {
     const ballc_drive_config *c = r->c;
-    int flags = c->observer_bits;
-    for (int p = 0; p < 2; p++) {
+    ballc_flags flags = c->observer_bits;
+    for (int p = 0; p < r->np; p++) {
         if (!r->in_contact[p]) continue;
         if (c->compliant_modes) {   /* compliantmodes.mode_flags */
-            if (r->compliant[p] == COMPLIANT_SLIDING) flags |= c->sliding_bits[p];
+            if (r->compliant[p] == COMPLIANT_SLIDING)
+                flags |= ballc_flag(BALLC_KIND_COMPLIANT_SLIDING, p);
             else if (r->compliant[p] == COMPLIANT_ELASTIC && r->armed[p])
-                flags |= c->elastic_bits[p];
-            else flags |= c->compliant_bits[p];
+                flags |= ballc_flag(BALLC_KIND_COMPLIANT_ELASTIC, p);
+            else flags |= ballc_flag(BALLC_KIND_COMPLIANT, p);
             continue;
         }
         flags |= c->contact_bits[p];
         if (with_coulomb) {
-            if (r->coulomb[p] == BALLC_MODE_SLIP) flags |= c->slip_bits[p];
-            else if (r->coulomb[p] == BALLC_MODE_SLIP_FIXED) flags |= c->slip_fixed_bits[p];
-            else if (r->coulomb[p] == BALLC_MODE_STICK) flags |= c->stick_bits[p];
+            if (r->coulomb[p] == BALLC_MODE_SLIP) flags |= ballc_flag(BALLC_KIND_SLIP, p);
+            else if (r->coulomb[p] == BALLC_MODE_SLIP_FIXED)
+                flags |= ballc_flag(BALLC_KIND_SLIP_FIXED, p);
+            else if (r->coulomb[p] == BALLC_MODE_STICK) flags |= ballc_flag(BALLC_KIND_STICK, p);
         }
     }
     return flags;
 }
 
-/* events.LinearEvent.__call__ of the plane's penetration: scale * y[z] + offset */
+/* Whether any plane has the flag of ``kind`` (the integrator's Jacobian options) */
+static int any_plane(const run_t *r, ballc_flags flags, int kind)
+{
+    for (int p = 0; p < r->np; p++)
+        if (flags & ballc_flag(kind, p)) return 1;
+    return 0;
+}
+
+/* the plane's penetration (plane_geometry): events.LinearEvent.__call__ */
 static double rho_of(const run_t *r, int p, const double *y)
 {
-    return r->c->rho_scale[p] * y[BALLC_STATE_Z] + r->c->rho_offset[p];
+    const plane_geometry *g = &r->geometry[p];
+    if (g->axis >= 0) return g->scale * y[g->axis] + g->offset;
+    return g->coef[0] * y[BALLC_STATE_X] + g->coef[1] * y[BALLC_STATE_Y]
+           + g->coef[2] * y[BALLC_STATE_Z] + g->offset;
+}
+
+/* the penetration rate rho' = -n . v */
+static double rho_rate(const run_t *r, int p, const double *y)
+{
+    const plane_geometry *g = &r->geometry[p];
+    if (g->axis >= 0) return g->scale * y[g->axis + 6];
+    return g->coef[0] * y[BALLC_STATE_VX] + g->coef[1] * y[BALLC_STATE_VY]
+           + g->coef[2] * y[BALLC_STATE_VZ];
+}
+
+/* The magnitude of the centre's coordinate along the plane where it touches it
+ * (compliantmodes.plane_position), whose ulps set the contact thresholds and the
+ * compliant guards' rounding: an axis-aligned plane's constant; a tilted plane's, the
+ * terms rho sums at state y (its rounding grows with them). */
+static double plane_position(const run_t *r, int p, const double *y)
+{
+    const plane_geometry *g = &r->geometry[p];
+    if (g->axis >= 0) return g->position;
+    return fabs(g->coef[0] * y[BALLC_STATE_X]) + fabs(g->coef[1] * y[BALLC_STATE_Y])
+           + fabs(g->coef[2] * y[BALLC_STATE_Z]) + fabs(g->offset);
+}
+
+/* compliantmodes.arm_penetration at state y; 0 when contacts begin at rho = 0 */
+static double arm_depth(const run_t *r, int p, const double *y)
+{
+    if (!r->c->starts_armed) return 0.0;
+    return py_max(ARM_ULPS * ballc_py_ulp(plane_position(r, p, y)), r->c->arm_force_depth);
+}
+
+/* The run's plane geometry (plane_geometry) and slip terms, from the prepared plane
+ * table: once per run. */
+static void plane_setup(run_t *r)
+{
+    const double radius = r->c->radius;
+    for (int p = 0; p < r->np; p++) {
+        const ballc_plane_t *pl = &r->prepared.planes[p];
+        const double *n = pl->frame[2], *point = pl->point;
+        plane_geometry *g = &r->geometry[p];
+        g->axis = -1;
+        int zeros = 0, along = -1;
+        for (int i = 0; i < 3; i++) {
+            g->coef[i] = -n[i];
+            if (n[i] == 0.0) zeros++;
+            else along = i;
+        }
+        if (zeros == 2) {   /* along a coordinate axis: the event of one state */
+            g->axis = BALLC_STATE_X + along;
+            g->scale = -n[along];
+            g->offset = radius + n[along] * point[along];
+            /* the centre's coordinate where it touches: p + r along n */
+            g->position = fabs(point[along] + n[along] * radius);
+        } else {
+            g->scale = 0.0;
+            g->offset = radius + (n[0] * point[0] + n[1] * point[1] + n[2] * point[2]);
+            g->position = 0.0;
+        }
+        for (int row = 0; row < 2; row++) {   /* stickslip.slip_terms */
+            const double *map = r->prepared.slip_map[p] + row * r->ns;
+            int k = 0;
+            for (int j = 0; j < r->ns; j++)
+                if (map[j] != 0.0) {
+                    r->term_index[p][row][k] = j;
+                    r->term_coef[p][row][k] = map[j];
+                    k++;
+                }
+            r->n_terms[p][row] = k;
+        }
+    }
+    for (int i = 0; i < 3; i++) r->gravity[i] = r->c->params[BALLC_PARAMETER_GRAVITY_X + i];
 }
 
 /* simulate.record_depth */
@@ -369,8 +479,8 @@ static void slip(const run_t *r, int p, const double *y, double u[2], double *sp
 {
     for (int row = 0; row < 2; row++) {
         double s = 0.0;   /* sum(): int 0 + the first float, then float adds */
-        for (int k = 0; k < r->c->n_terms[p][row]; k++)
-            s += r->c->term_coef[p][row][k] * y[r->c->term_index[p][row][k]];
+        for (int k = 0; k < r->n_terms[p][row]; k++)
+            s += r->term_coef[p][row][k] * y[r->term_index[p][row][k]];
         u[row] = s;
     }
     *speed = ballc_py_hypot(2, u);
@@ -430,19 +540,22 @@ static double force_scale(const run_t *r, double load)
 /* _Run.settle -> stickslip.settle */
 static int settle(run_t *r, int p)
 {
-    int base = run_flags(r, 0);
+    /* the other planes keep their modes (a second one sticking keeps its slip) */
+    ballc_flags base = run_flags(r, 1) & ~(ballc_flag(BALLC_KIND_SLIP, p)
+                                           | ballc_flag(BALLC_KIND_SLIP_FIXED, p)
+                                           | ballc_flag(BALLC_KIND_STICK, p));
     double y0[N], out[4];
     if (ballc_remove_slip(r->y, r->c->params, base, p, y0) != BALLC_OK) {
         r->failed_kernel = 1;
         return -1;
     }
-    int stick_flags = base | r->c->stick_bits[p];
+    ballc_flags stick_flags = base | ballc_flag(BALLC_KIND_STICK, p);
     if (ballc_stick_state(y0, r->c->params, r->latch, stick_flags, p, out) != BALLC_OK) {
         r->failed_kernel = 1;
         return -1;
     }
     double size = hypot(out[0], out[1]);   /* np.hypot: libm */
-    memcpy(r->y, y0, sizeof y0);
+    memcpy(r->y, y0, r->ns * sizeof(double));
     if (out[3] >= -force_scale(r, out[2]) || size == 0)
         return set_mode(r, p, BALLC_MODE_STICK, NULL, 0, 0.0);
     double d[2] = {-out[0] / size, -out[1] / size};
@@ -466,13 +579,19 @@ static int start_coulomb(run_t *r, int p)
 
 static int deflection_x(int p)
 {
-    return p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X;
+    return ballc_plane_state(p);
 }
 
-/* compliantmodes.margins (_core.compliant_margins); -1 where Python raises */
+/* compliantmodes.margins (_core.compliant_margins, with every other plane in contact);
+ * -1 where Python raises */
 static int margins_of(run_t *r, int p, const double *y, double *m)
 {
-    if (ballc_compliant_margins(y, r->c->params, r->latch, p, m) != BALLC_OK) {
+    int i, ok = 1;
+    for (i = 0; i < r->ns; i++) ok &= isfinite(y[i]) != 0;
+    for (i = 0; i < r->nl; i++) ok &= isfinite(r->latch[i]) != 0;
+    if (!ok || ballc_compliant_margins_prepared(y, &r->prepared, r->latch, run_flags(r, 1),
+                                                p, -1, m) != BALLC_OK) {
+        for (i = 0; i < BALLC_COMPLIANT_MARGINS; i++) m[i] = NAN;
         r->failed_kernel = 1;
         return -1;
     }
@@ -483,7 +602,7 @@ static int margins_of(run_t *r, int p, const double *y, double *m)
 static int at_cap(run_t *r, int p, const double *y, int only_down, double *out)
 {
     int sx = deflection_x(p);
-    memcpy(out, y, N * sizeof(double));
+    memcpy(out, y, r->ns * sizeof(double));
     double s[2] = {out[sx], out[sx + 1]};
     double size = ballc_py_hypot(2, s);
     if (!(size > 0)) return 0;
@@ -504,8 +623,8 @@ static int along_slip(run_t *r, int p, const double *y, double *along)
     double u[2];
     for (int row = 0; row < 2; row++) {   /* stickslip.slip_velocity_of */
         double s = 0.0;
-        for (int k = 0; k < r->c->n_terms[p][row]; k++)
-            s += r->c->term_coef[p][row][k] * y[r->c->term_index[p][row][k]];
+        for (int k = 0; k < r->n_terms[p][row]; k++)
+            s += r->term_coef[p][row][k] * y[r->term_index[p][row][k]];
         u[row] = s;
     }
     double speed = ballc_py_hypot(2, u);
@@ -532,7 +651,7 @@ static int decide(run_t *r, int p, const double *y, int arming, int *mode, doubl
         if (got < 0) return -1;
         if (!got) {
             *mode = COMPLIANT_ELASTIC;
-            memcpy(out, y, N * sizeof(double));
+            memcpy(out, y, r->ns * sizeof(double));
             return 0;
         }
         trial[sx] = along[0];
@@ -542,7 +661,7 @@ static int decide(run_t *r, int p, const double *y, int arming, int *mode, doubl
     if (margins_of(r, p, trial, m)) return -1;
     if (m[1] >= 0) {
         *mode = COMPLIANT_SLIDING;
-        memcpy(out, relaxed ? trial : y, N * sizeof(double));
+        memcpy(out, relaxed ? trial : y, r->ns * sizeof(double));
         return 0;
     }
     *mode = COMPLIANT_ELASTIC;
@@ -562,11 +681,11 @@ static int set_compliant(run_t *r, int p, int mode)
 static int start_compliant(run_t *r, int p, double rate)
 {
     const ballc_drive_config *c = r->c;
-    r->armed[p] = rho_of(r, p, r->y) >= 0.5 * c->arm_depth[p];
+    r->armed[p] = rho_of(r, p, r->y) >= 0.5 * arm_depth(r, p, r->y);
     int mode;
     double y[N];
     if (decide(r, p, r->y, 1, &mode, y)) return -1;
-    memcpy(r->y, y, sizeof y);
+    memcpy(r->y, y, r->ns * sizeof(double));
     if (set_compliant(r, p, mode)) return -1;
     double t_c = c->contact_time_base * pow(rate, -0.2);   /* compliantmodes.step_bound */
     r->has_step[p] = 1;
@@ -579,7 +698,7 @@ static int start_compliant(run_t *r, int p, double rate)
 static double run_max_step(const run_t *r)
 {
     double step = r->c->max_step;
-    for (int p = 0; p < 2; p++)
+    for (int p = 0; p < r->np; p++)
         if (r->has_step[p] && r->step_until[p] > r->t) step = py_min(step, r->step_bound[p]);
     return step;
 }
@@ -589,7 +708,7 @@ static double step_bound_end(const run_t *r)
 {
     double end = INFINITY;
     int found = 0;
-    for (int p = 0; p < 2; p++)
+    for (int p = 0; p < r->np; p++)
         if (r->has_step[p] && r->step_until[p] > r->t) {
             end = found ? py_min(end, r->step_until[p]) : r->step_until[p];
             found = 1;
@@ -603,7 +722,7 @@ static int begin_contact(run_t *r, int p)
     const ballc_drive_config *c = r->c;
     ballc_drive_output *o = r->o;
     double *y = r->y;
-    double kin[BALLC_CONTACT_KINEMATICS_NOUT];
+    double kin[BALLC_MAX_CONTACT_KINEMATICS_NOUT];
     ballc_contact_kinematics(y, &r->prepared, kin);
     int k = p * KIN_PER_PLANE;
     double rho = kin[k], rate = kin[k + 1];
@@ -617,16 +736,15 @@ static int begin_contact(run_t *r, int p)
     double speed = sqrt(ballc_dot3_fma(v)), direction[3];
     if (speed > 0) {
         for (int i = 0; i < 3; i++) direction[i] = v[i] / speed;
-    } else {
-        direction[0] = direction[1] = 0.0;
-        direction[2] = p == 0 ? -1.0 : 1.0;
+    } else {   /* into the plane, -n */
+        for (int i = 0; i < 3; i++) direction[i] = 0.0 - r->prepared.planes[p].frame[2][i];
     }
     if (MIN_IMPACT_RATE > rate) { rate = MIN_IMPACT_RATE; kernel_rate = 0; }
     int l = p * NLP;
     r->latch[l] = rate;
     for (int i = 0; i < 3; i++) r->latch[l + 1 + i] = direction[i];
-    y[p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X] = 0.0;
-    y[p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_Y : BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+    y[ballc_plane_state(p)] = 0.0;
+    y[ballc_plane_state(p) + 1] = 0.0;
     r->in_contact[p] = 1;
     if (grow((void **)&o->contacts, &o->cap_contacts, o->n_contacts + 1,
              sizeof(ballc_contact_rec)))
@@ -740,11 +858,11 @@ static int coulomb_event(run_t *r, int kind, int p)
             dir[1] = -out[1] / size;
             d = dir;
         }
-        if (ballc_remove_slip(r->y, r->c->params, run_flags(r, 0), p, y1) != BALLC_OK) {
+        if (ballc_remove_slip(r->y, r->c->params, run_flags(r, 1), p, y1) != BALLC_OK) {
             r->failed_kernel = 1;
             return -1;
         }
-        memcpy(r->y, y1, sizeof y1);
+        memcpy(r->y, y1, r->ns * sizeof(double));
         return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
     }
     }
@@ -774,19 +892,19 @@ static int compliant_event(run_t *r, int kind, int p)
     if (kind == K_ARM || kind == K_YIELD) {
         int mode;
         if (decide(r, p, r->y, kind == K_ARM, &mode, y)) return -1;
-        memcpy(r->y, y, sizeof y);
+        memcpy(r->y, y, r->ns * sizeof(double));
         return set_compliant(r, p, mode);
     }
     if (at_cap(r, p, r->y, 1, y)) return -1;   /* restick */
-    memcpy(r->y, y, sizeof y);
+    memcpy(r->y, y, r->ns * sizeof(double));
     return set_compliant(r, p, COMPLIANT_ELASTIC);
 }
 
 /* stickslip.slip_stop_coefficients */
 static void stop_coefficients(const run_t *r, int p, const double *d, double *row)
 {
-    const double *a = r->c->slip_map[p][0], *b = r->c->slip_map[p][1];
-    for (int j = 0; j < N; j++) row[j] = d[0] * a[j] + d[1] * b[j];
+    const double *a = r->prepared.slip_map[p], *b = a + r->ns;
+    for (int j = 0; j < r->ns; j++) row[j] = d[0] * a[j] + d[1] * b[j];
 }
 
 /* ---- the integrator's callbacks ---- */
@@ -816,18 +934,18 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
         if (st) r->user_failed = 1;
         return st;
     }
-    if (code >= 2) {   /* a compliant guard: the bridge's _ball_event, with its cache */
-        int row = (code - 2) / 2, plane = code % 2;
+    if (code >= MARGIN_CODE) {   /* a compliant guard: the bridge's _ball_event, cached */
+        int row = (code - MARGIN_CODE) / MAXP, plane = (code - MARGIN_CODE) % MAXP;
         if (r->margins_plane == plane && (row != 1 || r->margins_solved)
-                && memcmp(r->margins_y, y, N * sizeof(double)) == 0) {
+                && memcmp(r->margins_y, y, r->ns * sizeof(double)) == 0) {
             g[0] = r->margins_out[row];
             return BALLC_OK;
         }
-        int st = ballc_compliant_margins_prepared(y, &r->prepared, r->latch, plane, row,
-                                                  r->margins_out);
+        int st = ballc_compliant_margins_prepared(y, &r->prepared, r->latch, r->seg_flags,
+                                                  plane, row, r->margins_out);
         r->margins_plane = st == BALLC_OK ? plane : -1;
         r->margins_solved = row == 1;
-        memcpy(r->margins_y, y, N * sizeof(double));
+        memcpy(r->margins_y, y, r->ns * sizeof(double));
         g[0] = r->margins_out[row];
         return st;
     }
@@ -842,11 +960,11 @@ static int note_rearm(run_t *r, double t)
 {
     if (grow((void **)&r->rearmed_t, &r->cap_rearmed, r->n_rearmed + 1, sizeof(double)))
         return -1;
-    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * NL * sizeof(double));
+    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * r->nl * sizeof(double));
     if (!lat) return -1;
     r->rearmed_latch = lat;
     r->rearmed_t[r->n_rearmed] = t;
-    memcpy(r->rearmed_latch + r->n_rearmed * NL, r->latch, NL * sizeof(double));
+    memcpy(r->rearmed_latch + r->n_rearmed * r->nl, r->latch, r->nl * sizeof(double));
     r->n_rearmed++;
     return 0;
 }
@@ -861,10 +979,10 @@ static int user_rearm(run_t *r, int e, double t, const double *y)
     int got = c->rearm_fun(c->user_ctx, r->ev_plane[e], t, y, coef, &offset, latch);
     if (got < 0) r->user_failed = 1;   /* the loop stops: the bridge raises it */
     if (got != 1 || note_rearm(r, t)) return 0;
-    memcpy(r->ev_coef + (size_t)e * N, coef, sizeof coef);
+    memcpy(r->ev_coef + (size_t)e * r->ns, coef, r->ns * sizeof(double));
     r->ev_offset[e] = offset;
     r->ev_index[e] = -1;
-    memcpy(r->latch, latch, sizeof latch);
+    memcpy(r->latch, latch, r->nl * sizeof(double));
     r->margins_plane = -1;   /* the margins read the latch */
     return 1;
 }
@@ -876,7 +994,7 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
     int code = r->ev_plane_code[e];
     int p = r->ev_plane[e];
     if (code >= CAPACITY_FIRST) {   /* the bridge's _ball_rearm: a capacity guard toggles */
-        r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + 2 : code - 2;
+        r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + MAXP : code - MAXP;
         log_rearm(r, K_CAPACITY, p, plane_mode(r, p));
         return 1;
     }
@@ -896,7 +1014,7 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
     int before = plane_mode(r, p);
     if (set_mode(r, p, BALLC_MODE_SLIP, d, 1, approach)) return 0;
     log_rearm(r, K_APPROACH, p, before);
-    stop_coefficients(r, p, d, r->ev_coef + (size_t)e * N);
+    stop_coefficients(r, p, d, r->ev_coef + (size_t)e * r->ns);
     r->ev_offset[e] = -approach;
     r->margins_plane = -1;   /* the margins read the latch */
     return 1;
@@ -908,10 +1026,10 @@ static int add_event(run_t *r, int kind, int p, const double *coef, int state, d
                      double offset, int terminal, int direction)
 {
     int k = r->n_ev++;
-    double *row = r->ev_coef + (size_t)k * N;
-    if (coef) memcpy(row, coef, N * sizeof(double));
+    double *row = r->ev_coef + (size_t)k * r->ns;
+    if (coef) memcpy(row, coef, r->ns * sizeof(double));
     else {
-        memset(row, 0, N * sizeof(double));
+        memset(row, 0, r->ns * sizeof(double));
         if (state >= 0) row[state] = scale;
     }
     r->ev_offset[k] = offset;
@@ -927,28 +1045,43 @@ static int add_event(run_t *r, int kind, int p, const double *coef, int state, d
     return k;
 }
 
-static int segment_events(run_t *r, int flags)
+/* An event of plane p's penetration, rho + shift (rate: of its rate rho' + shift):
+ * one state's when the plane is axis-aligned, else a row on x, y, z (v) */
+static int add_plane_event(run_t *r, int kind, int p, int rate, double shift, int terminal,
+                           int direction)
+{
+    const plane_geometry *g = &r->geometry[p];
+    double offset = rate ? shift : g->offset + shift;
+    if (g->axis >= 0)
+        return add_event(r, kind, p, NULL, g->axis + (rate ? 6 : 0), g->scale, offset,
+                         terminal, direction);
+    double row[N];
+    memset(row, 0, r->ns * sizeof(double));
+    for (int i = 0; i < 3; i++) row[(rate ? BALLC_STATE_VX : BALLC_STATE_X) + i] = g->coef[i];
+    return add_event(r, kind, p, row, -1, 0, offset, terminal, direction);
+}
+
+static int segment_events(run_t *r, ballc_flags flags)
 {
     const ballc_drive_config *c = r->c;
     const double *y0 = r->y;
     int have_clear = 0;
     double clear = 0.0;
     r->n_ev = 0;
-    for (int p = 0; p < 2; p++) {
-        double rho0 = c->rho_scale[p] * y0[BALLC_STATE_Z] + c->rho_offset[p];
-        double base = c->threshold_base[p];
+    for (int p = 0; p < r->np; p++) {
+        double rho0 = rho_of(r, p, y0);
+        double position = plane_position(r, p, y0);
+        double base = 4 * ballc_py_ulp(position);   /* events.threshold_base */
         if (r->in_contact[p]) {
             double threshold = py_max(base, -rho0 + base);
-            add_event(r, K_LEAVE, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
-                      c->rho_offset[p] + threshold, 1, -1);
-            add_event(r, K_THROUGH, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
-                      c->through_offset[p], 1, 1);
-            add_event(r, K_DEEPEST, p, NULL, BALLC_STATE_VZ, p == 0 ? -1.0 : 1.0, 0.0, 0, -1);
+            add_plane_event(r, K_LEAVE, p, 0, threshold, 1, -1);
+            add_plane_event(r, K_THROUGH, p, 0, -c->radius, 1, 1);
+            add_plane_event(r, K_DEEPEST, p, 1, 0.0, 0, -1);
         } else {
             double threshold = py_max(base, rho0 + base);
-            if (c->arm_depth[p] > 0) threshold = py_max(threshold, c->arm_depth[p]);
-            add_event(r, K_ENTER, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
-                      c->rho_offset[p] + (-threshold), 1, 1);
+            double arm = arm_depth(r, p, y0);
+            if (arm > 0) threshold = py_max(threshold, arm);
+            add_plane_event(r, K_ENTER, p, 0, -threshold, 1, 1);
         }
         int mode = r->coulomb[p];
         if (mode == BALLC_MODE_SLIP || mode == BALLC_MODE_SLIP_FIXED) {
@@ -979,17 +1112,17 @@ static int segment_events(run_t *r, int flags)
         }
         if (r->compliant[p] != COMPLIANT_NONE) {   /* compliantmodes.guard */
             if (!r->armed[p]) {   /* the penetration rising through the arming depth */
-                add_event(r, K_ARM, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
-                          c->rho_offset[p] + (-c->arm_depth[p]), 1, 1);
+                add_plane_event(r, K_ARM, p, 0, -arm_depth(r, p, y0), 1, 1);
                 continue;
             }
-            double rounding = py_max(64 * DBL_EPSILON, c->ulp8[p] / py_max(rho0, 1e-300));
+            double ulp8 = 8 * ballc_py_ulp(position);
+            double rounding = py_max(64 * DBL_EPSILON, ulp8 / py_max(rho0, 1e-300));
             int elastic = r->compliant[p] == COMPLIANT_ELASTIC;
             double offset = elastic ? rounding
                                     : rounding * speed_scale(r, y0) * c->restick_factor;
             int k = add_event(r, elastic ? K_YIELD : K_RESTICK, p, NULL, -1, 0, offset, 1, -1);
             r->ev_nonlinear[k] = 1;
-            r->ev_plane_code[k] = 2 + 2 * (elastic ? 0 : 1) + p;
+            r->ev_plane_code[k] = MARGIN_CODE + (elastic ? 0 : 1) * MAXP + p;
             if (elastic && c->damping_positive) {   /* compliantmodes.capacity_guard */
                 double m[BALLC_COMPLIANT_MARGINS];
                 if (margins_of(r, p, y0, m)) return -1;
@@ -998,7 +1131,7 @@ static int segment_events(run_t *r, int flags)
                 k = add_event(r, K_CAPACITY, p, NULL, -1, 0, rounding * py_max(cap, 1e-12),
                               1, -1);
                 r->ev_nonlinear[k] = 1;
-                r->ev_plane_code[k] = 2 + 2 * row + p;
+                r->ev_plane_code[k] = MARGIN_CODE + row * MAXP + p;
                 r->ev_rearm[k] = 1;
             }
         }
@@ -1008,7 +1141,7 @@ static int segment_events(run_t *r, int flags)
         int left = c->user_count[u] ? (int)(c->user_count[u] - r->user_seen[u]) : 0;
         double offset = c->user_offset[u];
         if (c->user_linear[u] && left != c->user_count[u]) offset = offset + 0.0;  /* shifted */
-        int k = add_event(r, K_USER, u, c->user_linear[u] ? c->user_coef + (size_t)u * N : NULL,
+        int k = add_event(r, K_USER, u, c->user_linear[u] ? c->user_coef + (size_t)u * r->ns : NULL,
                           -1, 0, offset, left, c->user_direction[u]);
         r->ev_index[k] = c->user_linear[u] ? c->user_index[u] : -1;
         r->ev_scale[k] = c->user_linear[u] ? c->user_scale[u] : 0.0;
@@ -1023,40 +1156,44 @@ static int segment_events(run_t *r, int flags)
 
 /* ---- samples (samples.Samples) ---- */
 
-static int add_block(run_t *r, const double *t, const double *y, long count, int flags,
-                     const double *latch)
+static int add_block(run_t *r, const double *t, const double *y, long count,
+                     ballc_flags flags, const double *latch)
 {
     ballc_drive_output *o = r->o;
+    const int ns = r->ns, nl = r->nl;
+    long cap = o->cap;
     if (grow((void **)&o->t, &o->cap, o->n + count, sizeof(double))) return -1;
-    double *yy = realloc(o->y, (size_t)(o->cap ? o->cap : 1) * N * sizeof(double));
-    if (!yy) return -1;
-    o->y = yy;
+    if (o->cap != cap || !o->y) {
+        double *yy = realloc(o->y, (size_t)(o->cap ? o->cap : 1) * ns * sizeof(double));
+        if (!yy) return -1;
+        o->y = yy;
+    }
     long cb = o->cap_blocks;
     if (grow((void **)&o->block_count, &cb, o->n_blocks + 1, sizeof(long))) return -1;
     if (cb != o->cap_blocks) {
-        int *f = realloc(o->block_flags, (size_t)cb * sizeof(int));
+        ballc_flags *f = realloc(o->block_flags, (size_t)cb * sizeof(ballc_flags));
         if (!f) return -1;
         o->block_flags = f;
-        double *l = realloc(o->block_latch, (size_t)cb * NL * sizeof(double));
+        double *l = realloc(o->block_latch, (size_t)cb * nl * sizeof(double));
         if (!l) return -1;
         o->block_latch = l;
         o->cap_blocks = cb;
     }
     if (count) {
         memcpy(o->t + o->n, t, (size_t)count * sizeof(double));
-        memcpy(o->y + (size_t)o->n * N, y, (size_t)count * N * sizeof(double));
+        memcpy(o->y + (size_t)o->n * ns, y, (size_t)count * ns * sizeof(double));
     }
     o->n += count;
     o->block_count[o->n_blocks] = count;
     o->block_flags[o->n_blocks] = flags;
-    memcpy(o->block_latch + (size_t)o->n_blocks * NL, latch, NL * sizeof(double));
+    memcpy(o->block_latch + (size_t)o->n_blocks * nl, latch, nl * sizeof(double));
     o->n_blocks++;
     return 0;
 }
 
 /* Samples.add_later (first = 1: a segment's first sample is its start) */
 static int add_later_rows(run_t *r, long n, const double *t, const double *y_out,
-                          double after, int flags)
+                          double after, ballc_flags flags)
 {
     long first = r->c->t_eval ? 0 : 1;   /* simulate: skip */
     while (first < n && t[first] <= after) first++;
@@ -1065,16 +1202,16 @@ static int add_later_rows(run_t *r, long n, const double *t, const double *y_out
         long cut = 0;   /* searchsorted(t, when, 'right') */
         while (cut < n && t[cut] <= when) cut++;
         if (cut < first) cut = first;
-        if (add_block(r, t + first, y_out + (size_t)first * N, cut - first, flags,
-                      r->rearmed_latch + (size_t)k * NL))
+        if (add_block(r, t + first, y_out + (size_t)first * r->ns, cut - first, flags,
+                      r->rearmed_latch + (size_t)k * r->nl))
             return -1;
         first = cut;
     }
-    return add_block(r, t + first, y_out + (size_t)first * N, n - first, flags,
+    return add_block(r, t + first, y_out + (size_t)first * r->ns, n - first, flags,
                      r->latch);
 }
 
-static int add_later(run_t *r, const radau5_result *res, double after, int flags)
+static int add_later(run_t *r, const radau5_result *res, double after, ballc_flags flags)
 {
     return add_later_rows(r, res->n_out, res->t_out, res->y_out, after, flags);
 }
@@ -1084,11 +1221,12 @@ static int add_later(run_t *r, const radau5_result *res, double after, int flags
 #define FLIGHT_MIN_INTERVALS 32          /* flight.MIN_INTERVALS */
 #define FLIGHT_MAX_SAMPLES 100000000L    /* more: fall back (Python would allocate them) */
 
-typedef struct { double t0, rate, c[5][N]; } flight_t;
+typedef struct { double t0, rate, c[5][N]; int n; } flight_t;
 
-/* flight.FreeFlight.__init__ */
-static void flight_init(flight_t *f, double t0, const double *y0, double gravity)
+/* flight.FreeFlight.__init__ (gravity: the vector, 3; n states) */
+static void flight_init(flight_t *f, double t0, const double *y0, const double *gravity, int n)
 {
+    f->n = n;
     f->t0 = t0;
     double wx = y0[BALLC_STATE_OMEGA_X], wy = y0[BALLC_STATE_OMEGA_Y], wz = y0[BALLC_STATE_OMEGA_Z];
     f->rate = sqrt(wx * wx + wy * wy + wz * wz);
@@ -1099,15 +1237,17 @@ static void flight_init(flight_t *f, double t0, const double *y0, double gravity
     double turned[4] = {-(nx * qx + ny * qy + nz * qz), nx * qw + ny * qz - nz * qy,
                         ny * qw + nz * qx - nx * qz, nz * qw + nx * qy - ny * qx};
     memset(f->c, 0, sizeof f->c);
-    memcpy(f->c[0], y0, N * sizeof(double));
+    memcpy(f->c[0], y0, n * sizeof(double));
     for (int i = 0; i < 4; i++) {
         f->c[0][BALLC_STATE_QW + i] = 0.0;
         f->c[3][BALLC_STATE_QW + i] = y0[BALLC_STATE_QW + i];
         f->c[4][BALLC_STATE_QW + i] = turned[i];
     }
     for (int i = 0; i < 3; i++) f->c[1][BALLC_STATE_X + i] = y0[BALLC_STATE_VX + i];
-    f->c[1][BALLC_STATE_VZ] = -gravity;
-    f->c[2][BALLC_STATE_Z] = -0.5 * gravity;
+    for (int i = 0; i < 3; i++) {   /* v0 + g s, c0 + v0 s + g s^2 / 2 */
+        f->c[1][BALLC_STATE_VX + i] = gravity[i];
+        f->c[2][BALLC_STATE_X + i] = 0.5 * gravity[i];
+    }
 }
 
 /* FreeFlight.__call__ at an array of times, one time: basis 1, s, s*s, cos, sin and
@@ -1117,7 +1257,7 @@ static void flight_at(const flight_t *f, double t, double *y)
     double s = t - f->t0;
     double half = 0.5 * f->rate * s;
     double basis[5] = {1.0, s, s * s, cos(half), sin(half)};
-    for (int n = 0; n < N; n++) {
+    for (int n = 0; n < f->n; n++) {
         double acc = 0.0;
         for (int k = 0; k < 5; k++) acc += f->c[k][n] * basis[k];
         y[n] = acc;
@@ -1164,9 +1304,10 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
                           radau5_result *res)
 {
     const ballc_drive_config *c = r->c;
-    double t0 = r->t, g = c->gravity;
+    double t0 = r->t;
+    const double *g = r->gravity;
     flight_t f;
-    flight_init(&f, t0, r->y, g);
+    flight_init(&f, t0, r->y, g, r->ns);
     memset(res, 0, sizeof *res);
     res->stiff_at = NAN;
     res->method_end = -1;
@@ -1180,19 +1321,24 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
         double c0, c1, c2;
         if (k >= 0) {
             double scale = r->ev_scale[e], y0k = r->y[k];
+            int position = k >= BALLC_STATE_X && k <= BALLC_STATE_Z;
+            int velocity = k >= BALLC_STATE_VX && k <= BALLC_STATE_VZ;
             c0 = scale * y0k + r->ev_offset[e];
-            c1 = scale * (k >= BALLC_STATE_X && k <= BALLC_STATE_Z ? r->y[k + 6]
-                          : k == BALLC_STATE_VZ ? -g : 0.0);
-            c2 = k == BALLC_STATE_Z ? -0.5 * scale * g : 0.0;
+            c1 = scale * (position ? r->y[k + 6] : velocity ? g[k - BALLC_STATE_VX] : 0.0);
+            c2 = position ? 0.5 * scale * g[k - BALLC_STATE_X] : 0.0;
         } else {   /* several states (none of the quaternion's): plain C dots */
-            const double *row = r->ev_coef + (size_t)e * N;
+            const double *row = r->ev_coef + (size_t)e * r->ns;
             c0 = 0.0;
-            for (int i = 0; i < N; i++) c0 += row[i] * r->y[i];
+            for (int i = 0; i < r->ns; i++) c0 += row[i] * r->y[i];
             c0 += r->ev_offset[e];
             c1 = 0.0;
             for (int i = 0; i < 3; i++) c1 += row[BALLC_STATE_X + i] * r->y[BALLC_STATE_VX + i];
-            c1 -= row[BALLC_STATE_VZ] * g;
-            c2 = -0.5 * row[BALLC_STATE_Z] * g;
+            c2 = 0.0;
+            for (int i = 0; i < 3; i++) {   /* gravity's share (its zero components none) */
+                if (g[i] == 0.0) continue;
+                c1 += row[BALLC_STATE_VX + i] * g[i];
+                c2 += 0.5 * row[BALLC_STATE_X + i] * g[i];
+            }
         }
         double roots[2];
         int n = crossings(c0, c1, c2, r->ev_direction[e], span, roots);
@@ -1256,19 +1402,19 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
     }
     res->t_out = times;
     res->n_out = n;
-    res->y_out = malloc((size_t)(n ? n : 1) * N * sizeof(double));
+    res->y_out = malloc((size_t)(n ? n : 1) * r->ns * sizeof(double));
     res->hit_event = malloc((size_t)(kept ? kept : 1) * sizeof(int));
     res->hit_t = malloc((size_t)(kept ? kept : 1) * sizeof(double));
-    res->hit_y = malloc((size_t)(kept ? kept : 1) * N * sizeof(double));
+    res->hit_y = malloc((size_t)(kept ? kept : 1) * r->ns * sizeof(double));
     if (!res->y_out || !res->hit_event || !res->hit_t || !res->hit_y) return -2;
-    for (long i = 0; i < n; i++) flight_at(&f, times[i], res->y_out + (size_t)i * N);
+    for (long i = 0; i < n; i++) flight_at(&f, times[i], res->y_out + (size_t)i * r->ns);
     for (int h = 0, m = 0; h < nh && m < kept; h++) {
         if (stop >= 0 && !(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])))
             continue;
         double when = h == stop ? t_end : py_min(t0 + hs[h], t1);
         res->hit_event[m] = he[h];
         res->hit_t[m] = when;
-        flight_at(&f, when, res->hit_y + (size_t)m * N);
+        flight_at(&f, when, res->hit_y + (size_t)m * r->ns);
         m++;
     }
     res->n_hits = kept;
@@ -1286,11 +1432,14 @@ static void energy_of(const run_t *r, const double *y, double *e)
 /* resting._booked: the energy y has above ``new`` added to dissipated_normal */
 static void booked(const run_t *r, const double *y, double *new_y)
 {
-    double a[BALLC_ENERGY_NOUT], b[BALLC_ENERGY_NOUT];
+    double a[BALLC_MAX_ENERGY_NOUT], b[BALLC_MAX_ENERGY_NOUT];
     energy_of(r, y, a);
     energy_of(r, new_y, b);
-    double before = a[0] + a[1] + a[2] + a[3] + a[4] + a[5];
-    double after = b[0] + b[1] + b[2] + b[3] + b[4] + b[5];
+    double before = a[0], after = b[0];
+    for (int i = 1; i < BALLC_ENERGY_NOUT(r->np); i++) {
+        before += a[i];
+        after += b[i];
+    }
     new_y[BALLC_STATE_DISSIPATED_NORMAL] += before - after;
 }
 
@@ -1300,24 +1449,60 @@ static double normal_above(const ballc_drive_config *c, double x)
     return c->rest_weight * c->rho_eq * (0.4 * expm1(2.5 * (x == 0.0 ? x : log1p(x))) - x);
 }
 
-/* resting.at_rest (criteria 2-4); -1 where Python would raise */
-static int at_rest(const run_t *r, const double *y, double t_start, double t)
+/* the compliant law's tangential springs' energy, every plane's (J) */
+static double tangential_springs(const run_t *r, const double *e)
+{
+    double spring = e[2 + r->np];
+    for (int q = 1; q < r->np; q++) spring += e[2 + r->np + q];
+    return spring;
+}
+
+/* The resting plane p's state: y with the centre at the static equilibrium's height
+ * above the plane (r - rho_eq along its normal, which is opposite gravity) and no
+ * velocity along the normal, every deflection 0 (resting.rolling_state) */
+static void at_equilibrium(const run_t *r, int p, double *y)
+{
+    const plane_geometry *g = &r->geometry[p];
+    const ballc_plane_t *pl = &r->prepared.planes[p];
+    if (g->axis >= 0) {   /* along a coordinate axis: set that coordinate */
+        int k = g->axis - BALLC_STATE_X;
+        y[g->axis] = pl->point[k] + pl->frame[2][k] * r->c->z_eq;
+        y[g->axis + 6] = 0.0;
+    } else {
+        const double *n = pl->frame[2];
+        double height = 0.0, along = 0.0;
+        for (int i = 0; i < 3; i++) {
+            height += n[i] * (y[BALLC_STATE_X + i] - pl->point[i]);
+            along += n[i] * y[BALLC_STATE_VX + i];
+        }
+        for (int i = 0; i < 3; i++) {
+            y[BALLC_STATE_X + i] += (r->c->z_eq - height) * n[i];
+            y[BALLC_STATE_VX + i] -= along * n[i];
+        }
+    }
+    for (int q = 0; q < r->np; q++)
+        y[ballc_plane_state(q)] = y[ballc_plane_state(q) + 1] = 0.0;
+}
+
+/* resting.at_rest (criteria 2-4) on plane p; -1 where Python would raise */
+static int at_rest(const run_t *r, int p, const double *y, double t_start, double t)
 {
     const ballc_drive_config *c = r->c;
     if (t - t_start < c->rest_period) return 0;
     double across = 0.0, up = 0.0;
-    if (c->observer_massive) {   /* resting._observer_offset */
-        double where[BALLC_OBSERVER_POSITION_NOUT], d[3];
+    if (c->observer_massive) {   /* resting._observer_offset, in the plane's frame */
+        double where[BALLC_OBSERVER_POSITION_NOUT], d[3], local[3];
         ballc_observer_position(y, c->params, r->prepared.constants, NULL, where);
         for (int i = 0; i < 3; i++) d[i] = where[i] - y[BALLC_STATE_X + i];
-        across = ballc_py_hypot(2, d);
-        up = d[2];
+        ballc_plane_to_local(&r->prepared.planes[p], d, local);
+        across = ballc_py_hypot(2, local);
+        up = local[2];
         if (up >= 0) return 0;
     }
-    double e[BALLC_ENERGY_NOUT];
+    double e[BALLC_MAX_ENERGY_NOUT];
     energy_of(r, y, e);
-    double kinetic = e[0], spring = e[4] + e[5];
-    double rho = c->radius - y[BALLC_STATE_Z];
+    double kinetic = e[0], spring = tangential_springs(r, e);
+    double rho = rho_of(r, p, y);
     double x = (rho - c->rho_eq) / c->rho_eq;
     double normal = INFINITY;
     if (x > -1) {
@@ -1347,34 +1532,31 @@ static double max_abs(const double *v, int n)
 
 /* resting.rolls: BALLC_END_ROLLING / SLIDING with ``roll`` the uniform state, 0 none,
  * -1 where Python would raise */
-static int rolls(const run_t *r, const double *y, double t_start, double t,
+static int rolls(const run_t *r, int p, const double *y, double t_start, double t,
                  double slip_speed, double *roll)
 {
     const ballc_drive_config *c = r->c;
     if (t - t_start < c->rest_period || !c->rolls_allowed) return 0;
-    double e[BALLC_ENERGY_NOUT];
+    double e[BALLC_MAX_ENERGY_NOUT];
     energy_of(r, y, e);
-    double x = (c->radius - y[BALLC_STATE_Z] - c->rho_eq) / c->rho_eq;
+    double x = (rho_of(r, p, y) - c->rho_eq) / c->rho_eq;
     if (!(x > -1)) return 0;
     double normal = normal_above(c, x);
     if (!isfinite(normal) && isfinite(x)) return -1;
-    double above = c->half_mass * pow(y[BALLC_STATE_VZ], 2.0) + (e[4] + e[5])
+    double above = c->half_mass * pow(rho_rate(r, p, y), 2.0) + tangential_springs(r, e)
                    + py_max(normal, 0.0);
     if (!(above <= c->rest_threshold)) return 0;
-    memcpy(roll, y, N * sizeof(double));   /* resting.rolling_state */
-    roll[BALLC_STATE_Z] = c->z_eq;
-    roll[BALLC_STATE_VZ] = 0.0;
-    roll[BALLC_STATE_FLOOR_DEFLECTION_X] = roll[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
-    roll[BALLC_STATE_CEILING_DEFLECTION_X] = roll[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+    memcpy(roll, y, r->ns * sizeof(double));   /* resting.rolling_state */
+    at_equilibrium(r, p, roll);
     booked(r, y, roll);
     double rate[N];
     if (ballc_rhs(roll, c->params, r->latch, run_flags(r, 1), rate) != BALLC_OK) return -1;
     double level = c->rolls_level;
     if (max_abs(rate + BALLC_STATE_VX, 3) > level
-            || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level
-            || max_abs(rate + BALLC_STATE_FLOOR_DEFLECTION_X, 2) > level
-            || max_abs(rate + BALLC_STATE_CEILING_DEFLECTION_X, 2) > level)
+            || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level)
         return 0;
+    for (int q = 0; q < r->np; q++)
+        if (max_abs(rate + ballc_plane_state(q), 2) > level) return 0;
     return slip_speed <= c->rolls_dv ? BALLC_END_ROLLING : BALLC_END_SLIDING;
 }
 
@@ -1437,7 +1619,7 @@ static int trial_add(run_t *r, const radau5_result *res, double t0, double t1, i
     }
     if (!res->n_dense) return 0;   /* nothing integrated */
     return ballc_dense_add(d, t0, t1, res->n_dense, res->dense_t, res->dense_c,
-                           res->dense_kind, res->dense_terms, N) ? -2 : 0;
+                           res->dense_kind, res->dense_terms, r->ns) ? -2 : 0;
 }
 
 /* _Run.check_orbit: when this check ends the trial under way, the relative periodic
@@ -1461,7 +1643,7 @@ static int check_orbit(run_t *r, int p)
     const ballc_piecewise *solution = ballc_dense_view(d);
     if (!solution) return -2;
     double atol[N];
-    for (int i = 0; i < N; i++) atol[i] = c->atol;
+    for (int i = 0; i < r->ns; i++) atol[i] = c->atol;
     ballc_orbit_tolerances tol = {c->rtol, atol, c->rest_factor, c->rest_threshold,
                                   c->params};
     ballc_orbit orbit;
@@ -1490,28 +1672,26 @@ static int end_state(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
     const ballc_contact_rec *k = &r->o->contacts[r->o->open[p]];
-    int rest = at_rest(r, r->y, k->t_start, r->t);
+    int rest = at_rest(r, p, r->y, k->t_start, r->t);
     if (rest < 0) return -1;
     r->seg.end = rest ? BALLC_SEG_REST_CHECK : BALLC_SEG_UNIFORM_CHECK;   /* the log */
     if (rest) {   /* resting.rest_state */
         double new_y[N];
-        memcpy(new_y, r->y, sizeof new_y);
+        memcpy(new_y, r->y, r->ns * sizeof(double));
         for (int i = 0; i < 3; i++) new_y[BALLC_STATE_VX + i] = new_y[BALLC_STATE_OMEGA_X + i] = 0.0;
-        new_y[BALLC_STATE_Z] = c->z_eq;
-        new_y[BALLC_STATE_FLOOR_DEFLECTION_X] = new_y[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
-        new_y[BALLC_STATE_CEILING_DEFLECTION_X] = new_y[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+        at_equilibrium(r, p, new_y);
         booked(r, r->y, new_y);
-        memcpy(r->y, new_y, sizeof new_y);
+        memcpy(r->y, new_y, r->ns * sizeof(double));
         return BALLC_END_REST;
     }
     /* resting.next_check */
     r->rest_check[p] = r->t + py_max(c->rest_period, 0.25 * (r->t - k->t_start));
     double u[2], speed, error, clear, roll[N];
     slip(r, p, r->y, u, &speed, &error, &clear);
-    int kind = rolls(r, r->y, k->t_start, r->t, speed, roll);
+    int kind = rolls(r, p, r->y, k->t_start, r->t, speed, roll);
     if (kind < 0) return -1;
     if (kind) {
-        memcpy(r->y, roll, sizeof roll);
+        memcpy(r->y, roll, r->ns * sizeof(double));
         return kind;
     }
     if (!c->orbit_applies) return 0;
@@ -1546,10 +1726,10 @@ static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, i
         k->t0 = t0;
         k->t1 = t1;
         k->flight = 1;
-        memcpy(k->y0, r->y, sizeof k->y0);
+        memcpy(k->y0, r->y, r->ns * sizeof(double));
         return 0;
     }
-    long m = res->n_dense, width = (long)(1 + res->dense_terms) * N;
+    long m = res->n_dense, width = (long)(1 + res->dense_terms) * r->ns;
     if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1, sizeof(ballc_piece_rec)))
         return -1;
     long cs = o->cap_steps;
@@ -1623,7 +1803,7 @@ static int drv_poll(void *ctx, double t)
  * of memory (free_events frees what was allocated) */
 static int alloc_events(run_t *r, int n_user)
 {
-    size_t cap = DRIVER_EVENTS + (size_t)(n_user > 0 ? n_user : 0);
+    size_t cap = EVENTS_PER_PLANE * MAXP + (size_t)(n_user > 0 ? n_user : 0);
     double *d = malloc(cap * (N + 4) * sizeof(double));
     int *k = malloc(cap * 11 * sizeof(int));
     r->user_seen = calloc(n_user > 0 ? (size_t)n_user : 1, sizeof(long));
@@ -1675,21 +1855,31 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         free(r);
         return BALLC_DRIVE_NO_MEMORY;
     }
-    o->open[0] = o->open[1] = -1;
+    for (int p = 0; p < MAXP; p++) {
+        o->open[p] = -1;
+        r->rest_check[p] = INFINITY;
+        r->capacity_row[p] = -1;
+    }
     o->stiff_at = NAN;
     r->c = c;
     r->o = o;
-    ballc_parameters_init(&r->prepared, c->params);
-    memcpy(r->y, y0, sizeof r->y);
-    r->rest_check[0] = r->rest_check[1] = INFINITY;
-    r->capacity_row[0] = r->capacity_row[1] = -1;
+    if (ballc_parameters_init(&r->prepared, c->params) != BALLC_OK) {
+        free_events(r);
+        free(r);
+        return o->stop_code = BALLC_DRIVE_FALLBACK;
+    }
+    r->np = o->n_planes = r->prepared.n_planes;
+    r->ns = o->n_states = r->prepared.n_states;
+    r->nl = o->n_latch = r->prepared.n_latch;
+    memcpy(r->y, y0, r->ns * sizeof(double));
     r->margins_plane = -1;
     r->polled = wall_seconds();
     r->seg_interpolant = -1;
     int rc = 0;
-    for (int i = 0; i < BALLC_N_PARAMETERS; i++)
+    for (int i = 0; i < r->prepared.n_parameters; i++)
         if (!isfinite(c->params[i])) rc = -1;   /* solve_system would raise */
-    for (int p = 0; p < 2 && !rc; p++)
+    if (!rc) plane_setup(r);
+    for (int p = 0; p < r->np && !rc; p++)
         if (rho_of(r, p, r->y) > 0) rc = begin_contact(r, p);
     double t0 = 0.0;
     if (!rc && !c->t_eval) rc = add_block(r, &t0, r->y, 1, run_flags(r, 1), r->latch);
@@ -1697,7 +1887,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     if (!rc && c->t_eval) {   /* the points at 0 (t_eval == 0.0), each the initial state */
         long keep = 0;
         for (long i = 0; i < c->n_eval; i++) keep += c->t_eval[i] == 0.0;
-        double *rows = malloc((size_t)(keep ? keep : 1) * N * sizeof(double));
+        double *rows = malloc((size_t)(keep ? keep : 1) * r->ns * sizeof(double));
         double *times = malloc((size_t)(keep ? keep : 1) * sizeof(double));
         if (!rows || !times) rc = -2;
         else {
@@ -1705,7 +1895,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             for (long i = 0; i < c->n_eval; i++)
                 if (c->t_eval[i] == 0.0) {
                     times[j] = c->t_eval[i];
-                    memcpy(rows + j * N, r->y, N * sizeof(double));
+                    memcpy(rows + j * r->ns, r->y, r->ns * sizeof(double));
                     j++;
                 }
             rc = add_block(r, times, rows, keep, run_flags(r, 1), r->latch) ? -2 : 0;
@@ -1714,7 +1904,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         free(times);
     }
     double atol[N];
-    for (int i = 0; i < N; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
+    for (int i = 0; i < r->ns; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
     double first = c->first_step;
     int has_first = c->has_first_step;
     int implicit = 0;   /* method "auto": the segment starts with radau5 */
@@ -1726,21 +1916,24 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             r->stop_code = BALLC_DRIVE_USER_ERROR;
             break;
         }
-        int flags = run_flags(r, 1);
+        ballc_flags flags = run_flags(r, 1);
         int trial = r->trial_on;   /* an orbit's trial needs dense output */
         r->seg_flags = flags;
         if (segment_events(r, flags)) { rc = -1; break; }
         r->n_rearmed = 0;
         double t_check = INFINITY;
-        if (c->checks_rest && c->resting_plane >= 0 && r->in_contact[c->resting_plane]
-                && !r->in_contact[1 - c->resting_plane])
-            t_check = r->rest_check[c->resting_plane];
+        if (c->checks_rest && c->resting_plane >= 0 && r->in_contact[c->resting_plane]) {
+            int alone = 1;   /* in contact with the resting plane alone */
+            for (int p = 0; p < r->np; p++)
+                if (p != c->resting_plane && r->in_contact[p]) alone = 0;
+            if (alone) t_check = r->rest_check[c->resting_plane];
+        }
         /* a rest check, or the end of a compliant contact's step bound, ends it */
         double t_stop = py_min(py_min(t_check, c->t_end), step_bound_end(r));
         double max_step = run_max_step(r);
-        for (int i = 0; i < N; i++)
+        for (int i = 0; i < r->ns; i++)
             if (!isfinite(r->y[i])) rc = -1;
-        for (int i = 0; i < NL; i++)
+        for (int i = 0; i < r->nl; i++)
             if (!isfinite(r->latch[i])) rc = -1;
         if (rc) break;
         log_open(r);
@@ -1763,7 +1956,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         } else {
         radau5_problem pr;
         memset(&pr, 0, sizeof pr);
-        pr.n = N;
+        pr.n = r->ns;
         pr.fun = drv_fun;
         pr.jac = drv_jac;
         pr.ctx = r;
@@ -1803,12 +1996,12 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.ev_rearm = r->ev_rearm;
         pr.rearm = drv_rearm;
         pr.method = c->method;
-        pr.jacobian_ahead = (flags & c->compliant_any) != 0;
-        pr.jacobian_every_step = (flags & c->compliant_sliding_any) != 0;
+        pr.jacobian_ahead = any_plane(r, flags, BALLC_KIND_COMPLIANT);
+        pr.jacobian_every_step = any_plane(r, flags, BALLC_KIND_COMPLIANT_SLIDING);
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
         pr.poll = drv_poll;
-        ballc_segment seg = {flags, r->latch, c->params, -1};   /* the integrator interface */
+        ballc_segment seg = {flags, r->latch, c->params, -1, r->nl};   /* the integrator interface */
         memset(&res, 0, sizeof res);
         solved = (c->integrate ? c->integrate : ballc_compiled_integrator)(
             c->integrate_ctx, &pr, &seg, &res);
@@ -1872,7 +2065,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 int p = r->ev_plane[e];
                 for (long h = 0; h < res.n_hits; h++)
                     if (res.hit_event[h] == e) {
-                        const double *yy = res.hit_y + (size_t)h * N;
+                        const double *yy = res.hit_y + (size_t)h * r->ns;
                         record_depth(&o->contacts[o->open[p]], rho_of(r, p, yy), yy);
                     }
             } else if (r->ev_terminal[e] > 0 && r->ev_terminal[e] <= count
@@ -1892,14 +2085,15 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             if (cu != o->cap_user_hits) {
                 int *ue = realloc(o->user_hit_event, (size_t)cu * sizeof(int));
                 if (ue) o->user_hit_event = ue;
-                double *uy = realloc(o->user_hit_y, (size_t)cu * N * sizeof(double));
+                double *uy = realloc(o->user_hit_y, (size_t)cu * r->ns * sizeof(double));
                 if (uy) o->user_hit_y = uy;
                 if (!ue || !uy) { rc = -2; break; }
                 o->cap_user_hits = cu;
             }
             o->user_hit_event[m] = u;
             o->user_hit_t[m] = res.hit_t[h];
-            memcpy(o->user_hit_y + (size_t)m * N, res.hit_y + (size_t)h * N, N * sizeof(double));
+            memcpy(o->user_hit_y + (size_t)m * r->ns, res.hit_y + (size_t)h * r->ns,
+                   r->ns * sizeof(double));
             o->n_user_hits++;
         }
         if (rc) { radau5_free(&res); break; }
@@ -1927,7 +2121,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             r->t = t_stop;
             if (t_stop < c->t_end) {   /* a rest check (ballc.resting) or a step bound's end */
                 if (!res.n_out) { radau5_free(&res); rc = -1; break; }
-                memcpy(r->y, res.y_out + (size_t)(res.n_out - 1) * N, sizeof r->y);
+                memcpy(r->y, res.y_out + (size_t)(res.n_out - 1) * r->ns, r->ns * sizeof(double));
                 radau5_free(&res);
                 if (t_stop != t_check) {   /* only a step bound ended: a fresh step */
                     implicit = ended_implicit;
@@ -1941,7 +2135,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                     o->end_kind = kind;
                     o->end_plane = p;
                     o->end_t = r->t;
-                    memcpy(o->end_y, r->y, sizeof r->y);
+                    memcpy(o->end_y, r->y, r->ns * sizeof(double));
                     if (log_close(r, r->seg.end, p, r->t)) rc = -2;
                     break;
                 }
@@ -1959,7 +2153,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         }
         double h_next = res.h_next;
         r->t = t_fired;
-        memcpy(r->y, res.hit_y + (size_t)fired_hit * N, sizeof r->y);
+        memcpy(r->y, res.hit_y + (size_t)fired_hit * r->ns, r->ns * sizeof(double));
         radau5_free(&res);
         double h = ballc_py_hypot(4, r->y + BALLC_STATE_QW);
         for (int i = 0; i < 4; i++) r->y[BALLC_STATE_QW + i] /= h;
@@ -1971,7 +2165,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         if (kind == K_CAPACITY)   /* its row may have toggled inside the segment */
-            r->fired_row = (r->ev_plane_code[fired] - 2) / 2;
+            r->fired_row = (r->ev_plane_code[fired] - MARGIN_CODE) / MAXP;
         int handled = 0;
         switch (kind) {
         case K_ENTER: handled = begin_contact(r, p); break;
@@ -2005,10 +2199,10 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     o->status = r->status;
     o->stop_plane = r->stop_plane;
     o->t_run = r->t;
-    o->in_contact[0] = r->in_contact[0];
-    o->in_contact[1] = r->in_contact[1];
-    o->transitions[0] = r->transitions[0];
-    o->transitions[1] = r->transitions[1];
+    for (int p = 0; p < r->np; p++) {
+        o->in_contact[p] = r->in_contact[p];
+        o->transitions[p] = r->transitions[p];
+    }
     o->stalled = r->stalled;
     o->nfev = nfev;
     o->njev = njev;

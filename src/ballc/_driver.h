@@ -25,6 +25,7 @@
 #include "ballc_kernels.h"
 #include "_orbit.h"
 #include "_integrator.h"
+#include "_system.h"
 
 double ballc_py_hypot(int n, const double *values);
 double ballc_py_ulp(double x);
@@ -66,10 +67,11 @@ enum {
  * when it failed with an exception it keeps for the bridge to raise (scipy's methods:
  * the bridge's _scipy_integrate, which evaluates the events with radau5_event_value). */
 typedef struct {
-    int flags;                 /* the segment's ballc_rhs flags */
-    const double *latch;       /* the latched values (N_LATCH) at its start */
+    ballc_flags flags;         /* the segment's ballc_rhs flags */
+    const double *latch;       /* the latched values (the run's latch) at its start */
     const double *params;      /* the parameter vector */
     long interpolant;          /* out: the integrator's own interpolant's id, or -1 */
+    int n_latch;               /* the latch's length */
 } ballc_segment;
 
 typedef int (*ballc_integrator)(void *ctx, const radau5_problem *problem,
@@ -78,7 +80,7 @@ typedef int (*ballc_integrator)(void *ctx, const radau5_problem *problem,
 enum { BALLC_INTEGRATOR_RAISED = -100 };
 
 /* An integrator's own interpolant ``id`` (segment->interpolant) at n times t into y (n
- * rows of N_STATES), with the integrator's ctx: 0, or nonzero when it cannot (an
+ * rows of the run's states), with the integrator's ctx: 0, or nonzero when it cannot (an
  * exception kept for the bridge).  For C code that evaluates a segment's dense output
  * (ballc.orbit's trial) when the integrator keeps it itself; the compiled integrators'
  * dense steps are in their result instead. */
@@ -92,35 +94,29 @@ int ballc_compiled_integrator(void *ctx, const radau5_problem *problem,
 enum { BALLC_MODE_NONE = 0, BALLC_MODE_SLIP, BALLC_MODE_SLIP_FIXED, BALLC_MODE_STICK };
 
 typedef struct {                       /* constants of one run, filled by the bridge */
-    const double *params;              /* BALLC_N_PARAMETERS */
+    const double *params;              /* the parameter vector, its plane table included:
+                                        * the run's planes, states and latch follow from it */
     double rtol, atol;                 /* one atol for all states */
     double t_end, max_step, first_step;
     int has_first_step;
     long max_nfev;                     /* 0: none */
     int method, controller;
-    int observer_bits;                 /* the observer's flag when it has mass */
-    int contact_bits[2];               /* friction | digin of a plane in contact */
-    int slip_bits[2], slip_fixed_bits[2], stick_bits[2];
+    ballc_flags observer_bits;         /* the observer's flag when it has mass */
+    ballc_flags contact_bits[BALLC_MAX_PLANES];   /* friction | digin of a plane in contact */
     int exact;                         /* stickslip.uses_exact_coulomb */
     double radius, weight, hertz_k, total_mass, rest_period;   /* rest: 20 T0 */
     int resting_plane, checks_rest;    /* -1: none */
-    double rho_scale[2], rho_offset[2], through_offset[2], threshold_base[2];
-    int n_terms[2][2];                 /* slip_terms: plane, row -> at most 2 terms */
-    int term_index[2][2][2];
-    double term_coef[2][2][2];
-    double slip_map[2][2][BALLC_N_STATES];
     /* stage 2b: t_eval (sorted, within [0, t_end]; NULL: none) and dense output */
     const double *t_eval;
     long n_eval;
     int dense_output;
     /* stage 2c: exact flight (options.exact_flight and flight.scene_allows) */
     int exact_flight;
-    double gravity;                    /* params[gravity] */
     /* stage 4: the user's events (UserEvents), in order: LinearEvents (a row, offset;
      * index and scale when one state) or callables (called back through user_fun,
      * the bridge's, with user_ctx: it keeps an exception for the bridge to raise) */
     int n_user;
-    const double *user_coef;           /* n_user x N */
+    const double *user_coef;           /* n_user x the run's states */
     const double *user_offset, *user_scale;
     const int *user_linear, *user_index, *user_count, *user_direction;
     int user_flight;                   /* every one lets exact flight apply */
@@ -131,11 +127,9 @@ typedef struct {                       /* constants of one run, filled by the br
     int (*interrupted)(void *ctx);
     /* stage 3: the compliant law's exact modes (ballc.compliantmodes) */
     int compliant_modes;               /* compliantmodes.uses_modes */
-    int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* mode_flags per plane */
-    int compliant_any;                 /* FLOOR_COMPLIANT | CEILING_COMPLIANT */
-    int compliant_sliding_any;         /* FLOOR_COMPLIANT_SLIDING | CEILING_COMPLIANT_SLIDING */
-    double arm_depth[2];               /* arm_penetration; 0: contacts begin at rho = 0 (compliantmodes.starts_armed) */
-    double ulp8[2];                    /* 8 ulp(plane_position): _rounding */
+    int starts_armed;                  /* compliantmodes.starts_armed: contacts begin at the
+                                        * arming depth (else at rho = 0) */
+    double arm_force_depth;            /* (ARM_FORCE / k0)^(2/3): arm_penetration's floor */
     double restick_factor;             /* max(1, mu / max(tangential_stiffness_ratio, 1e-300)) */
     int damping_positive;              /* tangential_damping_ratio > 0: capacity guards */
     double contact_time_base;          /* 3.2145 (m_total / k0)^0.4: contact_time */
@@ -145,8 +139,8 @@ typedef struct {                       /* constants of one run, filled by the br
     int orbit_applies;                 /* orbit.applies: a check finding nothing tries an orbit */
     double rest_threshold;             /* resting.energy_threshold */
     double rho_eq, z_eq;               /* equilibrium_penetration, radius - rho_eq */
-    double rest_weight;                /* total_mass * gravity */
-    double observer_weight;            /* observer_mass * gravity */
+    double rest_weight;                /* total_mass * |gravity| */
+    double observer_weight;            /* observer_mass * |gravity| */
     double rolls_dv, rolls_level, half_mass;   /* resting.rolls: dv, 1e3 eps g, 0.5 M */
     /* ballc.orbit, run at the rest checks when orbit_applies (_orbit.c) */
     double orbit_axis[3];              /* orbit.body_axis */
@@ -155,7 +149,7 @@ typedef struct {                       /* constants of one run, filled by the br
     ballc_integrator integrate;        /* NULL: ballc_compiled_integrator */
     void *integrate_ctx;
     ballc_interpolant_fn interpolant;  /* its own interpolants (NULL: none) */
-    const double *atol_states;         /* N values (NULL: atol for each); atol is then
+    const double *atol_states;         /* one per state (NULL: atol for each); atol is then
                                         * their largest (stickslip.error_speed's) */
     /* may be NULL: the simulated time reached, reported at most every poll_interval s of
      * wall time (the bridge's: the progress bar), with user_ctx */
@@ -189,7 +183,7 @@ typedef struct {
     long step0, n_steps, coef0;
     int terms;
     int flight;                /* exact flight: FreeFlight(t0, y0, gravity, t_max = t1) */
-    double y0[BALLC_N_STATES];
+    double y0[BALLC_MAX_STATES];
     int own;                   /* nonzero: the integrator's own interpolant, by its id */
     long interpolant;
 } ballc_piece_rec;
@@ -235,29 +229,31 @@ typedef struct {
                                  * (auto: radau5 or dop853), -1 an exact flight */
     int switches;               /* method "auto": switches inside the segment */
     int end;                    /* BALLC_SEG_* */
-    int plane;                  /* the event's plane (0 floor, 1 ceiling), a user event's
-                                 * index, or -1 (no event) */
+    int plane;                  /* the event's plane (its index in the plane table), a
+                                 * user event's index, or -1 (no event) */
     int rearms;                 /* events re-armed inside the segment (a free slip's
                                  * approach re-latched, the capacity guard toggled) */
-    signed char before[2], after[2];   /* BALLC_PLANE_* of each plane during the segment
-                                        * and after its end was handled */
+    signed char before[BALLC_MAX_PLANES], after[BALLC_MAX_PLANES];
+                                /* BALLC_PLANE_* of each plane during the segment and
+                                 * after its end was handled (-1: no such plane) */
     signed char rearm_kind, rearm_plane;    /* the last re-arm: BALLC_SEG_APPROACH or
                                              * _CAPACITY and its plane; -1 none */
     signed char rearm_before, rearm_after;  /* the plane's mode before / after it */
 } ballc_segment_rec;
 
 typedef struct {
-    long n, cap;                        /* samples: t (n), y (n x N_STATES) */
+    int n_planes, n_states, n_latch;    /* the run's (its parameters' plane table) */
+    long n, cap;                        /* samples: t (n), y (n x n_states) */
     double *t, *y;
-    long n_blocks, cap_blocks;          /* blocks: count, flags, latch (N_LATCH) */
+    long n_blocks, cap_blocks;          /* blocks: count, flags, latch (n_latch) */
     long *block_count;
-    int *block_flags;
+    ballc_flags *block_flags;
     double *block_latch;
     long n_contacts, cap_contacts;
     ballc_contact_rec *contacts;
     long n_phases, cap_phases;
     ballc_phase_rec *phases;
-    int open[2];                        /* open contact per plane, -1 none */
+    int open[BALLC_MAX_PLANES];         /* open contact per plane, -1 none */
     long n_user_hits, cap_user_hits;    /* the user's events' hits, in order */
     int *user_hit_event;
     double *user_hit_t, *user_hit_y;
@@ -273,15 +269,15 @@ typedef struct {
     int stop_code, status, stop_plane;
     double t_run;                       /* run.t at the end */
     double fail_end;                    /* FAILED: t[-1] of the segment, or run.t */
-    int in_contact[2];
-    long transitions[2], stalled;
+    int in_contact[BALLC_MAX_PLANES];
+    long transitions[BALLC_MAX_PLANES], stalled;
     int unsettled_compliant;            /* UNSETTLED: the compliant law's modes */
     long nfev, njev, nlu;
     double stiff_at;                    /* NaN: none */
     char message[240];                  /* FAILED: the integrator's message */
     long segments;
     int end_kind, end_plane;            /* BALLC_END_*: rest / uniform motion found */
-    double end_t, end_y[BALLC_N_STATES];
+    double end_t, end_y[BALLC_MAX_STATES];
     /* a -DRADAU5_PROFILE build: thread CPU time (ns) inside radau5_solve, summed over
      * the segments, and in the whole of ballc_drive; zeros otherwise */
     int profiled;

@@ -21,27 +21,15 @@ cdef extern from "_driver.h":
         int has_first_step
         long max_nfev
         int method, controller
-        int observer_bits
-        int contact_bits[2]
-        int slip_bits[2]
-        int slip_fixed_bits[2]
-        int stick_bits[2]
+        ballc_flags observer_bits
+        ballc_flags contact_bits[6]
         int exact
         double radius, weight, hertz_k, total_mass, rest_period
         int resting_plane, checks_rest
-        double rho_scale[2]
-        double rho_offset[2]
-        double through_offset[2]
-        double threshold_base[2]
-        int n_terms[2][2]
-        int term_index[2][2][2]
-        double term_coef[2][2][2]
-        double slip_map[2][2][19]
         const double *t_eval
         long n_eval
         int dense_output
         int exact_flight
-        double gravity
         int n_user
         const double *user_coef
         const double *user_offset
@@ -55,13 +43,8 @@ cdef extern from "_driver.h":
         void *user_ctx
         int (*interrupted)(void *) noexcept nogil
         int compliant_modes
-        int compliant_bits[2]
-        int elastic_bits[2]
-        int sliding_bits[2]
-        int compliant_any
-        int compliant_sliding_any
-        double arm_depth[2]
-        double ulp8[2]
+        int starts_armed
+        double arm_force_depth
         double restick_factor
         int damping_positive
         double contact_time_base
@@ -101,7 +84,7 @@ cdef extern from "_driver.h":
         long step0, n_steps, coef0
         int terms
         int flight
-        double y0[19]
+        double y0[27]
         int own
         long interpolant
     enum: BALLC_N_PLANE_MODES, BALLC_N_SEGMENT_ENDS
@@ -111,22 +94,23 @@ cdef extern from "_driver.h":
         double t_start, t_end
         long nfev, njev, nlu, nstep, nreject
         int method, method_end, switches, end, plane, rearms
-        signed char before[2]
-        signed char after[2]
+        signed char before[6]
+        signed char after[6]
         signed char rearm_kind, rearm_plane, rearm_before, rearm_after
     ctypedef struct ballc_drive_output:
+        int n_planes, n_states, n_latch
         long n
         double *t
         double *y
         long n_blocks
         long *block_count
-        int *block_flags
+        ballc_flags *block_flags
         double *block_latch
         long n_contacts
         ballc_contact_rec *contacts
         long n_phases
         ballc_phase_rec *phases
-        int open[2]
+        int open[6]
         long n_user_hits
         int *user_hit_event
         double *user_hit_t
@@ -142,8 +126,8 @@ cdef extern from "_driver.h":
         int *dense_kind
         int stop_code, status, stop_plane
         double t_run, fail_end
-        int in_contact[2]
-        long transitions[2]
+        int in_contact[6]
+        long transitions[6]
         long stalled
         int unsettled_compliant
         long nfev, njev, nlu
@@ -152,7 +136,7 @@ cdef extern from "_driver.h":
         long segments
         int end_kind, end_plane
         double end_t
-        double end_y[19]
+        double end_y[27]
         int profiled
         double integrator_ns, drive_ns
         int end_orbit
@@ -197,7 +181,8 @@ cdef object _segment_record():
     fields = [("t_start", "f8"), ("t_end", "f8"), ("nfev", "l"), ("njev", "l"), ("nlu", "l"),
               ("nstep", "l"), ("nreject", "l"), ("method", "intc"), ("method_end", "intc"), ("switches", "intc"),
               ("end", "intc"), ("plane", "intc"), ("rearms", "intc"),
-              ("before", ("i1", (2,))), ("after", ("i1", (2,))), ("rearm_kind", "i1"),
+              ("before", ("i1", (BALLC_MAX_PLANES,))), ("after", ("i1", (BALLC_MAX_PLANES,))),
+              ("rearm_kind", "i1"),
               ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1")]
     return np.dtype(dict(names=[f[0] for f in fields], formats=[f[1] for f in fields],
                          offsets=offsets, itemsize=sizeof(ballc_segment_rec)))
@@ -245,26 +230,28 @@ cdef int _drive_user_rearm(void *ctx, int k, double t, const double *y, double *
     cdef double[::1] yv
     cdef const double[::1] cv, lv
     cdef double off
+    cdef int width, n_latch
     with gil:
         errors = (<list>ctx)[1]
         if errors:
             return -1
         try:
-            state = np.empty(BALLC_N_STATES)
+            width, n_latch = (<list>ctx)[4]
+            state = np.empty(width)
             yv = state
-            memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+            memcpy(&yv[0], y, width * sizeof(double))
             out = (<list>ctx)[2][k](t, state)
             if out is None:
                 return 0
             coefficients, new_offset, new_latch = out
-            cv = _checked_row("rearm coefficients", coefficients, BALLC_N_STATES)
-            lv = _checked_row("rearm latch", new_latch, BALLC_N_LATCH)
+            cv = _checked_row("rearm coefficients", coefficients, width)
+            lv = _checked_row("rearm latch", new_latch, n_latch)
             off = float(new_offset)
             if not isfinite(off):
                 raise ValueError(f"rearm offset = {new_offset!r} is not allowed: must be "
                                  "finite")
-            memcpy(coef, &cv[0], BALLC_N_STATES * sizeof(double))
-            memcpy(latch, &lv[0], BALLC_N_LATCH * sizeof(double))
+            memcpy(coef, &cv[0], width * sizeof(double))
+            memcpy(latch, &lv[0], n_latch * sizeof(double))
             offset[0] = off
             return 1
         except BaseException as error:
@@ -278,15 +265,17 @@ cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
     it: ctx is [the events (simulate's CheckedEvent), the exceptions kept]; an exception
     is kept for drive to raise and the event reads as NaN meanwhile."""
     cdef double[::1] yv
+    cdef int width
     with gil:
         events, errors = (<list>ctx)[0], (<list>ctx)[1]
         if errors:
             g[0] = NAN
             return -1
         try:
-            state = np.empty(BALLC_N_STATES)
+            width = (<list>ctx)[4][0]
+            state = np.empty(width)
             yv = state
-            memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+            memcpy(&yv[0], y, width * sizeof(double))
             g[0] = float(events[k](t, state))
             return 0
         except BaseException as error:
@@ -350,21 +339,23 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
     cdef double[:, ::1] rv, lv
     cdef ballc_contact_rec rec
     cdef Py_ssize_t i
-    cdef const double[:, :, ::1] smap = k["slip_map"]
     cdef const double[::1] t_eval = k["t_eval"]   # None: no t_eval
     cdef const double[:, ::1] ucoef = k["user_coef"]
     cdef const double[::1] uoffset = k["user_offset"], uscale = k["user_scale"]
     cdef const int[::1] ulinear = k["user_linear"], uindex = k["user_index"]
     cdef const int[::1] ucount = k["user_count"], udirection = k["user_direction"]
-    cdef list user_ctx = [k["user_events"], [], k["user_rearms"], progress]
+    cdef int n_planes = _planes_of(params)
+    cdef int width = _states(n_planes), n_latch = _latches(n_planes)
+    cdef list user_ctx = [k["user_events"], [], k["user_rearms"], progress, (width, n_latch)]
     cdef const int[::1] urearm = k["user_rearm"]
     cdef const double[::1] atol_states = k["atol_states"]   # None: one atol
     cdef _ScipyRun scipy_run = None
     cdef ballc_piece_rec piece
     cdef double[:, ::1] dtv, dcv
     cdef int[::1] dkv
-    if params.shape[0] != BALLC_N_PARAMETERS or y0.shape[0] != BALLC_N_STATES:
-        raise ValueError("params or y0 of the wrong length")
+    _check("y0", y0.shape[0], width)
+    if ucoef.shape[0] and ucoef.shape[1] != width:
+        raise ValueError(f"user_coef must have {width} columns, got {ucoef.shape[1]}")
     c.params = &params[0]
     c.rtol = k["rtol"]
     c.atol = k["atol"]
@@ -409,7 +400,6 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
         c.t_eval = &t_eval[0] if c.n_eval else &y0[0]   # non-NULL: t_eval given
     c.dense_output = k["dense_output"]
     c.exact_flight = k["exact_flight"]
-    c.gravity = k["gravity"]
     c.n_user = ucount.shape[0]
     c.user_flight = k["user_flight"]
     c.user_fun = _drive_user_event
@@ -428,17 +418,11 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
         c.user_count = &ucount[0]
         c.user_direction = &udirection[0]
     c.compliant_modes = k["compliant_modes"]
-    c.compliant_any = k["compliant_any"]
-    c.compliant_sliding_any = k["compliant_sliding_any"]
+    c.starts_armed = k["starts_armed"]
+    c.arm_force_depth = k["arm_force_depth"]
     c.restick_factor = k["restick_factor"]
     c.damping_positive = k["damping_positive"]
     c.contact_time_base = k["contact_time_base"]
-    for p in range(2):
-        c.compliant_bits[p] = k["compliant_bits"][p]
-        c.elastic_bits[p] = k["elastic_bits"][p]
-        c.sliding_bits[p] = k["sliding_bits"][p]
-        c.arm_depth[p] = k["arm_depth"][p]
-        c.ulp8[p] = k["ulp8"][p]
     c.observer_massive = k["observer_massive"]
     c.rolls_allowed = k["rolls_allowed"]
     c.orbit_applies = k["orbit_applies"]
@@ -453,23 +437,8 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
     for j in range(3):
         c.orbit_axis[j] = k["orbit_axis"][j]
     c.rest_factor = k["rest_factor"]
-    for p in range(2):
-        c.contact_bits[p] = k["contact_bits"][p]
-        c.slip_bits[p] = k["slip_bits"][p]
-        c.slip_fixed_bits[p] = k["slip_fixed_bits"][p]
-        c.stick_bits[p] = k["stick_bits"][p]
-        c.rho_scale[p] = k["rho_scale"][p]
-        c.rho_offset[p] = k["rho_offset"][p]
-        c.through_offset[p] = k["through_offset"][p]
-        c.threshold_base[p] = k["threshold_base"][p]
-        terms = k["slip_terms"][p]
-        for row in range(2):
-            c.n_terms[p][row] = len(terms[row])
-            for j in range(len(terms[row])):
-                c.term_index[p][row][j] = terms[row][j][0]
-                c.term_coef[p][row][j] = terms[row][j][1]
-            for j in range(BALLC_N_STATES):
-                c.slip_map[p][row][j] = smap[p, row, j]
+    for p in range(BALLC_MAX_PLANES):
+        c.contact_bits[p] = k["contact_bits"][p] if p < n_planes else 0
     with nogil:
         rc = ballc_drive(&c, &y0[0], &o)
     try:
@@ -482,24 +451,24 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
         user_event = np.array([o.user_hit_event[i] for i in range(o.n_user_hits)],
                               dtype=np.intc)
         user_t = np.array([o.user_hit_t[i] for i in range(o.n_user_hits)], dtype=float)
-        user_y = np.empty((o.n_user_hits, BALLC_N_STATES))
+        user_y = np.empty((o.n_user_hits, width))
         if o.n_user_hits:
             rv = user_y
-            memcpy(&rv[0, 0], o.user_hit_y, o.n_user_hits * BALLC_N_STATES * sizeof(double))
+            memcpy(&rv[0, 0], o.user_hit_y, o.n_user_hits * width * sizeof(double))
         n = o.n
         t = np.empty(n)
-        rows = np.empty((n, BALLC_N_STATES))
+        rows = np.empty((n, width))
         if n:
             tv = t
             rv = rows
             memcpy(&tv[0], o.t, n * sizeof(double))
-            memcpy(&rv[0, 0], o.y, n * BALLC_N_STATES * sizeof(double))
+            memcpy(&rv[0, 0], o.y, n * width * sizeof(double))
         counts = np.array([o.block_count[i] for i in range(o.n_blocks)], dtype=np.intp)
-        block_flags = np.array([o.block_flags[i] for i in range(o.n_blocks)], dtype=np.int32)
-        latches = np.empty((o.n_blocks, BALLC_N_LATCH))
+        block_flags = np.array([o.block_flags[i] for i in range(o.n_blocks)], dtype=np.int64)
+        latches = np.empty((o.n_blocks, n_latch))
         if o.n_blocks:
             lv = latches
-            memcpy(&lv[0, 0], o.block_latch, o.n_blocks * BALLC_N_LATCH * sizeof(double))
+            memcpy(&lv[0, 0], o.block_latch, o.n_blocks * n_latch * sizeof(double))
         contacts = []
         for i in range(o.n_contacts):
             rec = o.contacts[i]
@@ -527,10 +496,10 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
                 continue
             if piece.flight:
                 pieces.append((piece.t0, piece.t1,
-                               np.array([piece.y0[j] for j in range(BALLC_N_STATES)])))
+                               np.array([piece.y0[j] for j in range(width)])))
                 continue
             dense_t = np.empty((piece.n_steps, 2))
-            dense_c = np.empty((piece.n_steps, (1 + piece.terms) * BALLC_N_STATES))
+            dense_c = np.empty((piece.n_steps, (1 + piece.terms) * width))
             dense_kind = np.empty(piece.n_steps, dtype=np.intc)
             if piece.n_steps:
                 dtv = dense_t
@@ -539,7 +508,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
                 memcpy(&dtv[0, 0], o.dense_t + 2 * piece.step0,
                        piece.n_steps * 2 * sizeof(double))
                 memcpy(&dcv[0, 0], o.dense_c + piece.coef0,
-                       piece.n_steps * (1 + piece.terms) * BALLC_N_STATES * sizeof(double))
+                       piece.n_steps * (1 + piece.terms) * width * sizeof(double))
                 memcpy(&dkv[0], o.dense_kind + piece.step0, piece.n_steps * sizeof(int))
             pieces.append((piece.t0, piece.t1, dense_t, dense_c, piece.terms, dense_kind))
         orbit = None   # ballc.orbit's end: (c0, period, G, rate) and its base's pieces
@@ -553,15 +522,17 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
                     contacts=contacts, phases=phases, pieces=pieces,
                     user_hits=(user_event, user_t, user_y),
                     switches=[(o.switch_t[i], _METHOD_NAMES[o.switch_to[i]])
-                              for i in range(o.n_switches)], open=(o.open[0], o.open[1]),
+                              for i in range(o.n_switches)],
+                    open=tuple(o.open[p] for p in range(n_planes)),
                     stop_code=o.stop_code, status=o.status, stop_plane=o.stop_plane,
                     t_run=o.t_run, fail_end=o.fail_end, message=o.message.decode(),
-                    in_contact=(bool(o.in_contact[0]), bool(o.in_contact[1])),
-                    transitions=(o.transitions[0], o.transitions[1]), stalled=o.stalled,
+                    in_contact=tuple(bool(o.in_contact[p]) for p in range(n_planes)),
+                    transitions=tuple(o.transitions[p] for p in range(n_planes)),
+                    stalled=o.stalled,
                     unsettled_compliant=bool(o.unsettled_compliant),
                     nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
                     segments=o.segments, end_kind=o.end_kind, end_plane=o.end_plane,
-                    end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(BALLC_N_STATES)]),
+                    end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(width)]),
                     profiled=bool(o.profiled), segment_log=segments,
                     integrator_prof=dict(zip(("fun", "jac", "factor", "solve", "events",
                                               "total", "total_ns"),

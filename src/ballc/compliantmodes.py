@@ -165,6 +165,13 @@ def plane_position(scene, plane: str) -> float:
     return scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
 
 
+def arm_force_depth(scene) -> float:
+    """(ARM_FORCE / k0)^(2/3) (m): the penetration at which Hertz's force is ARM_FORCE,
+    arm_penetration's floor (the C loop takes the ulps of each plane's position
+    itself)."""
+    return (ARM_FORCE / scene.hertz_stiffness) ** (2.0 / 3.0)
+
+
 def arm_penetration(scene, plane: str) -> float:
     """The penetration (m) at which the guards of a contact with ``plane`` are armed:
     ARM_ULPS ulp of the plane's position, and Hertz's force ARM_FORCE."""

@@ -71,11 +71,10 @@ TERMINATED = "A termination event occurred."
 
 
 def scene_allows(params) -> bool:
-    """Whether the parameters admit exact flight: massless observer, isotropic inertia,
-    gravity along -z (or none)."""
+    """Whether the parameters admit exact flight: massless observer, isotropic inertia
+    (gravity, any constant vector, makes the centre's path a parabola)."""
     p = params
-    return bool(p[_OBSERVER_MASS] == 0 and p[_IXX] == p[_IYY] == p[_IZZ]
-                and p[_GRAVITY[0]] == p[_GRAVITY[1]] == 0)
+    return bool(p[_OBSERVER_MASS] == 0 and p[_IXX] == p[_IYY] == p[_IZZ])
 
 
 def applies(system, events) -> bool:
@@ -97,13 +96,16 @@ def polynomial_in_flight(event) -> bool:
 
 class FreeFlight:
     """The exact free-flight solution from (t0, y0): ``sol(t)`` gives the state
-    (N_STATES,) at a scalar t, (N_STATES, len(t)) at an array of times, like the
-    integrators' interpolants.  ``t_min``/``t_max``: the segment it was built for."""
+    (states,) at a scalar t, (states, len(t)) at an array of times, like the
+    integrators' interpolants.  ``gravity``: a number g (along -z, (0, 0, -g)) or the
+    acceleration vector.  ``t_min``/``t_max``: the segment it was built for."""
 
     def __init__(self, t0, y0, gravity, t_max=None):
         self.t0 = float(t0)
         self.y0 = np.array(y0, dtype=float)
-        self.gravity = float(gravity)
+        g = np.asarray(gravity, dtype=float)
+        #: the gravity vector (m/s^2)
+        self.gravity = np.array([0.0, 0.0, -float(g)]) if g.ndim == 0 else g.reshape(3).copy()
         self.t_min = self.t0
         self.t_max = self.t0 if t_max is None else float(t_max)
         wx, wy, wz = (float(v) for v in self.y0[_OMEGA])
@@ -120,8 +122,8 @@ class FreeFlight:
         c[0] = self.y0
         c[0, _QUATERNION] = 0.0
         c[1, _POSITION] = self.y0[_VELOCITY]
-        c[1, _VZ] = -self.gravity
-        c[2, _Z] = -0.5 * self.gravity
+        c[1, _VELOCITY] = self.gravity
+        c[2, _POSITION] = 0.5 * self.gravity
         c[3, _QUATERNION] = self.y0[_QUATERNION]
         c[4, _QUATERNION] = turned
         self._c = c
@@ -147,18 +149,25 @@ class FreeFlight:
     def event_polynomial(self, event):
         """(c0, c1, c2): ``event`` (a LinearEvent without quaternion terms) on this
         solution, g(t0 + s) = c0 + c1 s + c2 s^2."""
+        g = self.gravity
         if event._index is not None:     # one state (all of the driver's events)
             k, scale, y0 = event._index, event._scale, self.y0
+            position = _POSITION.start <= k < _POSITION.stop
+            velocity = _VELOCITY.start <= k < _VELOCITY.stop
             c0 = scale * y0[k] + event.offset
-            c1 = scale * (y0[k + _TO_VELOCITY] if _POSITION.start <= k < _POSITION.stop else
-                          -self.gravity if k == _VZ else 0.0)
-            c2 = -0.5 * scale * self.gravity if k == _Z else 0.0
+            c1 = scale * (y0[k + _TO_VELOCITY] if position else
+                          g[k - _VELOCITY.start] if velocity else 0.0)
+            c2 = 0.5 * scale * g[k - _POSITION.start] if position else 0.0
             return float(c0), float(c1), float(c2)
         c = event.coefficients
         c0 = float(c @ self.y0) + event.offset
-        c1 = float(c[_POSITION] @ self.y0[_VELOCITY]) - c[_VZ] * self.gravity
-        c2 = -0.5 * c[_Z] * self.gravity
-        return c0, c1, c2
+        c1 = float(c[_POSITION] @ self.y0[_VELOCITY])
+        c2 = 0.0
+        for i in range(3):   # gravity's share (its zero components none)
+            if g[i] != 0:
+                c1 += c[_VELOCITY.start + i] * g[i]
+                c2 += 0.5 * c[_POSITION.start + i] * g[i]
+        return float(c0), float(c1), float(c2)
 
 
 def crossings(c0, c1, c2, direction, s_max):
@@ -193,8 +202,7 @@ def propagate(system, t0, t1, y0, events, *, t_eval=None, max_step=np.inf,
     """The exact free-flight segment from (t0, y0) to t1 or its first terminal event
     (see the module's docstring); ``system``, ``events``, ``t_eval``, ``max_step`` and
     ``dense_output`` as for :func:`ballc.integrate.integrate_segment`."""
-    gravity = -float(system.params[_GRAVITY[2]])
-    flight = FreeFlight(t0, y0, gravity)
+    flight = FreeFlight(t0, y0, system.params[_GRAVITY])
     span = t1 - t0
     hits = []                     # (s, event index)
     counts = [_core.terminal_count(event.terminal) for event in events]

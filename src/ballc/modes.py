@@ -13,7 +13,7 @@ import numpy as np
 from . import _core, compliantmodes, stickslip
 
 PLANES = ("floor", "ceiling")
-_KIN_PER_PLANE = _core.CONTACT_KINEMATICS_NOUT // len(PLANES)
+_KIN_PER_PLANE = _core.CONTACT_KINEMATICS_PER_PLANE
 
 #: Smallest penetration rate latched at impact (m/s).  A contact that starts
 #: with a smaller rate (grazing, or a ball settling) uses this instead, so that
@@ -43,6 +43,17 @@ def flags(scene, in_contact, coulomb=None, compliant=None, armed=None):
         if coulomb:
             flags |= stickslip.mode_flags(plane, coulomb[plane])
     return flags
+
+
+def contact_flags(scene, plane: int) -> int:
+    """The flags of a contact with the plane with index ``plane`` (its laws: compliant;
+    or friction and/or dig-in by the mixture), without its modes: what the C loop adds
+    its modes to."""
+    if scene.tangential_model == "compliant":
+        return _core.flag("compliant", plane)
+    mixture = scene.effective_mixture
+    return ((_core.flag("friction", plane) if mixture < 1 else 0)
+            | (_core.flag("digin", plane) if mixture > 0 else 0))
 
 
 def latch_values(y, params, plane, scene=None):

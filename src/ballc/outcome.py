@@ -17,8 +17,6 @@ import numpy as np
 
 from . import _core
 
-PLANES = ("floor", "ceiling")
-
 #: Contacts of the classic experiment: floor, table underside, floor.
 CAME_BACK_AFTER_CONTACTS = 3
 
@@ -156,6 +154,7 @@ def summarize_contact_forces(result):
     if not contacts:
         return
     scene = result.scene
+    names = scene.plane_names
     mu = scene.friction_coefficient
     t = result.t
     ends = [c.t_end if np.isfinite(c.t_end) else t[-1] for c in contacts]
@@ -171,21 +170,25 @@ def summarize_contact_forces(result):
     forces = _core.contact_forces_per_sample(
         np.ascontiguousarray(result.y.T[rows]), scene.parameter_vector(),
         np.ascontiguousarray(result.latch.T[rows]),
-        np.ascontiguousarray(result.flags[rows], dtype=np.int32))
+        np.ascontiguousarray(result.flags[rows], dtype=np.int64))
     offset = 0
     for contact, end, first, stop in zip(contacts, ends, firsts, stops):
         if stop <= first:
             continue
-        k = PLANES.index(contact.plane)
-        normal = 1.0 if contact.plane == "floor" else -1.0
+        k = names.index(contact.plane)
         block = forces[offset:offset + stop - first, 3 * k:3 * k + 3]
         offset += stop - first
-        f_n = block[:, 2] * normal
+        n = contact.unit_normal
+        if n[0] == 0 and n[1] == 0:   # horizontal: the z component, as it is
+            f_n = block[:, 2] * n[2]
+            f_t = np.hypot(block[:, 0], block[:, 1])
+        else:   # along the normal, and the rest
+            f_n = block @ n
+            f_t = np.linalg.norm(block - f_n[:, None] * n, axis=1)
         contact.peak_normal_force = float(f_n.max())
         if contact.transitions:   # exact Coulomb friction: the phases are events
             contact.time_sticking, contact.time_slipping = _phase_times(contact, end)
             continue
-        f_t = np.hypot(block[:, 0], block[:, 1])
         slipping = (f_t >= STICK_SLIP_THRESHOLD * mu * f_n) & (f_n > 0)
         times = t[first:stop]
         dt = np.diff(times)

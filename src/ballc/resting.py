@@ -67,9 +67,31 @@ _Z, _VELOCITY, _ANGULAR = _STATE["z"], layout.VELOCITY, layout.ANGULAR_VELOCITY
 _DEFLECTION = layout.DEFLECTION
 
 
+#: How far (the length of n + g/|g|) a plane's unit normal may be from opposite gravity
+#: for rest and uniform rolling on it to count as exact (a scene turned as a whole keeps
+#: its floor within rounding of it).
+OPPOSITE_GRAVITY = 1e-12
+
+
+def resting_plane_index(scene) -> int | None:
+    """The index of the plane gravity presses the ball against -- the first whose normal
+    is opposite gravity (within OPPOSITE_GRAVITY), where rest and uniform rolling are
+    exact end states -- or None (g = 0, or no such plane: then the integration goes on)."""
+    g = scene.gravity_magnitude
+    if not g > 0:
+        return None
+    down = scene.gravity_vector / g
+    for i, plane in enumerate(scene.planes):
+        if float(np.linalg.norm(plane.unit_normal + down)) <= OPPOSITE_GRAVITY:
+            return i
+    return None
+
+
 def resting_plane(scene) -> str | None:
-    """The plane gravity presses the ball against ("floor"), or None (g = 0)."""
-    return "floor" if scene.gravity > 0 else None
+    """The name of the plane gravity presses the ball against (resting_plane_index), or
+    None."""
+    index = resting_plane_index(scene)
+    return None if index is None else scene.plane_names[index]
 
 
 def total_mass(scene) -> float:
@@ -78,7 +100,7 @@ def total_mass(scene) -> float:
 
 def equilibrium_penetration(scene) -> float:
     """rho_eq = (m_total g / k0)^(2/3) (m): the Hertz force k0 rho^(3/2) carries the weight."""
-    return (total_mass(scene) * scene.gravity / scene.hertz_stiffness) ** (2.0 / 3.0)
+    return (total_mass(scene) * scene.gravity_magnitude / scene.hertz_stiffness) ** (2.0 / 3.0)
 
 
 def linear_stiffness(scene) -> float:
@@ -102,13 +124,13 @@ def next_check(scene, t_start, t) -> float:
 def speed_tolerance(scene, rtol, atol) -> float:
     """dv = REST_FACTOR (atol + rtol sqrt(g r)) (m/s): REST_FACTOR integration
     tolerances of a speed."""
-    return REST_FACTOR * (float(np.max(atol)) + rtol * math.sqrt(scene.gravity * scene.radius))
+    return REST_FACTOR * (float(np.max(atol)) + rtol * math.sqrt(scene.gravity_magnitude * scene.radius))
 
 
 def steady_level(scene) -> float:
     """The rounding level (1e3 eps g, m/s^2) below which a state's accelerations count as
     zero (:func:`rolls`' steady state)."""
-    return 1e3 * np.finfo(float).eps * scene.gravity
+    return 1e3 * np.finfo(float).eps * scene.gravity_magnitude
 
 
 def energy_threshold(scene, rtol, atol) -> float:
@@ -134,7 +156,7 @@ def energy_above_rest(scene, y, plane="floor") -> float:
     rho_eq = equilibrium_penetration(scene)
     rho = scene.radius - y[_Z]
     x = (rho - rho_eq) / rho_eq
-    weight = total_mass(scene) * scene.gravity
+    weight = total_mass(scene) * scene.gravity_magnitude
     # (2/5) k0 (rho^(5/2) - rho_eq^(5/2)) - m g (rho - rho_eq), k0 rho_eq^(3/2) = m g
     normal = weight * rho_eq * (0.4 * math.expm1(2.5 * math.log1p(x)) - x) if x > -1 else \
         math.inf
@@ -142,7 +164,7 @@ def energy_above_rest(scene, y, plane="floor") -> float:
     if scene.observer_mass > 0:
         across, up = _observer_offset(scene, y)
         reach = math.hypot(across, up)
-        observer = scene.observer_mass * scene.gravity * across * across / (
+        observer = scene.observer_mass * scene.gravity_magnitude * across * across / (
             reach + abs(up)) if reach > 0 else 0.0
     return kinetic + max(normal, 0.0) + tangential_spring + observer
 
@@ -220,7 +242,7 @@ def rolls(scene, y, plane, t_start, t, rtol, atol, slip_speed, params, latch, fl
     x = (scene.radius - y[_Z] - rho_eq) / rho_eq
     if not x > -1:
         return None
-    weight = total_mass(scene) * scene.gravity
+    weight = total_mass(scene) * scene.gravity_magnitude
     above = (0.5 * total_mass(scene) * y[_STATE["vz"]] ** 2 + float(e[4] + e[5])
              + max(weight * rho_eq * (0.4 * math.expm1(2.5 * math.log1p(x)) - x), 0.0))
     if not above <= energy_threshold(scene, rtol, atol):

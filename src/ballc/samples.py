@@ -48,11 +48,11 @@ class Samples:
         return y[:, -1] if y.shape[1] else None
 
     def arrays(self):
-        """(t (n,), y (N_STATES, n), flags (n,) int32, latch (N_LATCH, n)).  ``y`` and
+        """(t (n,), y (N_STATES, n), flags (n,) int64, latch (N_LATCH, n)).  ``y`` and
         ``latch`` are in Fortran order: their transposes, one row per sample (what the
         per-sample C kernels take), are contiguous."""
         t = np.concatenate(self._times)
         y = np.concatenate([block.T for block in self._states]).T
-        flags = np.repeat(np.array(self._flags, dtype=np.int32), self._counts)
+        flags = np.repeat(np.array(self._flags, dtype=np.int64), self._counts)
         latch = np.repeat(np.array(self._latches), self._counts, axis=0).T
         return t, y, flags, latch

@@ -28,7 +28,7 @@ from .progress import progress_bar
 from .result import Contact, Result
 from .samples import Samples
 from .user_events import CheckedEvent, UserEvents
-from .scene import Scene, SceneError, check_speeds
+from .scene import Scene, SceneError, check_inside, check_speeds
 
 PLANES = layout.PLANES
 _STATE = layout.INDEX
@@ -44,25 +44,30 @@ CARRY_STEP = ("approach", "stop", "clear", "release", "arm", "yield", "restick",
 
 
 def check_initial_state(scene, y0):
-    """The full initial state: the scene's, or ``y0`` (N_STATES values, the quaternion
-    normalised) checked to be finite with the centre between the planes."""
+    """The full initial state: the scene's, or ``y0`` (one value per state of the scene,
+    ``scene.state_names``; the quaternion normalised) checked to be finite with the centre
+    on the ball's side of every plane."""
     if y0 is None:
         return scene.initial_state()
+    names = scene.state_names
     try:
         y = np.array(y0, dtype=float)
     except (TypeError, ValueError):
-        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {_core.N_STATES} numbers "
-                         f"({', '.join(_core.STATE_NAMES)})") from None
-    if y.shape != (_core.N_STATES,) or not np.all(np.isfinite(y)):
-        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {_core.N_STATES} finite "
-                         f"numbers ({', '.join(_core.STATE_NAMES)})")
+        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {len(names)} numbers "
+                         f"({', '.join(names)})") from None
+    if y.shape != (len(names),) or not np.all(np.isfinite(y)):
+        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {len(names)} finite "
+                         f"numbers ({', '.join(names)})")
     size = np.linalg.norm(y[_QUATERNION])
     if not size > 0:
         raise SceneError("y0 is not allowed: its quaternion (qw, qx, qy, qz) is zero")
     y[_QUATERNION] /= size
-    if not 0 < y[_STATE["z"]] < scene.ceiling_height:
-        raise SceneError(f"y0 is not allowed: z = {plain(y[_STATE['z']])} must be between the "
-                         f"planes, 0 < z < {scene.ceiling_height}")
+    if scene.ceiling_height is not None:
+        if not 0 < y[_STATE["z"]] < scene.ceiling_height:
+            raise SceneError(f"y0 is not allowed: z = {plain(y[_STATE['z']])} must be between "
+                             f"the planes, 0 < z < {scene.ceiling_height}")
+    else:
+        check_inside(scene, y[layout.POSITION], "y0's position (x, y, z)")
     check_speeds(scene, y[_STATE["vx"]:_STATE["vz"] + 1],
                  y[_STATE["omega_x"]:_STATE["omega_z"] + 1],
                  ("y0's velocity (vx, vy, vz)",
@@ -144,6 +149,7 @@ class _Run:
         y[_DEFLECTION[plane]] = 0.0      # the tangential spring starts relaxed
         self.in_contact[plane] = True
         contact = Contact(plane=plane, t_start=self.t, velocity_before=y[layout.VELOCITY].copy(),
+                          normal=self.scene.planes[PLANES.index(plane)].unit_normal,
                           angular_velocity_before=y[layout.ANGULAR_VELOCITY].copy(),
                           penetration_rate_at_impact=rate, digin_direction=direction)
         record_depth(contact, self.rho[plane](0, y), y)
@@ -711,12 +717,18 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     options = check_options(scene, t_end, method, rtol, atol, max_step, first_step, t_eval,
                             max_nfev, events, dense_output, exact_flight)
     y_start = check_initial_state(scene, y0)
-    if not os.environ.get("BALLC_PYTHON_DRIVER") and _seams_untouched():
-        config = _c_config(scene, options, progress, rest)
+    seed_layout = _python_driver_runs(scene)
+    if not seed_layout or (not os.environ.get("BALLC_PYTHON_DRIVER") and _seams_untouched()):
+        config = _c_config(scene, options, progress, rest, checked=not seed_layout)
         if config is not None:
             result = _simulate_c(scene, options, y_start, config, progress)
             if result is not None:
                 return result
+        if not seed_layout:
+            raise SceneError(
+                "this run needs what only the Python driver does (a kernel that failed where "
+                "it raises), and the Python driver runs only the seed's floor and ceiling "
+                "with gravity along -z: simulate() cannot run this scene")
     run = _Run(scene, options, y_start)
     run.driver = "python"
     t_end, t_eval = options.t_end, options.t_eval
@@ -857,7 +869,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         kind, plane, run.fired = driver_events[fired]
         if kind == "capacity":   # its row may have toggled inside the segment (C re-arms)
             codes = sol.get("system_events")
-            run.fired_row = run.fired._margin if codes is None else (int(codes[fired]) - 2) // 2
+            run.fired_row = run.fired._margin if codes is None else _core.margin_event_row(
+                int(codes[fired]))
         run.handle(kind, plane)
         h_next = sol.get("h_next", 0)
         if kind in CARRY_STEP and h_next > 0:
@@ -942,46 +955,36 @@ def _c_numerics_agree():
     return _NUMERICS_AGREE[0]
 
 
-#: The C loop's flag bits per plane (floor, ceiling), from the generated flags.
-_FLAG_BITS = dict(
-    compliant_bits=[_core.FLAGS[f"{plane}_compliant"] for plane in PLANES],
-    elastic_bits=[_core.FLAGS[f"{plane}_compliant_elastic"] for plane in PLANES],
-    sliding_bits=[_core.FLAGS[f"{plane}_compliant_sliding"] for plane in PLANES],
-    compliant_any=_core.FLAGS["floor_compliant"] | _core.FLAGS["ceiling_compliant"],
-    compliant_sliding_any=(_core.FLAGS["floor_compliant_sliding"]
-                           | _core.FLAGS["ceiling_compliant_sliding"]),
-    slip_bits=[_core.FLAGS[f"{plane}_slip"] for plane in PLANES],
-    slip_fixed_bits=[_core.FLAGS[f"{plane}_slip_fixed"] for plane in PLANES],
-    stick_bits=[_core.FLAGS[f"{plane}_stick"] for plane in PLANES])
+def _python_driver_runs(scene) -> bool:
+    """Whether the Python driver (simulate._Run: the seed's floor and ceiling only) can
+    run ``scene``: the ceiling_height shorthand and gravity along -z."""
+    return scene.ceiling_height is not None and not isinstance(scene.gravity, tuple)
 
 
-def _c_config(scene, options, progress, rest):
+def _c_config(scene, options, progress, rest, checked=False):
     """The constants of a C run (a dict for _core.drive), or None when the run is not
     in the C loop's subset: every method (scipy's through the loop's integrator
     interface), atol one number or one per state, any user events, t_eval (if given)
-    strictly increasing, slip rows of at most 2 terms (sum() of
-    more would be compensated on Python >= 3.12), and the process's hypot and dot as
-    the C loop reproduces them (_c_numerics_agree).  (``progress``: the bar is the
-    caller's, advanced from C.)"""
-    users = _c_user_events(options.events)
+    strictly increasing, and the process's hypot and dot as the C loop reproduces them
+    (_c_numerics_agree).  (``progress``: the bar is the caller's, advanced from C.)
+    ``checked``: a scene only the C loop runs (not the seed's planes): the numerics check
+    does not apply."""
+    width = len(scene.state_names)
+    users = _c_user_events(options.events, width)
     t_eval = options.t_eval
     if t_eval is not None:   # the C loop takes each segment's points as a range
         t_eval = np.ascontiguousarray(t_eval, dtype=float)
         if t_eval.ndim != 1 or not np.all(np.diff(t_eval) > 0):
             return None
-    if not _c_numerics_agree():
+    if not checked and not _c_numerics_agree():
         return None
     params = scene.parameter_vector()
+    n_planes = len(scene.planes)
     flight_allowed = bool(options.exact_flight and flight_scene_allows(params))
     atol = options.atol
     per_state = type(atol) is not float
-    terms = [stickslip.slip_terms(params, plane) for plane in PLANES]
-    if any(len(row) > 2 for rows in terms for row in rows):
-        return None
-    observer = _core.FLAGS["observer"] if scene.observer_mass != 0 else 0
-    segment_events = ev.SegmentEvents(scene)
-    planes = segment_events.planes
-    resting_plane = resting.resting_plane(scene)
+    observer = _core.flag("observer", 0) if scene.observer_mass != 0 else 0
+    resting_plane = resting.resting_plane_index(scene)
     period = resting.REST_PERIODS * resting.oscillation_period(scene) \
         if resting_plane is not None else math.inf
     rest_consts = dict(rest_threshold=math.inf, rho_eq=1.0, z_eq=0.0, rest_weight=0.0,
@@ -991,17 +994,16 @@ def _c_config(scene, options, progress, rest):
         rest_consts = dict(
             rest_threshold=resting.energy_threshold(scene, options.rtol, options.atol),
             rho_eq=rho_eq, z_eq=scene.radius - rho_eq,
-            rest_weight=resting.total_mass(scene) * scene.gravity,
-            observer_weight=scene.observer_mass * scene.gravity,
+            rest_weight=resting.total_mass(scene) * scene.gravity_magnitude,
+            observer_weight=scene.observer_mass * scene.gravity_magnitude,
             rolls_dv=resting.speed_tolerance(scene, options.rtol, options.atol),
             rolls_level=float(resting.steady_level(scene)),
             half_mass=0.5 * resting.total_mass(scene))
     modes_on = compliantmodes.uses_modes(scene)
-    arm_depth = segment_events.arm_depth or {plane: 0.0 for plane in PLANES}
     return dict(
-        compliant_modes=int(modes_on), **_FLAG_BITS,
-        arm_depth=[float(arm_depth[plane]) for plane in PLANES],
-        ulp8=[8 * math.ulp(compliantmodes.plane_position(scene, plane)) for plane in PLANES],
+        compliant_modes=int(modes_on),
+        starts_armed=int(compliantmodes.starts_armed(scene)),
+        arm_force_depth=compliantmodes.arm_force_depth(scene),
         restick_factor=max(1.0, scene.friction_coefficient
                            / max(scene.tangential_stiffness_ratio, 1e-300)),
         damping_positive=int(params[compliantmodes._TANGENTIAL_DAMPING] > 0),
@@ -1016,46 +1018,39 @@ def _c_config(scene, options, progress, rest):
         scipy=options.method in SCIPY_METHODS, scipy_atol=atol,
         max_step=float(options.max_step), first_step=options.first_step,
         max_nfev=options.max_nfev, method=options.method, observer_bits=observer,
-        contact_bits=[modes.flags(scene, {p: p == plane for p in PLANES}) ^ observer
-                      for plane in PLANES],
+        contact_bits=[modes.contact_flags(scene, plane) for plane in range(n_planes)],
         exact=int(stickslip.uses_exact_coulomb(scene)), radius=float(scene.radius),
-        weight=(scene.mass + scene.observer_mass) * abs(scene.gravity),
+        weight=(scene.mass + scene.observer_mass) * scene.gravity_magnitude,
         hertz_k=scene.hertz_stiffness, total_mass=scene.mass + scene.observer_mass,
         rest_period=period,
-        resting_plane=-1 if resting_plane is None else PLANES.index(resting_plane),
+        resting_plane=-1 if resting_plane is None else resting_plane,
         checks_rest=int(bool(rest) and t_eval is None and not options.events),
         t_eval=t_eval, dense_output=int(bool(options.dense_output)),
-        exact_flight=int(flight_allowed), **users,
-        gravity=-float(params[_core.PARAMETER_NAMES.index("gravity_z")]),
-        rho_scale=[entry[3] for entry in planes], rho_offset=[entry[4] for entry in planes],
-        through_offset=[entry[7].offset for entry in planes],
-        threshold_base=[entry[5] for entry in planes],
-        slip_terms=terms,
-        slip_map=np.ascontiguousarray([stickslip.slip_map(params, plane) for plane in PLANES]))
+        exact_flight=int(flight_allowed), **users)
 
 
-def _c_user_events(events):
+def _c_user_events(events, width):
     """The user's events as the C loop takes them (UserEvents.for_segment): a dict of
-    arrays.  A LinearEvent (a subclass too) is
+    arrays (``width``: the run's states).  A LinearEvent (a subclass too) is
     evaluated in C from its coefficients and offset, and its ``rearm``, if any, called
     back; one whose class overrides ``__call__`` (then its own function), and any other
     callable, is called back (CheckedEvent)."""
     events = list(events or ())
     n = len(events)
     if n == 0:   # the common case: the same (read-only) arrays every run
-        if not _NO_USER_EVENTS:
-            _NO_USER_EVENTS.update(_c_user_events_of([]))
-        return _NO_USER_EVENTS
-    return _c_user_events_of(events)
+        if width not in _NO_USER_EVENTS:
+            _NO_USER_EVENTS[width] = _c_user_events_of([], width)
+        return _NO_USER_EVENTS[width]
+    return _c_user_events_of(events, width)
 
 
 _NO_USER_EVENTS: dict = {}
 
 
-def _c_user_events_of(events):
+def _c_user_events_of(events, width):
     n = len(events)
     users = UserEvents(events)
-    coef, offset = np.zeros((n, _core.N_STATES)), np.zeros(n)
+    coef, offset = np.zeros((n, width)), np.zeros(n)
     scale, index = np.zeros(n), np.full(n, -1, dtype=np.intc)
     linear, direction = np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc)
     rearm = np.zeros(n, dtype=np.intc)
@@ -1098,7 +1093,8 @@ def _simulate_c(scene, options, y, config, progress):
     rows = out["rows"]
     block_flags, latches = out["block_flags"], out["latches"]
     end_kind = out["end_kind"]
-    gravity = config["gravity"]
+    gravity = scene.gravity_vector
+    names = scene.plane_names
     pieces = [(piece[0], piece[1], _piece(piece, gravity)) for piece in out["pieces"]]
     end = _END_KINDS[end_kind]
     periodic = out["orbit"]   # (c0, period, G, rate, its base's pieces) or None
@@ -1125,7 +1121,8 @@ def _simulate_c(scene, options, y, config, progress):
     contacts = []
     for rec in out["contacts"]:
         rate = np.float64(rec["rate"]) if rec["rate_is_kernel_value"] else rec["rate"]
-        contact = Contact(plane=PLANES[rec["plane"]], t_start=rec["t_start"],
+        contact = Contact(plane=names[rec["plane"]], t_start=rec["t_start"],
+                          normal=scene.planes[rec["plane"]].unit_normal,
                           velocity_before=np.array(rec["v_before"]),
                           angular_velocity_before=np.array(rec["w_before"]),
                           penetration_rate_at_impact=rate,
@@ -1145,7 +1142,7 @@ def _simulate_c(scene, options, y, config, progress):
         contacts[k].transitions.append((when, "stick" if phase else "slip"))
     message = SUCCESS
     if end:   # as _Run.enter_rest / enter_motion
-        plane = PLANES[out["end_plane"]]
+        plane = names[out["end_plane"]]
         when = out["end_t"]
         _record_end(contacts[out["open"][out["end_plane"]]], end, when)
         if periodic is not None:
@@ -1157,27 +1154,27 @@ def _simulate_c(scene, options, y, config, progress):
             message = _motion_message(scene, plane, when, out["end_y"], end)
     if counts[-1]:   # still in contact at the end
         last = states[:, -1]
-        for k in out["open"]:
+        for index, k in enumerate(out["open"]):
             if k >= 0:
-                plane = contacts[k].plane
-                record_depth(contacts[k], ev.penetration(plane, scene)(0, last), last)
+                record_depth(contacts[k], penetration(scene, index, last), last)
     code, status = out["stop_code"], out["status"]
     user_event, user_t, user_y = out["user_hits"]
     n_user = len(config["user_count"])
     if code == _core.DRIVE_FAILED:
         message = _failure_message(scene, options, out["message"], out["nfev"],
-                                   out["fail_end"], dict(zip(PLANES, out["in_contact"])))
+                                   out["fail_end"], dict(zip(names, out["in_contact"])))
     elif code == _core.DRIVE_UNSETTLED:
         what = (COMPLIANT_TRANSITIONS if out["unsettled_compliant"]
                 else COULOMB_TRANSITIONS)
-        message = _unsettled_message(what, PLANES[out["stop_plane"]],
+        message = _unsettled_message(what, names[out["stop_plane"]],
                                      out["transitions"][out["stop_plane"]], out["stalled"],
                                      out["t_run"])
     elif code == _core.DRIVE_TERMINATED:
         message = TERMINATED
     elif code == _core.DRIVE_THROUGH:
-        message = _through_message(PLANES[out["stop_plane"]], out["t_run"])
+        message = _through_message(names[out["stop_plane"]], out["t_run"])
     result = Result(t=t, y=states, scene=scene, status=status, message=message,
+                    state_names=scene.state_names,
                     nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], contacts=contacts,
                     flags=flags, latch=latch,
                     t_events=[user_t[user_event == k] for k in range(n_user)],
@@ -1203,6 +1200,22 @@ def _piece(piece, gravity):
     if isinstance(piece[2], np.ndarray):
         return FreeFlight(piece[0], piece[2], gravity, t_max=piece[1])
     return piece[2]
+
+
+def penetration(scene, plane: int, y) -> float:
+    """The ball's penetration rho = r - n . (c - p) (m) of the scene's plane with index
+    ``plane`` at state y, as the C loop's events take it (_driver.c, plane_geometry: the
+    one coordinate of an axis-aligned plane, scale y[k] + (r + n_k p_k))."""
+    plane = scene.planes[plane]
+    n, point = plane.unit_normal, plane.point
+    r = float(scene.radius)
+    position = y[layout.POSITION]
+    axes = np.flatnonzero(n)
+    if axes.size == 1:
+        k = int(axes[0])
+        return float(-n[k] * position[k] + (r + n[k] * point[k]))
+    return float(-n[0] * position[0] + -n[1] * position[1] + -n[2] * position[2]
+                 + (r + (n[0] * point[0] + n[1] * point[1] + n[2] * point[2])))
 
 
 def record_depth(contact, depth, y):

@@ -155,7 +155,7 @@ def passes_by_zero(u, direction, error) -> bool:
 
 def force_scale(scene, load) -> float:
     """A force (N) at rounding level of the stick force: 64 eps of weight + load."""
-    weight = (scene.mass + scene.observer_mass) * abs(scene.gravity)
+    weight = (scene.mass + scene.observer_mass) * scene.gravity_magnitude
     return 64 * np.finfo(float).eps * (weight + abs(load))
 
 
