@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
+from ._errors import SceneError
 from ._format import plain
 
 #: The most planes a scene may have (the C core's arrays are sized by it).
@@ -45,8 +46,8 @@ NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 ROOM_MARGIN = 1e-9
 
 
-class PlaneError(ValueError):
-    """A plane has a value ballc cannot simulate (a SceneError: see ballc.scene)."""
+class PlaneError(SceneError):
+    """A plane has a value ballc cannot simulate (a ballc.SceneError)."""
 
 
 def _vector(name, value) -> tuple:

@@ -15,6 +15,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from . import _core
+from ._errors import SceneError
 from ._format import plain
 from .orientation import quaternion_from_angles_123
 from .planes import MAX_PLANES, Plane, PlaneError, check_room, names_of, seed_planes
@@ -50,10 +51,6 @@ SEED_SYMBOLS = {
     "position": ("m1", "m2", "m3"), "velocity": ("um1", "um2", "um3"),
     "angles": ("q1", "q2", "q3"), "angular_velocity": ("u1", "u2", "u3"),
 }
-
-
-class SceneError(ValueError):
-    """A scene parameter has a value ballc cannot simulate."""
 
 
 @dataclass(frozen=True)
@@ -755,10 +752,10 @@ def check_inside(s: Scene, position, name="position") -> None:
     for plane, label in zip(s.planes, s.plane_names):
         height = plane.height(position)
         if not height > 0:
-            fail(name, tuple(float(v) for v in position),
-                 f"the centre must start on the ball's side of every plane, less than one "
-                 f"radius deep in it: its height above plane {label!r} is n . (c - p) = "
-                 f"{height:.6g} m, must be > 0 (a penetration below radius = {s.radius})")
+            _fail(name, tuple(float(v) for v in position),
+                  f"the centre must start on the ball's side of every plane, less than one "
+                  f"radius deep in it: its height above plane {label!r} is n . (c - p) = "
+                  f"{height:.6g} m, must be > 0 (a penetration below radius = {s.radius})")
 
 
 def _validate_gravity(s: Scene) -> None:

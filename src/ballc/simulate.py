@@ -537,8 +537,14 @@ def _rest_message(scene, plane, t):
 
 def _motion_message(scene, plane, t, y, kind):
     """The message of a run that goes on uniformly (``kind`` "rolling" or
-    "free_sliding") on ``plane`` from ``t`` in state ``y`` (either driver)."""
-    v = float(np.hypot(*y[layout.VELOCITY][:2]))
+    "free_sliding") on ``plane`` from ``t`` in state ``y`` (either driver): its speed
+    along the plane."""
+    n = scene.planes[scene.plane_names.index(plane)].unit_normal
+    velocity = y[layout.VELOCITY]
+    if n[0] == 0 and n[1] == 0:   # horizontal: the horizontal speed
+        v = float(np.hypot(*velocity[:2]))
+    else:
+        v = float(np.linalg.norm(velocity - (velocity @ n) * n))
     what = "rolls uniformly" if kind == "rolling" else (
         "slides uniformly (no force opposes its slip)")
     return (f"{SUCCESS} The ball {what} on the {plane} from t = "
