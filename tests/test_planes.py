@@ -203,6 +203,7 @@ def test_incline_against_the_closed_forms(k, side):
         assert np.all(speed[late] > RADIUS * spin[late] + 1e-6)
     # no motion across the slope, none into the plane: the normal stays at rest
     assert np.max(np.abs(v[1])) < 1e-12 and np.max(np.abs(n @ v)) < 1e-9
+    assert "incline, whose normal is not opposite gravity" in result.message
 
 
 # -------------------------------------------------------------------------------------
@@ -406,6 +407,7 @@ def test_rolling_along_a_wedges_groove():
     assert np.max(np.abs(v[[0, 2]])) < 1e-9
     balance = result.energy["balance"]
     assert abs(balance[-1] - balance[0]) < 1e-6 * balance[0]
+    assert "in contact with the right and the left at once" in result.message
 
 
 def test_a_box_of_six_planes_holds_the_ball():
@@ -422,3 +424,64 @@ def test_a_box_of_six_planes_holds_the_ball():
     balance = result.energy["balance"]
     assert abs(balance[-1] - balance[0]) < 1e-6 * balance[0]
     assert result.energy["dissipated"][-1] > 0
+
+
+# -------------------------------------------------------------------------------------
+# Pictures: each plane where it is, the contact table naming the plane
+# -------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def wedge_run():
+    scene = ballc.Scene(planes=wedge(math.radians(50)), radius=0.2, observer_mass=0.0,
+                        position=(2.0, 0.0, 0.5), velocity=(-3.0, 0.5, 1.0))
+    return ballc.simulate(scene, 1.2)
+
+
+def test_the_contact_table_names_the_plane(wedge_run):
+    table = wedge_run.contact_table()
+    planes = [c.plane for c in wedge_run.contacts]
+    assert set(planes) == {"lower", "upper"}
+    rows = table.splitlines()[3:3 + len(planes)]
+    assert [row.split()[1] for row in rows] == planes
+    frame = wedge_run.contacts_dataframe()
+    assert list(frame["plane"]) == planes and "contact_point_z" in frame
+
+
+def _on_plane(points, plane, tol=1e-9):
+    return np.allclose(np.asarray(points) @ plane.unit_normal, plane.offset, atol=tol)
+
+
+def test_figures_draw_each_plane_where_it_is(wedge_run):
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    from ballc.plot import contact_points
+    scene = wedge_run.scene
+    for contact, point in zip(wedge_run.contacts, contact_points(wedge_run)):
+        assert _on_plane([point], scene.planes[scene.plane_names.index(contact.plane)])
+    fig, ax = wedge_run.plot_side_view()
+    drawn = {line.get_label(): line.get_xydata() for line in ax.get_lines()}
+    for plane, name in zip(scene.planes, scene.plane_names):
+        xz = drawn[f"plane {name}"]   # the plane contains the y axis: its (x, z) line
+        n = plane.unit_normal
+        assert len(xz) >= 3 and np.allclose(xz @ n[[0, 2]], plane.offset, atol=1e-9)
+    matplotlib.pyplot.close(fig)
+    animation = wedge_run.animate(frames=2)
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    polygons = [c for c in animation._fig.axes[0].collections if isinstance(c, Poly3DCollection)]
+    assert len(polygons) == 2
+    matplotlib.pyplot.close(animation._fig)
+
+
+def test_the_html_view_puts_each_plane_where_it_is(wedge_run):
+    pytest.importorskip("meshcat")
+    from test_html_view import commands
+    from ballc.html_view import scene_html
+    page = commands(scene_html(wedge_run))
+    base = "/meshcat/ballc/planes"
+    for plane, name in zip(wedge_run.scene.planes, wedge_run.scene.plane_names):
+        matrix = np.asarray(page["set_transform"][f"{base}/{name}"]["matrix"]).reshape(
+            4, 4, order="F")   # three.js: column-major
+        assert np.allclose(matrix[:3, 2], plane.unit_normal)      # the slab's normal
+        depth = page["set_object"][f"{base}/{name}"]["object"]["geometries"][0]["depth"]
+        face = matrix[:3, 3] + 0.5 * depth * plane.unit_normal     # its face towards the ball
+        assert _on_plane([face], plane)

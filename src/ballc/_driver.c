@@ -456,6 +456,7 @@ static void record_depth(ballc_contact_rec *k, double depth, const double *y)
         k->max_penetration = depth;
         k->contact_point[0] = y[BALLC_STATE_X];
         k->contact_point[1] = y[BALLC_STATE_Y];
+        k->contact_point[2] = y[BALLC_STATE_Z];
     }
 }
 
@@ -759,7 +760,7 @@ static int begin_contact(run_t *r, int p)
     rec->rate_is_kernel_value = kernel_rate;
     memcpy(rec->digin, direction, sizeof direction);
     rec->max_penetration = 0.0;
-    rec->contact_point[0] = rec->contact_point[1] = NAN;
+    rec->contact_point[0] = rec->contact_point[1] = rec->contact_point[2] = NAN;
     rec->t_end = NAN;
     record_depth(rec, rho_of(r, p, y), y);
     o->open[p] = (int)o->n_contacts;

@@ -171,7 +171,8 @@ enum { BALLC_END_NONE = 0, BALLC_END_REST, BALLC_END_ROLLING, BALLC_END_SLIDING 
 typedef struct {
     int plane, ended, passed_through, rate_is_kernel_value;
     double t_start, t_end, v_before[3], w_before[3], v_after[3], w_after[3];
-    double rate, digin[3], max_penetration, contact_point[2], lost[2];
+    double rate, digin[3], max_penetration, contact_point[3], lost[2];   /* the centre at
+                                                                         * max. penetration */
 } ballc_contact_rec;
 
 typedef struct { long contact; double t; int phase; } ballc_phase_rec;  /* 0 slip, 1 stick */

@@ -73,7 +73,7 @@ cdef extern from "_driver.h":
         double rate
         double digin[3]
         double max_penetration
-        double contact_point[2]
+        double contact_point[3]
         double lost[2]
     ctypedef struct ballc_phase_rec:
         long contact
@@ -482,7 +482,8 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
                 w_after=[rec.w_after[j] for j in range(3)],
                 rate=rec.rate, digin=[rec.digin[j] for j in range(3)],
                 max_penetration=rec.max_penetration,
-                contact_point=[rec.contact_point[0], rec.contact_point[1]],
+                contact_point=[rec.contact_point[0], rec.contact_point[1],
+                               rec.contact_point[2]],
                 lost=(rec.lost[0], rec.lost[1])))
         phases = [(o.phases[i].contact, o.phases[i].t, o.phases[i].phase)
                   for i in range(o.n_phases)]

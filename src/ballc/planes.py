@@ -299,3 +299,70 @@ def swept(planes, changes: dict) -> tuple:
         R = rotation_y(together)
         planes = [turned(p, R) for p in planes]
     return tuple(planes)
+
+
+# -------------------------------------------------------------------------------------
+# Drawing a plane where it is (the figures, the animation, the HTML view)
+# -------------------------------------------------------------------------------------
+
+def tangents(plane: Plane) -> np.ndarray:
+    """(2, 3): two orthonormal vectors along ``plane``, t1 x t2 = n (the C core's frame,
+    _plane.c: t1 the axis the normal has least of made perpendicular to it)."""
+    n = plane.unit_normal
+    k = int(np.argmin(np.abs(n)))
+    t1 = np.eye(3)[k] - n[k] * n
+    t1 /= np.linalg.norm(t1)
+    return np.array([t1, np.cross(n, t1)])
+
+
+def foot(plane: Plane, point) -> np.ndarray:
+    """The point of ``plane`` nearest ``point`` (3): ``point`` less its height along the
+    normal (a horizontal plane: the plane's own z, exactly)."""
+    point = np.asarray(point, dtype=float)
+    n = plane.unit_normal
+    if n[0] == 0 and n[1] == 0:
+        return np.array([point[0], point[1], plane.point[2]])
+    return point - plane.height(point) * n
+
+
+def clipped(plane: Plane, low, high) -> np.ndarray:
+    """(k, 3): the polygon where ``plane`` cuts the box [low, high] (3 each), its corners
+    in order around it (k = 0 when it misses the box)."""
+    low, high = np.asarray(low, float), np.asarray(high, float)
+    n, offset = plane.unit_normal, plane.offset
+    corners = np.array([[(high if (c >> i) & 1 else low)[i] for i in range(3)]
+                        for c in range(8)])
+    side = corners @ n - offset
+    points = []
+    for a in range(8):
+        for i in range(3):
+            b = a | (1 << i)
+            if b == a:
+                continue
+            sa, sb = side[a], side[b]
+            if sa == 0:
+                points.append(corners[a])
+            if (sa < 0 < sb) or (sb < 0 < sa):
+                points.append(corners[a] + sa / (sa - sb) * (corners[b] - corners[a]))
+    if len(points) < 3:
+        return np.empty((0, 3))
+    points = np.unique(np.round(np.array(points), 12), axis=0)
+    if len(points) < 3:
+        return np.empty((0, 3))
+    t = tangents(plane)
+    middle = points.mean(axis=0)
+    angle = np.arctan2((points - middle) @ t[1], (points - middle) @ t[0])
+    return points[np.argsort(angle)]
+
+
+def drawing_box(scene, positions, margin: float = 1.5) -> tuple:
+    """(low, high): the box a picture of ``scene`` shows: the centre's path
+    (``positions``, (3, n)) and ``margin`` radii around it; with the seed's two planes,
+    from below the floor to above the ceiling (as the pictures always showed them)."""
+    r = float(scene.radius)
+    low = np.min(positions, axis=1) - margin * r
+    high = np.max(positions, axis=1) + margin * r
+    if scene.ceiling_height is not None:
+        low[2], high[2] = -0.5, float(scene.ceiling_height) + 0.5
+        low[:2], high[:2] = min(low[0], low[1], -0.5), max(high[0], high[1], 0.5)
+    return low, high

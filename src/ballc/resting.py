@@ -281,3 +281,33 @@ class Constant:
         if t.ndim == 0:
             return self.y.copy()
         return np.repeat(self.y[:, None], t.size, axis=1)
+
+
+def why_no_end_state(scene, contacts, t_end) -> str:
+    """What a run that went on to ``t_end`` in a long contact (more than REST_PERIODS
+    small-oscillation periods) says about why no end state finished it in closed form:
+    rest and uniform rolling are exact only on a plane whose normal is opposite gravity,
+    alone (resting_plane_index); on any other plane -- an incline, where rolling is
+    uniformly accelerated -- or against two planes at once the integration goes on.
+    "" when no such contact was open at the end."""
+    g = scene.gravity_magnitude
+    if not g > 0:
+        return ""
+    long_ago = t_end - REST_PERIODS * oscillation_period(scene)
+    open_ = [c for c in contacts if c.t_end != c.t_end and c.t_start <= long_ago
+             and c.t_rest != c.t_rest and c.t_rolling != c.t_rolling
+             and c.t_sliding != c.t_sliding]
+    if not open_:
+        return ""
+    names = " and the ".join(c.plane for c in open_)
+    resting = resting_plane_index(scene)
+    if len(open_) > 1:
+        why = (f"the ball is in contact with the {names} at once (rest and uniform rolling "
+               "are checked on a plane whose normal is opposite gravity, alone)")
+    elif resting is None or open_[0].plane != scene.plane_names[resting]:
+        why = (f"the ball is in contact with the {names}, whose normal is not opposite "
+               "gravity: rest and uniform rolling are exact end states only on such a "
+               "plane (on an incline the rolling is uniformly accelerated)")
+    else:
+        return ""
+    return f" No closed-form end state: {why}; the integration went on to t_end."

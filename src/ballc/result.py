@@ -47,6 +47,9 @@ class Contact:
         Largest penetration depth (m).
     contact_point : ndarray, shape (2,)
         Centre (x, y) when the penetration was largest: the contact point (m).
+    contact_point_z : float
+        Centre z then (m): with (x, y), the centre, whose foot on the plane is the
+        contact point (``ballc.plot.contact_points``).
     peak_normal_force : float
         Largest normal force over the stored samples (N).
     energy_lost_normal, energy_lost_tangential : float
@@ -74,6 +77,8 @@ class Contact:
     max_penetration: float = 0.0     # m
     #: centre (x, y) when the penetration was largest: the contact point (m)
     contact_point: np.ndarray = field(default_factory=_NAN_2.copy)
+    #: centre z then (m; NaN in a file from before planes of any orientation)
+    contact_point_z: float = np.nan
     peak_normal_force: float = np.nan      # N, largest F . n over the stored samples
     energy_lost_normal: float = np.nan     # J, dissipated by the normal force
     energy_lost_tangential: float = np.nan  # J, dissipated by the tangential force
@@ -134,6 +139,7 @@ class Contact:
                "max_penetration": self.max_penetration,
                "contact_point_x": float(self.contact_point[0]),
                "contact_point_y": float(self.contact_point[1]),
+               "contact_point_z": float(self.contact_point_z),
                "peak_normal_force": self.peak_normal_force,
                "energy_lost_normal": self.energy_lost_normal,
                "energy_lost_tangential": self.energy_lost_tangential,
@@ -152,7 +158,8 @@ class Contact:
 CONTACT_UNITS = {
     "plane": "", "t_start": "s", "t_end": "s", "duration": "s", "rebound_ratio": "1",
     "max_penetration": "m",
-    "contact_point_x": "m", "contact_point_y": "m", "peak_normal_force": "N",
+    "contact_point_x": "m", "contact_point_y": "m", "contact_point_z": "m",
+    "peak_normal_force": "N",
     "energy_lost_normal": "J", "energy_lost_tangential": "J", "time_sticking": "s",
     "time_slipping": "s", "penetration_rate_at_impact": "m/s", "t_rest": "s",
     "t_rolling": "s", "t_sliding": "s",
@@ -385,6 +392,12 @@ class Result:
         """The observer's specific force (g) against time; returns (figure, axes)."""
         from .plot import plot_observer
         return plot_observer(self, **options)
+
+    def plot_side_view(self, **options):
+        """Side view (x, z): the planes where they are, the path, the contact points;
+        returns (figure, axes).  See ballc.plot."""
+        from .plot import plot_side_view
+        return plot_side_view(self, **options)
 
     def plot_contacts(self, **options):
         """Top view of the contact points coloured by time; returns (figure, axes)."""

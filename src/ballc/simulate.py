@@ -1135,7 +1135,8 @@ def _simulate_c(scene, options, y, config, progress):
                           digin_direction=np.array(rec["digin"]))
         contact.max_penetration = rec["max_penetration"]
         if not math.isnan(rec["contact_point"][0]):
-            contact.contact_point = np.array(rec["contact_point"])
+            contact.contact_point = np.array(rec["contact_point"][:2])
+            contact.contact_point_z = rec["contact_point"][2]
         if rec["ended"]:
             contact.t_end = rec["t_end"]
             contact.velocity_after = np.array(rec["v_after"])
@@ -1179,6 +1180,8 @@ def _simulate_c(scene, options, y, config, progress):
         message = TERMINATED
     elif code == _core.DRIVE_THROUGH:
         message = _through_message(names[out["stop_plane"]], out["t_run"])
+    elif code == _core.DRIVE_OK and not end and config["checks_rest"]:
+        message += resting.why_no_end_state(scene, contacts, options.t_end)
     result = Result(t=t, y=states, scene=scene, status=status, message=message,
                     state_names=scene.state_names,
                     nfev=out["nfev"], njev=out["njev"], nlu=out["nlu"], contacts=contacts,
@@ -1229,3 +1232,4 @@ def record_depth(contact, depth, y):
     if depth >= contact.max_penetration:
         contact.max_penetration = float(depth)
         contact.contact_point = y[_CENTRE_XY].copy()
+        contact.contact_point_z = float(y[_STATE["z"]])
