@@ -105,11 +105,13 @@ class Plane:
             raise PlaneError(f"plane: name = {plain(self.name)} is not allowed: must be "
                              "letters, digits and underscores, starting with a letter")
 
-    @property
+    @functools.cached_property
     def unit_normal(self) -> np.ndarray:
-        """The normal made unit (1)."""
+        """The normal made unit (1; read-only)."""
         n = np.array(self.normal)
-        return n / math.sqrt(float(n @ n))
+        n /= math.sqrt(float(n @ n))
+        n.flags.writeable = False
+        return n
 
     @property
     def offset(self) -> float:

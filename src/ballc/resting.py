@@ -290,13 +290,12 @@ def why_no_end_state(scene, contacts, t_end) -> str:
     alone (resting_plane_index); on any other plane -- an incline, where rolling is
     uniformly accelerated -- or against two planes at once the integration goes on.
     "" when no such contact was open at the end."""
-    g = scene.gravity_magnitude
-    if not g > 0:
+    open_ = [c for c in contacts if c.t_end != c.t_end and c.t_rest != c.t_rest
+             and c.t_rolling != c.t_rolling and c.t_sliding != c.t_sliding]
+    if not open_ or not scene.gravity_magnitude > 0:
         return ""
     long_ago = t_end - REST_PERIODS * oscillation_period(scene)
-    open_ = [c for c in contacts if c.t_end != c.t_end and c.t_start <= long_ago
-             and c.t_rest != c.t_rest and c.t_rolling != c.t_rolling
-             and c.t_sliding != c.t_sliding]
+    open_ = [c for c in open_ if c.t_start <= long_ago]
     if not open_:
         return ""
     names = " and the ".join(c.plane for c in open_)

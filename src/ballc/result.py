@@ -102,8 +102,8 @@ class Contact:
     def unit_normal(self) -> np.ndarray:
         """The plane's unit normal towards the ball: ``normal``, or the seed's floor's
         (+z) or ceiling's (-z) by the plane's name when a file did not store it."""
-        if np.all(np.isfinite(self.normal)):
-            return np.asarray(self.normal, dtype=float)
+        if self.normal[0] == self.normal[0]:   # stored (not NaN)
+            return self.normal
         return np.array([0.0, 0.0, -1.0 if self.plane == "ceiling" else 1.0])
 
     @property

@@ -379,23 +379,23 @@ class Scene:
         a fresh copy each call (the scene is frozen: built once)."""
         return self._parameters.copy()
 
-    @property
+    @functools.cached_property
     def plane_names(self) -> tuple:
         """Each plane's name (its own, or ``plane<i>``), in the plane table's order."""
         return names_of(self.planes)
 
-    @property
+    @functools.cached_property
     def state_names(self) -> tuple:
         """The names of the state vector's rows: the ball's 15, then each plane's
         ``<name>_deflection_x``, ``_y`` (the seed's: ``ballc.STATE_NAMES``)."""
         return _core.state_names(self.plane_names)
 
-    @property
+    @functools.cached_property
     def parameter_names(self) -> tuple:
         """The names of :meth:`parameter_vector`'s entries."""
         return _core.parameter_names(self.plane_names)
 
-    @property
+    @functools.cached_property
     def latch_names(self) -> tuple:
         """The names of the latched values (per plane, LATCH fields)."""
         return _core.latch_names(self.plane_names)
