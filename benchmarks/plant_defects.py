@@ -304,6 +304,17 @@ DEFECTS = [
            "        f->c[1][BALLC_STATE_VX + i] = gravity[i];\n",
            "        f->c[1][BALLC_STATE_VX + i] = i == 2 ? gravity[i] : 0.0;\n",
            tests=("tests/test_planes.py::test_a_turned_floor_keeps_its_end_state",)),
+    Defect("planes: rolling down an incline in closed form without the rolling inertia",
+           "src/ballc/_driver.c",
+           "    double factor = 1.0 / (1.0 + c->params[BALLC_PARAMETER_INERTIA_XX] / "
+           "(M * radius * radius));\n", "    double factor = 1.0;\n",
+           tests=("tests/test_planes.py::test_rolling_down_an_incline_ends_in_closed_form",)),
+    Defect("planes: the incline's closed form ignores the planes ahead",
+           "src/ballc/_driver.c",
+           "        if (crossings(rho_of(r, q, y), c1, c2, 1, c->t_end - r->t, roots)) return 0;\n",
+           "        if (0 && crossings(rho_of(r, q, y), c1, c2, 1, c->t_end - r->t, roots)) "
+           "return 0;\n",
+           tests=("tests/test_planes.py::test_rolling_down_an_incline_ends_in_closed_form",)),
 ]
 
 

@@ -160,9 +160,8 @@ THETA = math.radians(25)
 RADIUS, MASS = 0.1, 1.0
 
 
-def incline_run(mu, k, t_end=0.4):
-    """A ball released at rest on the incline, at its static penetration: (result, its
-    unit normal, the downhill direction, the closed-form load m g cos(theta))."""
+def incline_scene(mu, k):
+    """A ball at rest on the incline at its static penetration, and the incline."""
     plane = tilted(Plane(name="incline"), THETA)
     n = plane.unit_normal
     down = np.array([math.cos(THETA), 0.0, -math.sin(THETA)])
@@ -173,10 +172,19 @@ def incline_run(mu, k, t_end=0.4):
                         position=(0.0, 0.0, 1.0), velocity=(0.0, 0.0, 0.0))
     load = MASS * G * math.cos(THETA)
     rho_eq = (load / scene.hertz_stiffness) ** (2 / 3)   # the Hertz force carries the load
-    scene = scene.replace(position=tuple((RADIUS - rho_eq) * n))
-    result = ballc.simulate(scene, t_end, rtol=1e-10, atol=1e-12)
+    return scene.replace(position=tuple((RADIUS - rho_eq) * n)), plane
+
+
+def incline_run(mu, k, t_end=0.4):
+    """A ball released at rest on the incline, at its static penetration, integrated to
+    t_end (rest=False: no end state): (result, the plane's unit normal, the downhill
+    direction, the closed-form load m g cos(theta))."""
+    scene, plane = incline_scene(mu, k)
+    result = ballc.simulate(scene, t_end, rtol=1e-10, atol=1e-12, rest=False)
     assert result.status == 0, result.message
-    return result, n, down, load
+    n = plane.unit_normal
+    down = np.array([math.cos(THETA), 0.0, -math.sin(THETA)])
+    return result, n, down, MASS * G * math.cos(THETA)
 
 
 @pytest.mark.parametrize("k", [0.4, 2 / 3], ids=["solid", "hollow"])
@@ -203,7 +211,42 @@ def test_incline_against_the_closed_forms(k, side):
         assert np.all(speed[late] > RADIUS * spin[late] + 1e-6)
     # no motion across the slope, none into the plane: the normal stays at rest
     assert np.max(np.abs(v[1])) < 1e-12 and np.max(np.abs(n @ v)) < 1e-9
-    assert "incline, whose normal is not opposite gravity" in result.message
+
+
+def test_rolling_down_an_incline_ends_in_closed_form():
+    """Rolling down the unbounded incline (massless observer, isotropic inertia) ends in
+    closed form at a rest check: uniformly accelerated at 5/7 g sin(theta), the state at
+    t_end (and the dense output) that of the integration without end states; sliding, a
+    wall ahead, or a throw across the slope do not, and the message says why."""
+    mu_c = math.tan(THETA) / (1 + 1 / 0.4)
+    scene, plane = incline_scene(1.05 * mu_c, 0.4)
+    ended = ballc.simulate(scene, 4.0, rtol=1e-10, atol=1e-12, dense_output=True)
+    whole = ballc.simulate(scene, 4.0, rtol=1e-10, atol=1e-12, rest=False)
+    assert ended.status == whole.status == 0
+    a = G * math.sin(THETA) / 1.4
+    assert f"uniformly accelerated at {a:.6g} m/s^2" in ended.message
+    assert 0 < ended.contacts[-1].t_rolling < 1.0 and ended.nfev < whole.nfev / 10
+    for rows in (slice(4, 7), slice(7, 10), slice(10, 13)):
+        assert np.allclose(ended.y[rows, -1], whole.y[rows, -1], rtol=1e-9, atol=1e-9)
+    t = np.linspace(ended.contacts[-1].t_rolling, 4.0, 7)
+    index = np.searchsorted(whole.t, t)
+    assert np.allclose(ended.sol(whole.t[index])[4:13], whole.y[4:13, index], rtol=1e-9,
+                       atol=1e-9)
+    q_end, q_whole = ended.y[0:4, -1], whole.y[0:4, -1]
+    assert min(np.abs(q_end - q_whole).max(), np.abs(q_end + q_whole).max()) < 1e-7
+    # sliding: no closed form
+    sliding = ballc.simulate(incline_scene(0.95 * mu_c, 0.4)[0], 1.0)
+    assert "incline, whose normal is not opposite gravity" in sliding.message
+    # a wall across the slope 3 m down (reached at ~1.6 s): no closed form before it
+    wall = Plane((3.0 * math.cos(THETA), 0.0, -3.0 * math.sin(THETA)),
+                 (-math.cos(THETA), 0.0, math.sin(THETA)), "wall")
+    walled = ballc.simulate(scene.replace(planes=(plane, wall)), 3.0)
+    assert "wall" in [c.plane for c in walled.contacts]
+    assert math.isnan(walled.contacts[0].t_rolling)
+    # thrown across the slope: it never rolls straight down, no closed form
+    across = ballc.simulate(scene.replace(velocity=(0.0, 1.0, 0.0)), 1.0)
+    assert math.isnan(across.contacts[-1].t_rolling)
+    assert "straight down the slope" in across.message
 
 
 # -------------------------------------------------------------------------------------

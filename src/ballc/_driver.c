@@ -283,7 +283,8 @@ static int plane_mode(const run_t *r, int p)
             ? BALLC_PLANE_PASSED_THROUGH : BALLC_PLANE_FLIGHT;
     if (r->o->end_kind != BALLC_END_NONE && r->o->end_plane == p)
         return r->o->end_kind == BALLC_END_REST ? BALLC_PLANE_RESTING
-            : r->o->end_kind == BALLC_END_ROLLING ? BALLC_PLANE_ROLLING
+            : r->o->end_kind == BALLC_END_ROLLING
+              || r->o->end_kind == BALLC_END_ACCELERATING ? BALLC_PLANE_ROLLING
             : BALLC_PLANE_FREE_SLIDING;
     switch (r->coulomb[p]) {
     case BALLC_MODE_SLIP: return BALLC_PLANE_SLIP;
@@ -717,6 +718,30 @@ static double step_bound_end(const run_t *r)
     return end;
 }
 
+/* Whether plane p is an incline where rolling down may end in closed form: not the
+ * resting plane, gravity pressing the ball into it, and the rotation exact (massless
+ * observer, isotropic inertia: flight.scene_allows) */
+static int is_incline(const run_t *r, int p)
+{
+    const double *n = r->prepared.planes[p].frame[2], *g = r->gravity;
+    return r->c->rolls_allowed && p != r->c->resting_plane
+           && n[0] * g[0] + n[1] * g[1] + n[2] * g[2] < 0;
+}
+
+/* The plane whose rest checks apply in the segment starting now: the one plane in
+ * contact, when it is the resting plane or an incline; -1 when none */
+static int checked_plane(const run_t *r)
+{
+    int found = -1;
+    for (int p = 0; p < r->np; p++) {
+        if (!r->in_contact[p]) continue;
+        if (found >= 0) return -1;   /* two planes at once */
+        found = p;
+    }
+    if (found < 0 || !(found == r->c->resting_plane || is_incline(r, found))) return -1;
+    return found;
+}
+
 /* _Run.begin_contact (with modes.latch_values) */
 static int begin_contact(run_t *r, int p)
 {
@@ -768,7 +793,8 @@ static int begin_contact(run_t *r, int p)
     r->dissipated_at_start[p][0] = y[BALLC_STATE_DISSIPATED_NORMAL];
     r->dissipated_at_start[p][1] = y[BALLC_STATE_DISSIPATED_TANGENTIAL];
     r->relatches[p] = r->transitions[p] = 0;
-    r->rest_check[p] = p == c->resting_plane ? r->t + c->rest_period : INFINITY;
+    r->rest_check[p] = p == c->resting_plane || is_incline(r, p) ? r->t + c->rest_period
+                                                                  : INFINITY;
     if (c->exact && start_coulomb(r, p)) return -1;
     if (c->compliant_modes) return start_compliant(r, p, rate);
     return 0;
@@ -1665,6 +1691,91 @@ static int check_orbit(run_t *r, int p)
     return sticking || speed <= c->rest_factor * error ? BALLC_END_ROLLING : BALLC_END_SLIDING;
 }
 
+/* At a rest check on an incline p: BALLC_END_ACCELERATING (r->y the rolling state,
+ * r->o->end_acceleration its acceleration) when the ball rolls down it uniformly
+ * accelerated and nothing else is reached before t_end, else 0 (the next check
+ * scheduled).  The closed form is exact for a massless observer and isotropic inertia
+ * (checked before: is_incline) once the normal oscillation has settled (its energy about
+ * the static equilibrium under the load M g_n below the rest threshold), the contact
+ * point does not slip, the centre moves along gravity's component in the plane g_t and
+ * the ball does not spin about the normal: then a = g_t / (1 + I / (M r^2)) and the spin
+ * turns about the fixed axis n x a / |a| at |a| / r per second (the lever arm r). */
+static int incline_state(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    const ballc_contact_rec *k = &r->o->contacts[r->o->open[p]];
+    r->seg.end = BALLC_SEG_UNIFORM_CHECK;   /* the log */
+    r->rest_check[p] = r->t + py_max(c->rest_period, 0.25 * (r->t - k->t_start));
+    if (r->t - k->t_start < c->rest_period) return 0;
+    const double *y = r->y, *n = r->prepared.planes[p].frame[2], *g = r->gravity;
+    const double M = c->total_mass, radius = c->radius;
+    double gn = -(n[0] * g[0] + n[1] * g[1] + n[2] * g[2]);   /* the load per mass */
+    double gt[3], size = 0.0;
+    for (int i = 0; i < 3; i++) {
+        gt[i] = g[i] + gn * n[i];
+        size += gt[i] * gt[i];
+    }
+    size = sqrt(size);
+    if (!(gn > 0) || !(size > 0)) return 0;
+    /* the normal motion settled at the static equilibrium under M g_n */
+    double rho_eq = pow(M * gn / c->hertz_k, 2.0 / 3.0);
+    double x = (rho_of(r, p, y) - rho_eq) / rho_eq;
+    if (!(x > -1)) return 0;
+    double normal = M * gn * rho_eq * (0.4 * expm1(2.5 * (x == 0.0 ? x : log1p(x))) - x);
+    double e[BALLC_MAX_ENERGY_NOUT];
+    energy_of(r, y, e);
+    double above = 0.5 * M * pow(rho_rate(r, p, y), 2.0) + tangential_springs(r, e)
+                   + py_max(normal, 0.0);
+    if (!(above <= c->rest_threshold)) return 0;
+    /* rolling along g_t, no spin about n */
+    double u[2], speed, error, clear;
+    slip(r, p, y, u, &speed, &error, &clear);
+    if (!(speed <= c->rolls_dv)) return 0;
+    const double *v = y + BALLC_STATE_VX, *w = y + BALLC_STATE_OMEGA_X;
+    double vn = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+    double along = 0.0, across = 0.0, spin = n[0] * w[0] + n[1] * w[1] + n[2] * w[2];
+    for (int i = 0; i < 3; i++) along += (v[i] - vn * n[i]) * gt[i] / size;
+    for (int i = 0; i < 3; i++) {
+        double d = v[i] - vn * n[i] - along * gt[i] / size;
+        across += d * d;
+    }
+    if (!(sqrt(across) <= c->rolls_dv) || !(radius * fabs(spin) <= c->rolls_dv)) return 0;
+    double factor = 1.0 / (1.0 + c->params[BALLC_PARAMETER_INERTIA_XX] / (M * radius * radius));
+    double a[3];
+    for (int i = 0; i < 3; i++) a[i] = factor * gt[i];
+    /* unbounded: no other plane reached on the way before t_end */
+    for (int q = 0; q < r->np; q++) {
+        if (q == p) continue;
+        const plane_geometry *h = &r->geometry[q];
+        double c1 = 0.0, c2 = 0.0, roots[2];
+        for (int i = 0; i < 3; i++) {
+            c1 += h->coef[i] * along * gt[i] / size;
+            c2 += 0.5 * h->coef[i] * a[i];
+        }
+        if (crossings(rho_of(r, q, y), c1, c2, 1, c->t_end - r->t, roots)) return 0;
+    }
+    /* the rolling state: at the equilibrium height, moving along g_t, rolling exactly */
+    double roll[N];
+    memcpy(roll, y, r->ns * sizeof(double));
+    const ballc_plane_t *pl = &r->prepared.planes[p];
+    double height = 0.0;
+    for (int i = 0; i < 3; i++) height += n[i] * (y[BALLC_STATE_X + i] - pl->point[i]);
+    for (int i = 0; i < 3; i++) {
+        roll[BALLC_STATE_X + i] += (radius - rho_eq - height) * n[i];
+        roll[BALLC_STATE_VX + i] = along * gt[i] / size;
+    }
+    const double *rv = roll + BALLC_STATE_VX;   /* omega = n x v / r */
+    roll[BALLC_STATE_OMEGA_X] = (n[1] * rv[2] - n[2] * rv[1]) / radius;
+    roll[BALLC_STATE_OMEGA_Y] = (n[2] * rv[0] - n[0] * rv[2]) / radius;
+    roll[BALLC_STATE_OMEGA_Z] = (n[0] * rv[1] - n[1] * rv[0]) / radius;
+    for (int q = 0; q < r->np; q++)
+        roll[ballc_plane_state(q)] = roll[ballc_plane_state(q) + 1] = 0.0;
+    booked(r, y, roll);
+    memcpy(r->y, roll, r->ns * sizeof(double));
+    memcpy(r->o->end_acceleration, a, sizeof a);
+    return BALLC_END_ACCELERATING;
+}
+
 /* _Run.end_state at a rest check on plane p at (r->t, r->y): BALLC_END_* when the run
  * finishes in closed form from here (r->y the new state, or the state of the orbit's
  * start), 0 to go on (the next check scheduled), -1 to fall back (where Python would
@@ -1673,6 +1784,7 @@ static int end_state(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
     const ballc_contact_rec *k = &r->o->contacts[r->o->open[p]];
+    if (p != c->resting_plane) return incline_state(r, p);
     int rest = at_rest(r, p, r->y, k->t_start, r->t);
     if (rest < 0) return -1;
     r->seg.end = rest ? BALLC_SEG_REST_CHECK : BALLC_SEG_UNIFORM_CHECK;   /* the log */
@@ -1923,12 +2035,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         if (segment_events(r, flags)) { rc = -1; break; }
         r->n_rearmed = 0;
         double t_check = INFINITY;
-        if (c->checks_rest && c->resting_plane >= 0 && r->in_contact[c->resting_plane]) {
-            int alone = 1;   /* in contact with the resting plane alone */
-            for (int p = 0; p < r->np; p++)
-                if (p != c->resting_plane && r->in_contact[p]) alone = 0;
-            if (alone) t_check = r->rest_check[c->resting_plane];
-        }
+        int checked = c->checks_rest ? checked_plane(r) : -1;   /* its rest checks */
+        if (checked >= 0) t_check = r->rest_check[checked];
         /* a rest check, or the end of a compliant contact's step bound, ends it */
         double t_stop = py_min(py_min(t_check, c->t_end), step_bound_end(r));
         double max_step = run_max_step(r);
@@ -2129,7 +2237,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                     if (log_close(r, BALLC_SEG_STEP_BOUND, -1, r->t)) { rc = -2; break; }
                     continue;
                 }
-                int p = c->resting_plane;
+                int p = checked;
                 int kind = end_state(r, p);
                 if (kind < 0) { rc = kind; break; }
                 if (kind) {   /* to t_end in closed form: the samples are Python's */

@@ -166,7 +166,8 @@ typedef struct {                       /* constants of one run, filled by the br
 } ballc_drive_config;
 
 /* how a run ended at a rest check (ballc.resting): the state from end_t on is end_y */
-enum { BALLC_END_NONE = 0, BALLC_END_REST, BALLC_END_ROLLING, BALLC_END_SLIDING };
+enum { BALLC_END_NONE = 0, BALLC_END_REST, BALLC_END_ROLLING, BALLC_END_SLIDING,
+       BALLC_END_ACCELERATING };   /* rolling down an unbounded incline: end_acceleration */
 
 typedef struct {
     int plane, ended, passed_through, rate_is_kernel_value;
@@ -279,6 +280,7 @@ typedef struct {
     long segments;
     int end_kind, end_plane;            /* BALLC_END_*: rest / uniform motion found */
     double end_t, end_y[BALLC_MAX_STATES];
+    double end_acceleration[3];         /* ACCELERATING: the centre's (m/s^2) */
     /* a -DRADAU5_PROFILE build: thread CPU time (ns) inside radau5_solve, summed over
      * the segments, and in the whole of ballc_drive; zeros otherwise */
     int profiled;

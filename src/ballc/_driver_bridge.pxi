@@ -137,6 +137,7 @@ cdef extern from "_driver.h":
         int end_kind, end_plane
         double end_t
         double end_y[27]
+        double end_acceleration[3]
         int profiled
         double integrator_ns, drive_ns
         int end_orbit
@@ -534,6 +535,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
                     nfev=o.nfev, njev=o.njev, nlu=o.nlu, stiff_at=o.stiff_at,
                     segments=o.segments, end_kind=o.end_kind, end_plane=o.end_plane,
                     end_t=o.end_t, end_y=np.array([o.end_y[j] for j in range(width)]),
+                    end_acceleration=np.array([o.end_acceleration[j] for j in range(3)]),
                     profiled=bool(o.profiled), segment_log=segments,
                     integrator_prof=dict(zip(("fun", "jac", "factor", "solve", "events",
                                               "total", "total_ns"),

@@ -270,6 +270,62 @@ def rolling_samples(t0, t1, rate):
     return t
 
 
+class AcceleratedRolling:
+    """The dense output of rolling down an unbounded incline, uniformly accelerated
+    (the C loop's end state on an incline, _driver.c: incline_state): from (t0, y0), a
+    state rolling without slip (omega = n x v / r), no spin about the normal, moving along
+    the acceleration ``acceleration`` = g_t / (1 + I / (m r^2)): the centre
+    c0 + v0 s + a s^2 / 2, the velocity v0 + a s, the angular velocity
+    omega(s) = (w0 + |a| s / r) e about the fixed axis e = n x a / |a| (w0 = omega0 . e),
+    the quaternion turned about e by theta(s) = w0 s + |a| s^2 / (2 r), the rest constant
+    (s = t - t0; isotropic inertia and a massless observer: the rotation is exact)."""
+
+    def __init__(self, t0, y0, acceleration, radius, normal, t_max=None):
+        self.t0, self.y0 = float(t0), np.array(y0, dtype=float)
+        self.t_min, self.t_max = self.t0, self.t0 if t_max is None else float(t_max)
+        self.a = np.array(acceleration, dtype=float)
+        self.spin_rate = float(np.linalg.norm(self.a)) / float(radius)   # rad/s^2
+        axis = np.cross(np.asarray(normal, dtype=float), self.a)
+        self.axis = axis / np.linalg.norm(axis)                          # n x a / |a|
+        self.w0 = float(self.y0[layout.ANGULAR_VELOCITY] @ self.axis)
+
+    def _angle(self, s):
+        return self.w0 * s + 0.5 * self.spin_rate * s * s
+
+    def sample_times(self, t_end):
+        """Sample times after t0 up to t_end: the turn at most ballc.flight.MAX_TURN per
+        interval, at least 32 and at most MAX_ROLL_SAMPLES (sol(t) is exact anywhere)."""
+        from . import flight
+        turn = abs(self._angle(t_end - self.t0))
+        n = min(MAX_ROLL_SAMPLES, max(flight.MIN_INTERVALS, math.ceil(turn / flight.MAX_TURN)))
+        t = self.t0 + (t_end - self.t0) * np.arange(1, n + 1) / n
+        t[-1] = t_end
+        return t
+
+    def __call__(self, t):
+        from .orientation import quaternion_multiply
+        t = np.asarray(t, dtype=float)
+        s = (t - self.t0).ravel()
+        y = np.repeat(self.y0[:, None], s.size, axis=1)
+        y[layout.POSITION] += self.y0[layout.VELOCITY][:, None] * s + 0.5 * self.a[:, None] * s * s
+        y[layout.VELOCITY] += self.a[:, None] * s
+        y[layout.ANGULAR_VELOCITY] = self.axis[:, None] * (self.w0 + self.spin_rate * s)
+        half = 0.5 * self._angle(s)
+        turn = np.column_stack([np.cos(half), np.sin(half)[:, None] * self.axis])
+        y[layout.QUATERNION] = quaternion_multiply(turn, self.y0[layout.QUATERNION][None, :]).T
+        return y[:, 0] if t.ndim == 0 else y.reshape((-1,) + t.shape)
+
+
+def accelerating_message(scene, plane, t, y, acceleration, success) -> str:
+    """The message of a run that rolls down ``plane`` uniformly accelerated from ``t``."""
+    v = float(np.linalg.norm(y[layout.VELOCITY]))
+    return (f"{success} The ball rolls down the {plane} without slip from t = {t:.9g} s at "
+            f"{v:.6g} m/s, uniformly accelerated at {float(np.linalg.norm(acceleration)):.6g} "
+            "m/s^2 (g_t / (1 + I / (m r^2)), g_t gravity along the plane; nothing else is "
+            "reached by t_end); from there to t_end the state is that rolling, in closed "
+            "form.")
+
+
 class Constant:
     """The dense output of the rest state: y(t) = y_rest."""
 
@@ -306,7 +362,10 @@ def why_no_end_state(scene, contacts, t_end) -> str:
     elif resting is None or open_[0].plane != scene.plane_names[resting]:
         why = (f"the ball is in contact with the {names}, whose normal is not opposite "
                "gravity: rest and uniform rolling are exact end states only on such a "
-               "plane (on an incline the rolling is uniformly accelerated)")
+               "plane; rolling down an incline, uniformly accelerated, ends in closed form "
+               "only once it rolls without slip straight down the slope without spin "
+               "about the normal, reaching no other plane by t_end (a massless observer, "
+               "isotropic inertia)")
     else:
         return ""
     return f" No closed-form end state: {why}; the integration went on to t_end."

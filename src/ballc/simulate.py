@@ -604,18 +604,22 @@ def _record_end(contact, kind, t):
     "free_sliding") it entered at ``t`` (either driver)."""
     if kind == "rest":
         contact.t_rest = t
-    elif kind == "rolling":
+    elif kind in ("rolling", "accelerating"):
         contact.t_rolling = t
     else:
         contact.t_sliding = t
-    contact.transitions.append((t, kind))
+    contact.transitions.append((t, "rolling" if kind == "accelerating" else kind))
 
 
-def _closed_form(kind, t, y, t_end):
+def _closed_form(kind, t, y, t_end, acceleration=None, radius=None, normal=None):
     """(sample times after t up to t_end, the closed-form solution from (t, y)) of the
-    end state ``kind``: the rest state, or uniform motion (either driver)."""
+    end state ``kind``: the rest state, uniform motion (either driver), or rolling down
+    an incline uniformly accelerated (``acceleration``, the C loop's)."""
     if kind == "rest":
         return np.array([t_end]), resting.Constant(y)
+    if kind == "accelerating":
+        motion = resting.AcceleratedRolling(t, y, acceleration, radius, normal, t_max=t_end)
+        return motion.sample_times(t_end), motion
     motion = FreeFlight(t, y, 0.0, t_max=t_end)
     return resting.rolling_samples(t, t_end, motion.rate), motion
 
@@ -928,7 +932,7 @@ def _finish(result, options, stiff_at):
 # the C run; the closed-form samples and the message are added here.  ``result._driver`` says which ran ("c" or "python").
 
 #: The C loop's end states (_driver.h: BALLC_END_*; 0 none) by name.
-_END_KINDS = (None, "rest", "rolling", "free_sliding")
+_END_KINDS = (None, "rest", "rolling", "free_sliding", "accelerating")
 _SEAMS = (integrate_segment, _radau5.solve_system)
 
 
@@ -991,11 +995,12 @@ def _c_config(scene, options, progress, rest, checked=False):
     per_state = type(atol) is not float
     observer = _core.flag("observer", 0) if scene.observer_mass != 0 else 0
     resting_plane = resting.resting_plane_index(scene)
-    period = resting.REST_PERIODS * resting.oscillation_period(scene) \
-        if resting_plane is not None else math.inf
+    # the rest checks' constants (resting.at_rest, rolls; an incline's, _driver.c)
+    checks = resting_plane is not None or scene.gravity_magnitude > 0
+    period = resting.REST_PERIODS * resting.oscillation_period(scene) if checks else math.inf
     rest_consts = dict(rest_threshold=math.inf, rho_eq=1.0, z_eq=0.0, rest_weight=0.0,
                        observer_weight=0.0, rolls_dv=0.0, rolls_level=0.0, half_mass=0.0)
-    if resting_plane is not None:   # the rest checks' constants (resting.at_rest, rolls)
+    if checks:
         rho_eq = resting.equilibrium_penetration(scene)
         rest_consts = dict(
             rest_threshold=resting.energy_threshold(scene, options.rtol, options.atol),
@@ -1107,7 +1112,9 @@ def _simulate_c(scene, options, y, config, progress):
     if end:   # a rest check found an end state: to t_end in closed form
         when = out["end_t"]
         if periodic is None:
-            times, closed = _closed_form(end, when, out["end_y"], options.t_end)
+            times, closed = _closed_form(end, when, out["end_y"], options.t_end,
+                                         out["end_acceleration"], scene.radius,
+                                         scene.planes[out["end_plane"]].unit_normal)
         else:   # ballc.orbit: G^k of the trial's solution over [c0, c0 + T]
             c0, period, motion, _, base = periodic
             base = PiecewiseSolution([(a, b, CompiledInterpolant(*rest)) for a, b, *rest in base])
@@ -1157,6 +1164,9 @@ def _simulate_c(scene, options, y, config, progress):
                                      periodic[1], periodic[2][0], periodic[3], options.t_end)
         elif end == "rest":
             message = _rest_message(scene, plane, when)
+        elif end == "accelerating":
+            message = resting.accelerating_message(scene, plane, when, out["end_y"],
+                                                   out["end_acceleration"], SUCCESS)
         else:
             message = _motion_message(scene, plane, when, out["end_y"], end)
     if counts[-1]:   # still in contact at the end
