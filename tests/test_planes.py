@@ -528,3 +528,19 @@ def test_the_html_view_puts_each_plane_where_it_is(wedge_run):
         depth = page["set_object"][f"{base}/{name}"]["object"]["geometries"][0]["depth"]
         face = matrix[:3, 3] + 0.5 * depth * plane.unit_normal     # its face towards the ball
         assert _on_plane([face], plane)
+
+
+def test_ballc_run_takes_a_scene_file_with_planes(tmp_path, capsys):
+    """`ballc run` on a TOML file with [[planes]]: the contact table names the planes and
+    the side view is written with the other figures."""
+    from ballc.cli import main
+    scene = ballc.Scene(planes=channel(3.0, math.radians(10)), radius=0.3,
+                        observer_mass=0.0, position=(0.0, 0.0, 1.5), velocity=(-2.0, 0.0, -4.0))
+    scene.to_toml(tmp_path / "channel.toml")
+    code = main(["run", str(tmp_path / "channel.toml"), "--t-end", "1.5", "--out",
+                 str(tmp_path / "out")])
+    printed = capsys.readouterr()
+    assert code == 0, printed.err
+    assert "floor" in printed.out and "ceiling" in printed.out
+    written = {p.name for p in (tmp_path / "out").iterdir()}
+    assert {"side_view.png", "contacts_top_view.png", "contacts.csv"} <= written

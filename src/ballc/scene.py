@@ -198,6 +198,9 @@ class Scene:
     friction_regularization            (none)          (none)       "exact" (or "max",
                                                                     "smooth")
     tangential_stiffness_ratio         (none)          1            Mindlin (compliant)
+    planes                             (none)          (none)       None: the floor and
+                                                                    ceiling_height's
+                                                                    ceiling
     position (centre)                  m1, m2, m3      m            (0, 0, 5)
     velocity (centre)                  um1, um2, um3   m/s          (-5, 5, -25)
     angles (body-fixed 123)            q1, q2, q3      rad          (0, 0, 0)

@@ -675,13 +675,14 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         As solve_ivp's: g(t, y) with optional ``terminal`` (bool) and ``direction``
         attributes; their zeros are located on the dense output and returned in
         ``result.t_events`` / ``result.y_events`` (one array per event).  A terminal
-        event ends the run with status 1.  ``y`` is the full state (``STATE_NAMES``).
+        event ends the run with status 1.  ``y`` is the full state (``scene.state_names``).
     dense_output : bool
         Build ``result.sol``: the continuous solution sol(t) over the run, piecewise
         across contact and stick/slip events, from each integrator's own interpolant.
     y0 : array_like, optional
-        The full initial state (``STATE_NAMES``: quaternion, centre, angular velocity,
-        velocity, then the auxiliary states) instead of the scene's; the quaternion is
+        The full initial state (``scene.state_names``: quaternion, centre, angular
+        velocity, velocity, then the auxiliary states, two per plane) instead of the
+        scene's; the quaternion is
         normalised.  A state in contact with a plane starts that contact (see
         ballc.modes.latch_values for what it latches).
     max_nfev : int or None
