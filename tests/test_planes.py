@@ -544,3 +544,8 @@ def test_ballc_run_takes_a_scene_file_with_planes(tmp_path, capsys):
     assert " 1 floor " in printed.out   # the contact table names the plane
     written = {p.name for p in (tmp_path / "out").iterdir()}
     assert {"side_view.png", "contacts_top_view.png", "contacts.csv"} <= written
+
+
+def test_impact_needs_the_seeds_planes():
+    with pytest.raises(ballc.SceneError, match="ceiling_height \\(not planes\\)"):
+        ballc.impact(ballc.Scene(planes=channel(5.0), position=(0, 0, 2)), (1.0, 0.0, -2.0))

@@ -2,7 +2,7 @@
 
 A :class:`Plane` is a point ``p`` on it and its normal ``n`` (any length > 0), pointing
 into the space where the ball lives; the ball's penetration of it is
-rho = r - n . (c - p) / |n| for the centre c.  A :class:`ballc.Scene` takes one to
+rho = r - n . (c - p) for the centre c, n made unit.  A :class:`ballc.Scene` takes one to
 :data:`MAX_PLANES` of them (``Scene(planes=...)``); without, its ``ceiling_height`` is
 the shorthand for the seed's two: the floor (0, 0, 0), (0, 0, 1) and the ceiling
 (0, 0, H), (0, 0, -1) (:func:`seed_planes`).

@@ -276,8 +276,9 @@ class AcceleratedRolling:
     state rolling without slip (omega = n x v / r), no spin about the normal, moving along
     the acceleration ``acceleration`` = g_t / (1 + I / (m r^2)): the centre
     c0 + v0 s + a s^2 / 2, the velocity v0 + a s, the angular velocity
-    omega(s) = (w0 + |a| s / r) e about the fixed axis e = n x a / |a| (w0 = omega0 . e),
-    the quaternion turned about e by theta(s) = w0 s + |a| s^2 / (2 r), the rest constant
+    omega(s) = (w0 + A s / r) e about the fixed axis e = n x a / A (A the length of a,
+    w0 = omega0 . e), the quaternion turned about e by theta(s) = w0 s + A s^2 / (2 r), the
+    rest constant
     (s = t - t0; isotropic inertia and a massless observer: the rotation is exact)."""
 
     def __init__(self, t0, y0, acceleration, radius, normal, t_max=None):

@@ -412,7 +412,7 @@ class Scene:
 
     @property
     def gravity_magnitude(self) -> float:
-        """|gravity| (m/s^2)."""
+        """The length of the gravity vector (m/s^2)."""
         if isinstance(self.gravity, tuple):
             return math.sqrt(sum(g * g for g in self.gravity))
         return float(self.gravity)
