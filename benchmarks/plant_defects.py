@@ -247,6 +247,32 @@ DEFECTS = [
     Defect("plane frame: a plane's forces not turned back", "src/ballc/_system.c",
            "        ballc_plane_to_inertial(pl, sum + BALLC_LAW_GENERALIZED_FORCE, 2);\n", "",
            tests=("tests/test_plane_frame.py",)),
+    # planes at any orientation (issue 30b)
+    Defect("planes: two sticking planes get no constraint force (not solved jointly)",
+           "src/ballc/_system.c", "    } else if (k > 1) {\n",
+           "    } else if (k > BALLC_MAX_PLANES) {\n",
+           tests=("tests/test_planes.py::test_rolling_along_a_wedges_groove",)),
+    Defect("planes: a tilted plane's penetration event leaves out n . p",
+           "src/ballc/_driver.c",
+           "            g->offset = radius + (n[0] * point[0] + n[1] * point[1] + n[2] * point[2]);\n",
+           "            g->offset = radius;\n",
+           tests=("tests/test_planes.py::test_the_seed_turned_as_a_whole",)),
+    Defect("planes: exact flight takes gravity's z component only", "src/ballc/_driver.c",
+           "        f->c[1][BALLC_STATE_VX + i] = gravity[i];\n",
+           "        f->c[1][BALLC_STATE_VX + i] = i == 2 ? gravity[i] : 0.0;\n",
+           tests=("tests/test_planes.py::test_a_turned_floor_keeps_its_end_state",)),
+    Defect("planes: rolling down an incline in closed form without the rolling inertia",
+           "src/ballc/_driver.c",
+           "    double factor = 1.0 / (1.0 + c->params[BALLC_PARAMETER_INERTIA_XX] / "
+           "(M * radius * radius));\n", "    double factor = 1.0;\n",
+           tests=("tests/test_planes.py::test_rolling_down_an_incline_ends_in_closed_form",)),
+    Defect("planes: the incline's closed form ignores the planes ahead",
+           "src/ballc/_driver.c",
+           "        if (ballc_flight_crossings(rho_of(r, q, y), c1, c2, 1, c->t_end - r->t, "
+           "roots)) return 0;\n",
+           "        if (0 && ballc_flight_crossings(rho_of(r, q, y), c1, c2, 1, "
+           "c->t_end - r->t, roots)) return 0;\n",
+           tests=("tests/test_planes.py::test_rolling_down_an_incline_ends_in_closed_form",)),
 ]
 
 

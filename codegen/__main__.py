@@ -14,9 +14,9 @@ from .emit import (CONSTANTS_SIGNATURE, GENERATOR_VERSION, SIGNATURE, BallcPrint
                    ParameterConstants, c_string_array, constants_c, header_comment, kernel_c)
 from .contact import TANGENTIAL_LAWS
 from .kernels import MASS_LAYOUT, build_kernels, contact_law_offsets, describe_contact_law_layout
-from .model import (CONTACT_STATE_NAMES, LATCH_FIELDS, LATCH_NAMES, MECHANICAL_STATE_NAMES,
-                    PARAMETER_NAMES, PARAMETERS, PLANE_FIELDS, PLANE_INPUT_NAMES, PLANES,
-                    STATE_NAMES)
+from .model import (BALL_STATE_NAMES, CONTACT_STATE_NAMES, LATCH_FIELDS, MAX_PLANES,
+                    MECHANICAL_STATE_NAMES, PARAMETER_NAMES, PARAMETERS, PLANE_FIELDS,
+                    PLANE_INPUT_NAMES, PLANE_STATE_FIELDS)
 
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
@@ -50,26 +50,35 @@ def render(verbose=False) -> dict[str, str]:
               file=sys.stderr)
 
     law_names = {f"plane_{law}" for law in TANGENTIAL_LAWS}
-    first_plane_parameter = PARAMETER_NAMES.index(f"{PLANES[0]}_{PLANE_FIELDS[0][0]}")
-    if PARAMETER_NAMES[first_plane_parameter:] != tuple(
-            f"{plane}_{name}" for plane in PLANES for name, *_ in PLANE_FIELDS):
-        raise ValueError("the plane table must close the parameters, plane after plane")
+    if PARAMETER_NAMES[-1] != "plane_count":
+        raise ValueError("the plane table must close the parameters: plane_count last")
     (contact_law_nout,) = {len(k.outputs) for k in kernels if k.name in law_names}
     units = [p[2] for p in PARAMETERS]
+    n_ball, n_plane_states = len(BALL_STATE_NAMES), len(PLANE_STATE_FIELDS)
+    n_fixed, n_fields = len(PARAMETER_NAMES), len(PLANE_FIELDS)
     h = [header, "#ifndef BALLC_KERNELS_H", "#define BALLC_KERNELS_H", "",
-         "/* Argument layout: the one source of truth for state and parameter order. */",
+         "/* Argument layout: the one source of truth for state and parameter order.  A run",
+         "   with n planes has BALLC_N_BALL_STATES + n BALLC_N_PLANE_STATES states (the",
+         "   ball's, then each plane's own from BALLC_STATE_PLANES on), BALLC_PARAMETER_PLANES",
+         "   + n BALLC_N_PLANE_FIELDS parameters (the plane table closes them, its count at",
+         "   BALLC_PARAMETER_PLANE_COUNT) and n BALLC_N_LATCH_PER_PLANE latched values. */",
          f"#define BALLC_GENERATOR_VERSION \"{GENERATOR_VERSION}\"",
-         f"#define BALLC_N_STATES {len(STATE_NAMES)}",
-         f"#define BALLC_N_PARAMETERS {len(PARAMETER_NAMES)}",
-         f"#define BALLC_N_LATCH {len(LATCH_NAMES)}",
+         f"#define BALLC_MAX_PLANES {MAX_PLANES}",
+         f"#define BALLC_N_BALL_STATES {n_ball}",
+         f"#define BALLC_N_PLANE_STATES {n_plane_states}",
+         *[f"#define BALLC_PLANE_STATE_{name.upper()} {i}"
+           for i, name in enumerate(PLANE_STATE_FIELDS)],
+         f"#define BALLC_STATE_PLANES {n_ball}",
+         f"#define BALLC_MAX_STATES {n_ball + MAX_PLANES * n_plane_states}",
          "/* parameter constants: ballc_parameter_constants(params, constants) */",
          f"#define BALLC_N_PARAMETER_CONSTANTS {len(constants)}",
          f"#define BALLC_N_LATCH_PER_PLANE {len(LATCH_FIELDS)}",
-         f"#define BALLC_N_PLANES {len(PLANES)}",
-         "/* the plane table, in the parameters: BALLC_N_PLANE_FIELDS per plane from "
-         "BALLC_PARAMETER_PLANES on */",
-         f"#define BALLC_PARAMETER_PLANES {first_plane_parameter}",
-         f"#define BALLC_N_PLANE_FIELDS {len(PLANE_FIELDS)}",
+         f"#define BALLC_MAX_LATCH {MAX_PLANES * len(LATCH_FIELDS)}",
+         "/* the plane table, in the parameters: its count, then BALLC_N_PLANE_FIELDS per "
+         "plane from BALLC_PARAMETER_PLANES on */",
+         f"#define BALLC_PARAMETER_PLANES {n_fixed}",
+         f"#define BALLC_N_PLANE_FIELDS {n_fields}",
+         f"#define BALLC_MAX_PARAMETERS {n_fixed + MAX_PLANES * n_fields}",
          *[f"#define BALLC_PLANE_{name.upper()} {i}" for i, (name, *_) in enumerate(PLANE_FIELDS)],
          "/* a plane kernel's state: one contact in its plane's own frame */",
          f"#define BALLC_N_CONTACT_STATES {len(CONTACT_STATE_NAMES)}",
@@ -79,7 +88,7 @@ def render(verbose=False) -> dict[str, str]:
          f"#define BALLC_N_PLANE_INPUTS {len(PLANE_INPUT_NAMES)}",
          f"#define BALLC_PLANE_INPUT_GRAVITY {PLANE_INPUT_NAMES.index('gravity_into_plane')}",
          f"#define BALLC_MASS_SIZE {len(MASS_LAYOUT)}",
-         *[f"#define BALLC_STATE_{name.upper()} {i}" for i, name in enumerate(STATE_NAMES)],
+         *[f"#define BALLC_STATE_{name.upper()} {i}" for i, name in enumerate(BALL_STATE_NAMES)],
          *[f"#define BALLC_PARAMETER_{name.upper()} {i}"
            for i, name in enumerate(PARAMETER_NAMES)],
          *[f"#define BALLC_LATCH_{field[0].upper()} {i}" for i, field in enumerate(LATCH_FIELDS)],
@@ -88,10 +97,13 @@ def render(verbose=False) -> dict[str, str]:
          "/* contact-law kernel outputs: " + describe_contact_law_layout() + " */",
          *[f"#define BALLC_LAW_{suffix} {offset}" for suffix, offset in contact_law_offsets()],
          *sizes, "",
-         c_string_array("BALLC_STATE_NAMES", STATE_NAMES).rstrip(),
+         c_string_array("BALLC_STATE_NAMES", BALL_STATE_NAMES).rstrip(),
+         c_string_array("BALLC_PLANE_STATE_NAMES", PLANE_STATE_FIELDS).rstrip(),
          c_string_array("BALLC_PARAMETER_NAMES", PARAMETER_NAMES).rstrip(),
          c_string_array("BALLC_PARAMETER_UNITS", units).rstrip(),
-         c_string_array("BALLC_LATCH_NAMES", LATCH_NAMES).rstrip(),
+         c_string_array("BALLC_PLANE_FIELD_NAMES", [f[0] for f in PLANE_FIELDS]).rstrip(),
+         c_string_array("BALLC_PLANE_FIELD_UNITS", [f[1] for f in PLANE_FIELDS]).rstrip(),
+         c_string_array("BALLC_LATCH_FIELD_NAMES", [f[0] for f in LATCH_FIELDS]).rstrip(),
          c_string_array("BALLC_CONTACT_STATE_NAMES", CONTACT_STATE_NAMES).rstrip(),
          c_string_array("BALLC_PARAMETER_CONSTANT_NAMES", map(str, constants.values)).rstrip(),
          c_string_array("BALLC_MASS_LAYOUT", MASS_LAYOUT).rstrip(),

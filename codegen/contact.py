@@ -63,9 +63,10 @@ def hertz_stiffness(model: Model):
 
 
 def latch_symbols(model: Model, plane: str):
-    """The four latched symbols (rhodot^-, d_x, d_y, d_z) of ``plane``."""
-    offset = 0 if plane == "floor" else len(LATCH_FIELDS)
-    return model.latches[offset:offset + len(LATCH_FIELDS)]
+    """The latched symbols (LATCH_FIELDS: rhodot^-, d_x, d_y, d_z, ...) of ``plane``
+    (model.FRAME_PLANE only: every plane's latch is turned into its frame at run time)."""
+    require_frame_plane(plane)
+    return model.latches[:len(LATCH_FIELDS)]
 
 
 def contact_kinematics(model: Model, plane: str):
@@ -153,7 +154,9 @@ def digin_model_force(model: Model, plane: str):
 
 
 def deflection_symbols(model: Model, plane: str):
-    return model.state(f"{plane}_deflection_x"), model.state(f"{plane}_deflection_y")
+    """The tangential deflection states (x, y) of ``plane`` (model.FRAME_PLANE only)."""
+    require_frame_plane(plane)
+    return model.state("deflection_x"), model.state("deflection_y")
 
 
 #: Sharpness n of the compliant model's yield: flow ~ (|F_el| / mu F_n)^n.  Chosen by

@@ -27,7 +27,7 @@ import sympy as sm
 from sympy.core.function import AppliedUndef
 from sympy.printing.c import C99CodePrinter
 
-GENERATOR_VERSION = "1"
+GENERATOR_VERSION = "2"
 SIGNATURE = ("void ballc_{name}(const double *restrict state, const double *restrict params,\n"
              "        const double *restrict constants, const double *restrict extra,\n"
              "        double *restrict out)")

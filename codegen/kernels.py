@@ -33,8 +33,9 @@ from sympy.core.function import AppliedUndef
 
 from . import contact
 from .emit import Kernel, forward_jacobian, plain_symbols
-from .model import (CONTACT_STATE, FRAME_PLANE, STATE_NAMES, Model, bodies, build_model,
-                    gravity_loads, gravity_vector, kanes_equations, quaternion_dcm)
+from .model import (BALL_STATE_NAMES, CONTACT_STATE, FRAME_PLANE, STATE_NAMES, Model, bodies,
+                    build_model, gravity_loads, gravity_vector, kanes_equations,
+                    quaternion_dcm)
 
 MASS_LAYOUT = ("J00", "J01", "J02", "J11", "J12", "J22",
                "B00", "B01", "B02", "B10", "B11", "B12", "B20", "B21", "B22", "D")
@@ -151,21 +152,28 @@ def jacobian_kernel(model, name, doc, outputs, extra=(), extra_doc="", prefix="j
                     state=None):
     """Kernel of d(outputs)/d(state), row-major, by forward_jacobian.  ``frozen``:
     [(symbol, expression)] computed first and differentiated as constants.  ``state``:
-    the symbols of the kernel's state (a plane kernel's contact state), the model's by
-    default."""
+    the symbols of the kernel's state (a plane kernel's contact state); by default the
+    model's state, differentiated by the ball's states only (BALL_STATE_NAMES: nothing
+    of the ball's dynamics depends on a plane's deflection, and a run's planes are known
+    at run time only; the C core places the columns)."""
     if state is None:
         states = plain_symbols(model.states)
         replacements = dict(zip(model.states, states))
+        variables = states[:len(BALL_STATE_NAMES)]
+        others = set(states) - set(variables)
+        if any(sm.sympify(e).xreplace(replacements).has(*others) for e in outputs):
+            raise ValueError(f"{name}: the ball's dynamics depend on a plane's state")
     else:
         states, replacements = list(state), {}
+        variables = states
     outputs = [sm.sympify(e).xreplace(replacements) for e in outputs]
     leading = [(symbol, sm.sympify(e).xreplace(replacements)) for symbol, e in frozen]
-    definitions, jac = forward_jacobian(outputs, states, prefix)
+    definitions, jac = forward_jacobian(outputs, variables, prefix)
     return Kernel(name, doc, jac, list(extra), extra_doc, leading + definitions, state)
 
 
 def _dynamics_kernels(model, name, M, F, what):
-    n = len(model.states)
+    n = len(BALL_STATE_NAMES)
     a = sm.symbols("a0:6")
     mass = pack_mass(M)
     Ma = M * sm.Matrix(a)
@@ -178,7 +186,8 @@ def _dynamics_kernels(model, name, M, F, what):
         Kernel(name, f"{what}: mass blocks (16, MASS_LAYOUT) then forcing (6).",
                mass + list(F), []),
         Kernel(f"{name}_jac",
-               f"{what}: dF/dx (6x{n} row-major) then d(M a)/dq (6x4 row-major).",
+               f"{what}: dF/d(the ball's states) (6x{n} row-major) then d(M a)/dq (6x4 "
+               "row-major).",
                dF.outputs + dMa_q, list(a), "a (6): the vector M is multiplied with (udot)",
                dF.definitions + dMa.definitions),
     ]
@@ -187,12 +196,11 @@ def _dynamics_kernels(model, name, M, F, what):
 def build_kernels():
     """All kernels, in emission order, and the model they came from."""
     model, pieces = derive()
-    x = model.states
     kernels = [
         Kernel("kinematics", "Time derivatives of qw qx qy qz x y z (7).",
                list(model.kinematics), []),
-        jacobian_kernel(model, "kinematics_jac", f"d(kinematics)/dx (7x{len(x)} row-major).",
-                        list(model.kinematics)),
+        jacobian_kernel(model, "kinematics_jac", "d(kinematics)/d(the ball's states) "
+                        f"(7x{len(BALL_STATE_NAMES)} row-major).", list(model.kinematics)),
     ]
     kernels += _dynamics_kernels(model, "ball", pieces["M_ball"], pieces["F_ball"], "Ball")
     value, M_offset, F_offset = observer_value_kernel(model, pieces)

@@ -44,14 +44,20 @@ MECHANICAL_STATE_NAMES = (
     "vx", "vy", "vz",
 )
 #: States that ride along with the mechanics: dissipated work (J), integrated so that
-#: kinetic + potential + spring + dissipated is conserved, and the elastic tangential
-#: deflection (m) of the compliant contact model on each plane.
-AUXILIARY_STATE_NAMES = (
-    "dissipated_normal", "dissipated_tangential",
-    "floor_deflection_x", "floor_deflection_y",
-    "ceiling_deflection_x", "ceiling_deflection_y",
-)
-STATE_NAMES = MECHANICAL_STATE_NAMES + AUXILIARY_STATE_NAMES
+#: kinetic + potential + spring + dissipated is conserved.
+DISSIPATED_STATE_NAMES = ("dissipated_normal", "dissipated_tangential")
+#: The ball's states: every run's first states, in this order.
+BALL_STATE_NAMES = MECHANICAL_STATE_NAMES + DISSIPATED_STATE_NAMES
+#: Each plane's own states, after the ball's, plane after plane (a run's state vector is
+#: BALL_STATE_NAMES + PLANE_STATE_FIELDS per plane: 15 + 2 x its number of planes): the
+#: elastic tangential deflection (m) of the compliant contact model, in the plane's
+#: frame (along its tangents t1, t2).  A run names them ``<plane name>_<field>``.
+PLANE_STATE_FIELDS = ("deflection_x", "deflection_y")
+#: The most planes a run may have (the run-time arrays of the C core are sized by it).
+MAX_PLANES = 6
+#: The model's states: the ball's, and the deflection of the plane the contact laws are
+#: derived on (FRAME_PLANE, below); at run time each plane's own (src/ballc/_plane.c).
+STATE_NAMES = BALL_STATE_NAMES + PLANE_STATE_FIELDS
 
 #: (name, seed symbol, unit, description)
 PARAMETERS = (
@@ -87,11 +93,15 @@ PARAMETERS = (
     ("tangential_damping_ratio", "-", "1",
      "compliant model's tangential damping: c_t = 2 gamma_t sqrt(m* k_t)"),
 )
-PLANES = ("floor", "ceiling")
-#: Each plane's table entry, part of the parameters: a point of the plane and its normal,
-#: towards the ball (any length > 0: the C core normalises it and builds the plane's
-#: frame, src/ballc/_plane.c).  The seed's floor: (0, 0, 0), (0, 0, 1); its ceiling:
-#: (0, 0, H), (0, 0, -1).
+#: The plane table closes the parameters: its number of planes, then PLANE_FIELDS per
+#: plane, plane after plane (a run's parameter vector is PARAMETERS + PLANE_FIELDS per
+#: plane).
+PARAMETERS += (("plane_count", "-", "1",
+                f"the number of planes in the plane table that follows (1 to {MAX_PLANES})"),)
+#: Each plane's table entry: a point of the plane and its normal, towards the ball (any
+#: length > 0: the C core normalises it and builds the plane's frame,
+#: src/ballc/_plane.c).  The seed's floor: (0, 0, 0), (0, 0, 1); its ceiling: (0, 0, H),
+#: (0, 0, -1).  A run names them ``<plane name>_<field>``.
 PLANE_FIELDS = (
     ("point_x", "m", "a point of the plane, x"),
     ("point_y", "m", "a point of the plane, y"),
@@ -100,9 +110,6 @@ PLANE_FIELDS = (
     ("normal_y", "1", "the plane's normal towards the ball, y"),
     ("normal_z", "1", "the plane's normal towards the ball, z"),
 )
-PARAMETERS += tuple((f"{plane}_{name}", "-" if plane != "ceiling" or name != "point_z" else "H",
-                     unit, f"{plane}: {what}")
-                    for plane in PLANES for name, unit, what in PLANE_FIELDS)
 PARAMETER_NAMES = tuple(p[0] for p in PARAMETERS)
 
 #: The plane whose frame the contact laws are derived in: the floor's (normal +z through
@@ -116,12 +123,12 @@ FRAME_PLANE = "floor"
 CONTACT_STATE = (
     ("z", "z"), ("omega_x", "omega_x"), ("omega_y", "omega_y"), ("omega_z", "omega_z"),
     ("vx", "vx"), ("vy", "vy"), ("vz", "vz"),
-    (f"{FRAME_PLANE}_deflection_x", "deflection_x"),
-    (f"{FRAME_PLANE}_deflection_y", "deflection_y"),
+    ("deflection_x", "deflection_x"), ("deflection_y", "deflection_y"),
 )
 CONTACT_STATE_NAMES = tuple(local for _, local in CONTACT_STATE)
 
-#: Values latched at the start of a contact, per plane, in this order.
+#: Values latched at the start of a contact, per plane, in this order (a run's latch is
+#: LATCH_FIELDS per plane, plane after plane, named ``<plane name>_<field>``).
 LATCH_FIELDS = (
     ("penetration_rate_at_impact", "rhodtu / rhodto",
      "m/s", "penetration rate when the contact started"),
@@ -134,7 +141,9 @@ LATCH_FIELDS = (
     ("slip_direction_y", "-", "1",
      "exact Coulomb friction: unit slip direction latched at the segment start, along t2"),
 )
-LATCH_NAMES = tuple(f"{plane}_{f[0]}" for plane in PLANES for f in LATCH_FIELDS)
+#: The latched symbols of FRAME_PLANE (the contact laws read them, turned into the
+#: plane's frame where they are vectors).
+LATCH_NAMES = tuple(f[0] for f in LATCH_FIELDS)
 #: A plane kernel's ``extra`` argument: the plane's latched values (LATCH_FIELDS, the
 #: dig-in direction turned into the plane's frame), then gravity's component into the
 #: plane, -n . g (m/s^2; the floor's g in the seed), the one parameter of the scene that

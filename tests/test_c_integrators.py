@@ -75,7 +75,7 @@ def test_c_code_reads_a_scipy_segments_interpolant(method):
                             dense_output=True, progress=False)
     t0, t1, piece = result.sol.pieces[1]   # the first contact's first segment
     t = np.linspace(t0, t1, 13)
-    rows = _core._scipy_interpolant_rows(piece, t)
+    rows = _core._scipy_interpolant_rows(piece, t, result.scene.parameter_vector())
     assert rows.shape == (13, N) and np.array_equal(rows, piece(t).T)
 
 

@@ -46,7 +46,7 @@ def _samples(result, mode):
     latch = result.latch if result.latch.shape[0] == result.t.size else result.latch.T
     forces = _core.contact_forces_per_sample(
         np.ascontiguousarray(result.y.T[inside]), result.scene.parameter_vector(),
-        np.ascontiguousarray(latch[inside]), np.ascontiguousarray(flags[inside], np.intc))
+        np.ascontiguousarray(latch[inside]), np.ascontiguousarray(flags[inside], np.int64))
     return forces[:, 2], np.hypot(forces[:, 0], forces[:, 1])
 
 

@@ -23,7 +23,7 @@ sm = pytest.importorskip("sympy")
 me = pytest.importorskip("sympy.physics.mechanics")
 
 from codegen import contact  # noqa: E402
-from codegen.model import FRAME_PLANE, PARAMETER_NAMES, PLANES, build_model  # noqa: E402
+from codegen.model import FRAME_PLANE, PARAMETER_NAMES, build_model  # noqa: E402
 
 SEED_LAWS = ("friction", "digin")
 POINTS = 25
@@ -52,9 +52,7 @@ def random_point(rng, model, plane):
         "smooth_friction": float(rng.integers(2)), "tangential_stiffness_ratio": 0.8,
         "normal_damping_model": 0.0, "damping_ratio": 0.1, "tangential_damping_ratio": 0.1,
     }
-    for name, value in zip(("point_x", "point_y", "point_z", "normal_x", "normal_y", "normal_z"),
-                           (0.0, 0.0, 0.0, 0.0, 0.0, 1.0)):   # the plane table: no law reads it
-        p.update({f"{each}_{name}": value for each in PLANES})
+    p["plane_count"] = 1.0   # the plane table (run time): no law reads it
     assert set(p) == set(PARAMETER_NAMES)
     r = p["radius"]
     z = r - rng.uniform(0, 0.3 * r)

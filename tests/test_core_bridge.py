@@ -154,7 +154,7 @@ def test_non_array_arguments_raise(bad):
 
 def test_flags_and_time_of_wrong_type_raise():
     with pytest.raises(OverflowError):
-        _core.rhs(Y, P, L, 2 ** 40)
+        _core.rhs(Y, P, L, 2 ** 70)   # flags are 64 bits
     with pytest.raises(TypeError):
         _core.System(P, L, 0)("0.0", Y)
 

@@ -17,7 +17,8 @@ EXAMPLES = REPOSITORY / "examples"
 needs_sources = pytest.mark.skipif(not (DOCS / "conf.py").is_file(),
                                    reason="needs the source tree")
 GALLERY = ["seed_reproduction", "superball", "compare_tangential_models",
-           "restitution_calibration", "sweep_mixture_mu", "fit_superball", "choose_integrator"]
+           "restitution_calibration", "sweep_mixture_mu", "plates_orientation", "fit_superball",
+           "choose_integrator"]
 
 
 @needs_sources

@@ -13,95 +13,152 @@ import numpy as np
 from libc.math cimport NAN, isfinite
 
 cdef extern from "ballc_kernels.h":
-    int BALLC_N_STATES, BALLC_N_PARAMETERS, BALLC_N_LATCH, BALLC_N_LATCH_PER_PLANE
+    enum:
+        BALLC_MAX_PLANES
+        BALLC_MAX_STATES
+        BALLC_MAX_LATCH
+        BALLC_MAX_PARAMETERS
+    int BALLC_N_BALL_STATES, BALLC_N_PLANE_STATES
+    int BALLC_PARAMETER_PLANES, BALLC_PARAMETER_PLANE_COUNT, BALLC_N_PLANE_FIELDS
+    int BALLC_N_LATCH_PER_PLANE
     int BALLC_N_PARAMETER_CONSTANTS
     const char *const BALLC_PARAMETER_CONSTANT_NAMES[]
     void ballc_parameter_constants(const double *, double *) nogil
     const char *const BALLC_STATE_NAMES[]
+    const char *const BALLC_PLANE_STATE_NAMES[]
     const char *const BALLC_PARAMETER_NAMES[]
     const char *const BALLC_PARAMETER_UNITS[]
-    const char *const BALLC_LATCH_NAMES[]
+    const char *const BALLC_PLANE_FIELD_NAMES[]
+    const char *const BALLC_PLANE_FIELD_UNITS[]
+    const char *const BALLC_LATCH_FIELD_NAMES[]
     const char *BALLC_GENERATOR_VERSION
-    int BALLC_OBSERVER_POSITION_NOUT, BALLC_N_PLANES
+    int BALLC_OBSERVER_POSITION_NOUT
     void ballc_observer_position(const double *, const double *, const double *, const double *,
         double *) nogil
     void ballc_hertz_stiffness(const double *, const double *, const double *, const double *,
         double *) nogil
 
 cdef extern from "_system.h":
-    int BALLC_WITH_OBSERVER, BALLC_FLOOR_FRICTION, BALLC_FLOOR_DIGIN
-    int BALLC_CEILING_FRICTION, BALLC_CEILING_DIGIN
-    int BALLC_FLOOR_COMPLIANT, BALLC_CEILING_COMPLIANT
+    ctypedef long long ballc_flags
+    ballc_flags BALLC_WITH_OBSERVER
+    enum:
+        BALLC_KIND_FRICTION, BALLC_KIND_DIGIN, BALLC_KIND_COMPLIANT, BALLC_KIND_SLIP,
+        BALLC_KIND_STICK, BALLC_KIND_SLIP_FIXED, BALLC_KIND_COMPLIANT_SLIDING,
+        BALLC_KIND_COMPLIANT_ELASTIC, BALLC_N_FLAG_KINDS
+    ballc_flags ballc_flag(int, int) nogil
     int BALLC_OK
-    int ballc_rhs(const double *, const double *, const double *, int, double *) nogil
-    int ballc_jacobian(const double *, const double *, const double *, int, double *) nogil
+    int ballc_rhs(const double *, const double *, const double *, ballc_flags, double *) nogil
+    int ballc_jacobian(const double *, const double *, const double *, ballc_flags,
+                       double *) nogil
     ctypedef struct ballc_plane_t:
+        double point[3]
         double frame[3][3]     # rows t1, t2, n
     ctypedef struct ballc_parameters_t:
         const double *values
+        int n_planes, n_states, n_latch, n_parameters
         double *constants      # an array in C (BALLC_N_PARAMETER_CONSTANTS)
-        ballc_plane_t *planes  # an array in C (BALLC_N_PLANES)
-    void ballc_parameters_init(ballc_parameters_t *, const double *) nogil
-    int BALLC_ENERGY_NOUT, BALLC_CONTACT_KINEMATICS_NOUT, BALLC_SLIP_NOUT
+        ballc_plane_t *planes  # an array in C (BALLC_MAX_PLANES)
+    int ballc_parameters_init(ballc_parameters_t *, const double *) nogil
+    enum:
+        BALLC_MAX_SLIP_NOUT
+    int BALLC_CONTACT_KINEMATICS_PER_PLANE
     void ballc_energy(const double *, const ballc_parameters_t *, double *) nogil
     void ballc_contact_kinematics(const double *, const ballc_parameters_t *, double *) nogil
     void ballc_slip_state(const double *, const ballc_parameters_t *, int, double *) nogil
     int ballc_rhs_checked_inputs(const double *, const ballc_parameters_t *, const double *,
-                                 int, double *) nogil
+                                 ballc_flags, double *) nogil
     int ballc_jacobian_checked_inputs(const double *, const ballc_parameters_t *,
-                                      const double *, int, double *) nogil
-    int ballc_contact_forces(const double *, const double *, const double *, int, double *) nogil
+                                      const double *, ballc_flags, double *) nogil
+    int ballc_contact_forces(const double *, const double *, const double *, ballc_flags,
+                             double *) nogil
     int ballc_contact_forces_prepared(const double *, const ballc_parameters_t *,
-                                      const double *, int, double *) nogil
-    int ballc_stick_state(const double *, const double *, const double *, int, int,
+                                      const double *, ballc_flags, double *) nogil
+    int ballc_stick_state(const double *, const double *, const double *, ballc_flags, int,
                           double *) nogil
-    int ballc_remove_slip(const double *, const double *, int, int, double *) nogil
-    int BALLC_FLOOR_SLIP, BALLC_CEILING_SLIP, BALLC_FLOOR_STICK, BALLC_CEILING_STICK
-    int BALLC_FLOOR_SLIP_FIXED, BALLC_CEILING_SLIP_FIXED
-    int BALLC_FLOOR_COMPLIANT_SLIDING, BALLC_CEILING_COMPLIANT_SLIDING
+    int ballc_remove_slip(const double *, const double *, ballc_flags, int, double *) nogil
     int BALLC_COMPLIANT_MARGINS
-    int BALLC_FLOOR_COMPLIANT_ELASTIC, BALLC_CEILING_COMPLIANT_ELASTIC
     int ballc_compliant_margins(const double *, const double *, const double *, int,
                                 double *) nogil
     int ballc_compliant_margins_prepared(const double *, const ballc_parameters_t *,
-                                         const double *, int, int, double *) nogil
+                                         const double *, ballc_flags, int, int, double *) nogil
 
-N_STATES = BALLC_N_STATES
-N_PARAMETERS = BALLC_N_PARAMETERS
-N_LATCH = BALLC_N_LATCH
+#: The most planes a scene may have, and the layout of a run with n planes: the ball's
+#: states (BALL_STATE_NAMES), then PLANE_STATE_FIELDS per plane (``<plane>_<field>``);
+#: the scene's parameters (BASE_PARAMETER_NAMES, the last the plane table's count), then
+#: PLANE_FIELD_NAMES per plane; LATCH_FIELD_NAMES per plane.  (ballc.layout names them.)
+MAX_PLANES = BALLC_MAX_PLANES
+BALL_STATE_NAMES = tuple(BALLC_STATE_NAMES[i].decode() for i in range(BALLC_N_BALL_STATES))
+PLANE_STATE_FIELDS = tuple(BALLC_PLANE_STATE_NAMES[i].decode()
+                           for i in range(BALLC_N_PLANE_STATES))
+BASE_PARAMETER_NAMES = tuple(BALLC_PARAMETER_NAMES[i].decode()
+                             for i in range(BALLC_PARAMETER_PLANES))
+BASE_PARAMETER_UNITS = tuple(BALLC_PARAMETER_UNITS[i].decode()
+                             for i in range(BALLC_PARAMETER_PLANES))
+PLANE_FIELD_NAMES = tuple(BALLC_PLANE_FIELD_NAMES[i].decode()
+                          for i in range(BALLC_N_PLANE_FIELDS))
+PLANE_FIELD_UNITS = tuple(BALLC_PLANE_FIELD_UNITS[i].decode()
+                          for i in range(BALLC_N_PLANE_FIELDS))
+LATCH_FIELD_NAMES = tuple(BALLC_LATCH_FIELD_NAMES[i].decode()
+                          for i in range(BALLC_N_LATCH_PER_PLANE))
 N_LATCH_PER_PLANE = BALLC_N_LATCH_PER_PLANE
-STATE_NAMES = tuple(BALLC_STATE_NAMES[i].decode() for i in range(BALLC_N_STATES))
-#: state name -> index in the state vector (from the generated layout)
+CONTACT_KINEMATICS_PER_PLANE = BALLC_CONTACT_KINEMATICS_PER_PLANE
+
+
+def state_names(planes):
+    """The state names of a run with the planes named ``planes``, in layout order."""
+    return BALL_STATE_NAMES + tuple(f"{plane}_{field}" for plane in planes
+                                    for field in PLANE_STATE_FIELDS)
+
+
+def parameter_names(planes):
+    """The parameter names of a run with the planes named ``planes``, in layout order."""
+    return BASE_PARAMETER_NAMES + tuple(f"{plane}_{field}" for plane in planes
+                                        for field in PLANE_FIELD_NAMES)
+
+
+def latch_names(planes):
+    """The latched values' names of a run with the planes named ``planes``."""
+    return tuple(f"{plane}_{field}" for plane in planes for field in LATCH_FIELD_NAMES)
+
+
+#: The seed's planes (Scene's ceiling_height shorthand: a floor and a ceiling), and the
+#: layout of a run with them: its states, parameters and latched values (19, 38, 12).
+SEED_PLANES = ("floor", "ceiling")
+STATE_NAMES = state_names(SEED_PLANES)
+N_STATES = len(STATE_NAMES)
+#: state name -> index in the state vector (the ball's states: the same in every run)
 STATE_INDEX = {name: i for i, name in enumerate(STATE_NAMES)}
-PARAMETER_NAMES = tuple(BALLC_PARAMETER_NAMES[i].decode() for i in range(BALLC_N_PARAMETERS))
-PARAMETER_UNITS = tuple(BALLC_PARAMETER_UNITS[i].decode() for i in range(BALLC_N_PARAMETERS))
-LATCH_NAMES = tuple(BALLC_LATCH_NAMES[i].decode() for i in range(BALLC_N_LATCH))
+PARAMETER_NAMES = parameter_names(SEED_PLANES)
+N_PARAMETERS = len(PARAMETER_NAMES)
+PARAMETER_UNITS = BASE_PARAMETER_UNITS + PLANE_FIELD_UNITS * len(SEED_PLANES)
+LATCH_NAMES = latch_names(SEED_PLANES)
+N_LATCH = len(LATCH_NAMES)
 #: The parameter constants (parameter-only subexpressions of the kernels), each named by
 #: its sympy expression of PARAMETER_NAMES; see codegen/emit.py.
 PARAMETER_CONSTANT_NAMES = tuple(BALLC_PARAMETER_CONSTANT_NAMES[i].decode()
                                  for i in range(BALLC_N_PARAMETER_CONSTANTS))
 GENERATOR_VERSION = BALLC_GENERATOR_VERSION.decode()
-FLAGS = {
-    "observer": BALLC_WITH_OBSERVER,
-    "floor_friction": BALLC_FLOOR_FRICTION,
-    "floor_digin": BALLC_FLOOR_DIGIN,
-    "ceiling_friction": BALLC_CEILING_FRICTION,
-    "ceiling_digin": BALLC_CEILING_DIGIN,
-    "floor_compliant": BALLC_FLOOR_COMPLIANT,
-    "ceiling_compliant": BALLC_CEILING_COMPLIANT,
-    "floor_slip": BALLC_FLOOR_SLIP,
-    "ceiling_slip": BALLC_CEILING_SLIP,
-    "floor_stick": BALLC_FLOOR_STICK,
-    "ceiling_stick": BALLC_CEILING_STICK,
-    "floor_slip_fixed": BALLC_FLOOR_SLIP_FIXED,
-    "ceiling_slip_fixed": BALLC_CEILING_SLIP_FIXED,
-    "floor_compliant_sliding": BALLC_FLOOR_COMPLIANT_SLIDING,
-    "ceiling_compliant_sliding": BALLC_CEILING_COMPLIANT_SLIDING,
-    "floor_compliant_elastic": BALLC_FLOOR_COMPLIANT_ELASTIC,
-    "ceiling_compliant_elastic": BALLC_CEILING_COMPLIANT_ELASTIC,
-}
-ENERGY_NOUT = BALLC_ENERGY_NOUT
-CONTACT_KINEMATICS_NOUT = BALLC_CONTACT_KINEMATICS_NOUT
+#: The kinds of the right-hand side's flags (_system.h), in their order.
+FLAG_KINDS = ("friction", "digin", "compliant", "slip", "stick", "slip_fixed",
+              "compliant_sliding", "compliant_elastic")
+if len(FLAG_KINDS) != BALLC_N_FLAG_KINDS:
+    raise ImportError("ballc._core: FLAG_KINDS does not match _system.h")
+
+
+def flag(kind, int plane):
+    """The right-hand side's flag of ``kind`` (FLAG_KINDS, or "observer") on the plane
+    with index ``plane`` (an int, 64 bits)."""
+    if kind == "observer":
+        return int(BALLC_WITH_OBSERVER)
+    if not 0 <= plane < BALLC_MAX_PLANES:
+        raise ValueError(f"plane = {plane} is not allowed: must be 0 to {BALLC_MAX_PLANES - 1}")
+    return int(ballc_flag(FLAG_KINDS.index(kind), plane))
+
+
+#: The flags by name for the seed's planes ("floor_friction", ..., and "observer").
+FLAGS = {"observer": int(BALLC_WITH_OBSERVER),
+         **{f"{plane}_{kind}": flag(kind, i) for i, plane in enumerate(SEED_PLANES)
+            for kind in FLAG_KINDS}}
 
 
 cdef inline void _check(name, Py_ssize_t got, Py_ssize_t expected) except *:
@@ -109,17 +166,38 @@ cdef inline void _check(name, Py_ssize_t got, Py_ssize_t expected) except *:
         raise ValueError(f"{name} must have length {expected}, got {got}")
 
 
-cdef enum:
-    BALLC_MAX_STATES = 64   # the stack buffer System copies a state into
+cdef int _planes_of(const double[::1] params) except -1:
+    """The number of planes of a parameter vector (its plane table's count), checked with
+    the vector's length; ValueError when either is not allowed."""
+    if params.shape[0] <= BALLC_PARAMETER_PLANE_COUNT:
+        raise ValueError(f"params must have length >= {BALLC_PARAMETER_PLANES} (the scene's "
+                         f"parameters, then its plane table), got {params.shape[0]}")
+    count = params[BALLC_PARAMETER_PLANE_COUNT]
+    if not (1 <= count <= BALLC_MAX_PLANES and count == int(count)):
+        raise ValueError(f"params: plane_count = {count!r} is not allowed: must be a whole "
+                         f"number from 1 to {BALLC_MAX_PLANES}")
+    cdef int n = int(count)
+    _check("params", params.shape[0], BALLC_PARAMETER_PLANES + n * BALLC_N_PLANE_FIELDS)
+    return n
 
-if BALLC_N_STATES > BALLC_MAX_STATES:   # a layout that outgrew the buffer: refuse to load
-    raise ImportError(f"ballc._core: {BALLC_N_STATES} states exceed the {BALLC_MAX_STATES}-"
-                      "state buffer of System; raise BALLC_MAX_STATES in _core.pyx")
+
+cdef inline int _states(int planes):
+    return BALLC_N_BALL_STATES + BALLC_N_PLANE_STATES * planes
 
 
-cdef inline void _copy_state(const double[:] y, double *ys) except *:
+cdef inline int _latches(int planes):
+    return BALLC_N_LATCH_PER_PLANE * planes
+
+
+def layout_of(params):
+    """(planes, states, latched values) of a run with the parameter vector ``params``."""
+    cdef int n = _planes_of(np.ascontiguousarray(params, dtype=float))
+    return n, _states(n), _latches(n)
+
+
+cdef void _copy_state(const double[:] y, double *ys, int n) except *:
     """Copy a (possibly strided) state into a C buffer; integrators may pass views."""
-    _check("y", y.shape[0], BALLC_N_STATES)
+    _check("y", y.shape[0], n)
     cdef Py_ssize_t i
     for i in range(y.shape[0]):
         ys[i] = y[i]
@@ -128,22 +206,25 @@ cdef inline void _copy_state(const double[:] y, double *ys) except *:
 cdef class System:
     """f(t, y) and its Jacobian for one integration segment.
 
-    ``params`` (N_PARAMETERS) and ``latch`` (N_LATCH) are copied; ``flags`` selects
-    the contributions (see FLAGS).  A state at which the equations cannot be
-    evaluated (non-finite values, mass matrix not positive definite) gives NaNs,
-    which makes the integrator reject the step; ``failures`` counts them.
+    ``params`` (the run's parameter vector, its plane table included) and ``latch`` (its
+    latched values) are copied; ``flags`` selects the contributions (see FLAGS, flag).  A
+    state at which the equations cannot be evaluated (non-finite values, mass matrix not
+    positive definite) gives NaNs, which makes the integrator reject the step;
+    ``failures`` counts them.
     """
     cdef double[::1] _params
     cdef double[::1] _latch
     cdef object _params_array, _latch_array   # the arrays _params and _latch view
-    cdef readonly int flags
+    cdef readonly long long flags
+    cdef readonly int n_states
     cdef public long nfev, njev, failures
 
-    def __init__(self, const double[::1] params, const double[::1] latch, int flags):
-        _check("params", params.shape[0], BALLC_N_PARAMETERS)
-        _check("latch", latch.shape[0], BALLC_N_LATCH)
-        self._params_array = np.empty(BALLC_N_PARAMETERS)
-        self._latch_array = np.empty(BALLC_N_LATCH)
+    def __init__(self, const double[::1] params, const double[::1] latch, long long flags):
+        cdef int planes = _planes_of(params)
+        _check("latch", latch.shape[0], _latches(planes))
+        self.n_states = _states(planes)
+        self._params_array = np.empty(params.shape[0])
+        self._latch_array = np.empty(latch.shape[0])
         self._params = self._params_array
         self._latch = self._latch_array
         self._params[:] = params
@@ -165,8 +246,8 @@ cdef class System:
 
     def __call__(self, double t, const double[:] y):
         cdef double ys[BALLC_MAX_STATES]
-        _copy_state(y, ys)
-        out = np.empty(BALLC_N_STATES)
+        _copy_state(y, ys, self.n_states)
+        out = np.empty(self.n_states)
         cdef double[::1] o = out
         self.nfev += 1
         if ballc_rhs(ys, &self._params[0], &self._latch[0], self.flags, &o[0]) != BALLC_OK:
@@ -176,8 +257,8 @@ cdef class System:
 
     def jacobian(self, double t, const double[:] y):
         cdef double ys[BALLC_MAX_STATES]
-        _copy_state(y, ys)
-        out = np.empty((BALLC_N_STATES, BALLC_N_STATES))
+        _copy_state(y, ys, self.n_states)
+        out = np.empty((self.n_states, self.n_states))
         cdef double[:, ::1] o = out
         self.njev += 1
         if ballc_jacobian(ys, &self._params[0], &self._latch[0], self.flags,
@@ -187,12 +268,20 @@ cdef class System:
         return out
 
 
-def rhs(const double[::1] y, const double[::1] params, const double[::1] latch, int flags):
-    """State derivative (N_STATES) at one state; raises if it cannot be evaluated."""
-    _check("y", y.shape[0], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latch", latch.shape[0], BALLC_N_LATCH)
-    out = np.empty(BALLC_N_STATES)
+cdef int _check_call(const double[::1] params, Py_ssize_t states, Py_ssize_t latch) except -1:
+    """The planes of ``params``, checked with a state's and a latch's length (-1: none)."""
+    cdef int planes = _planes_of(params)
+    _check("y", states, _states(planes))
+    if latch >= 0:
+        _check("latch", latch, _latches(planes))
+    return planes
+
+
+def rhs(const double[::1] y, const double[::1] params, const double[::1] latch,
+        long long flags):
+    """State derivative (the run's states) at one state; raises if it cannot be evaluated."""
+    _check_call(params, y.shape[0], latch.shape[0])
+    out = np.empty(y.shape[0])
     cdef double[::1] o = out
     cdef int status = ballc_rhs(&y[0], &params[0], &latch[0], flags, &o[0])
     if status != BALLC_OK:
@@ -201,12 +290,10 @@ def rhs(const double[::1] y, const double[::1] params, const double[::1] latch, 
 
 
 def jacobian(const double[::1] y, const double[::1] params, const double[::1] latch,
-             int flags):
-    """Jacobian (N_STATES x N_STATES) at one state; raises if it cannot be evaluated."""
-    _check("y", y.shape[0], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latch", latch.shape[0], BALLC_N_LATCH)
-    out = np.empty((BALLC_N_STATES, BALLC_N_STATES))
+             long long flags):
+    """Jacobian (states x states) at one state; raises if it cannot be evaluated."""
+    _check_call(params, y.shape[0], latch.shape[0])
+    out = np.empty((y.shape[0], y.shape[0]))
     cdef double[:, ::1] o = out
     cdef int status = ballc_jacobian(&y[0], &params[0], &latch[0], flags, &o[0, 0])
     if status != BALLC_OK:
@@ -215,16 +302,14 @@ def jacobian(const double[::1] y, const double[::1] params, const double[::1] la
 
 
 def rhs_per_sample(const double[:, ::1] states, const double[::1] params,
-                   const double[:, ::1] latch, const int[::1] flags):
-    """(n, N_STATES): the state derivative at each state row, with that row's latched
+                   const double[:, ::1] latch, const long long[::1] flags):
+    """(n, states): the state derivative at each state row, with that row's latched
     values and flags (what ``rhs`` gives row by row, in one call); a row whose
     right-hand side cannot be evaluated raises, as ``rhs`` does."""
-    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latch.shape[1]", latch.shape[1], BALLC_N_LATCH)
+    _check_call(params, states.shape[1], latch.shape[1])
     _check("latch.shape[0]", latch.shape[0], states.shape[0])
     _check("flags", flags.shape[0], states.shape[0])
-    out = np.empty((states.shape[0], BALLC_N_STATES))
+    out = np.empty((states.shape[0], states.shape[1]))
     cdef double[:, ::1] o = out
     cdef Py_ssize_t i
     cdef int status
@@ -243,8 +328,7 @@ ctypedef void (*system_fn)(const double *, const ballc_parameters_t *, double *)
 
 cdef object _per_row(kernel_fn kernel, int nout, const double[:, ::1] states,
                      const double[::1] params):
-    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _check_call(params, states.shape[1], -1)
     out = np.empty((states.shape[0], nout))
     cdef double[:, ::1] o = out
     cdef Py_ssize_t i
@@ -255,11 +339,10 @@ cdef object _per_row(kernel_fn kernel, int nout, const double[:, ::1] states,
     return out
 
 
-cdef object _per_row_of_system(system_fn function, int nout, const double[:, ::1] states,
-                               const double[::1] params):
-    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    out = np.empty((states.shape[0], nout))
+cdef object _per_row_of_system(system_fn function, int per_plane, int fixed,
+                               const double[:, ::1] states, const double[::1] params):
+    cdef int planes = _check_call(params, states.shape[1], -1)
+    out = np.empty((states.shape[0], fixed + per_plane * planes))
     cdef double[:, ::1] o = out
     cdef Py_ssize_t i
     cdef ballc_parameters_t prepared
@@ -270,26 +353,26 @@ cdef object _per_row_of_system(system_fn function, int nout, const double[:, ::1
 
 
 def energies(const double[:, ::1] states, const double[::1] params):
-    """(n, 6): kinetic, potential, spring floor, spring ceiling, tangential spring floor,
-    tangential spring ceiling (J) per state row."""
-    return _per_row_of_system(ballc_energy, BALLC_ENERGY_NOUT, states, params)
+    """(n, 2 + 2 planes): kinetic, potential, each plane's Hertz spring, each plane's
+    tangential spring (J) per state row."""
+    return _per_row_of_system(ballc_energy, 2, 2, states, params)
 
 
 def contact_kinematics(const double[:, ::1] states, const double[::1] params):
-    """(n, 10): per plane rho, rhodot, contact-point velocity x, y, z (inertial)."""
-    return _per_row_of_system(ballc_contact_kinematics, BALLC_CONTACT_KINEMATICS_NOUT, states,
-                              params)
+    """(n, 5 planes): per plane rho, rhodot, contact-point velocity x, y, z (inertial)."""
+    return _per_row_of_system(ballc_contact_kinematics, BALLC_CONTACT_KINEMATICS_PER_PLANE, 0,
+                              states, params)
 
 
 def plane_frames(const double[::1] params):
-    """(N_PLANES, 3, 3): each plane's frame as the C core builds it from the parameters'
+    """(planes, 3, 3): each plane's frame as the C core builds it from the parameters'
     plane table, rows t1, t2, n (inertial components; see _plane.h)."""
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    out = np.empty((BALLC_N_PLANES, 3, 3))
+    cdef int planes = _planes_of(params)
+    out = np.empty((planes, 3, 3))
     cdef ballc_parameters_t prepared
     cdef int p, i, j
     ballc_parameters_init(&prepared, &params[0])
-    for p in range(BALLC_N_PLANES):
+    for p in range(planes):
         for i in range(3):
             for j in range(3):
                 out[p, i, j] = prepared.planes[p].frame[i][j]
@@ -302,13 +385,11 @@ def observer_positions(const double[:, ::1] states, const double[::1] params):
 
 
 def contact_forces(const double[:, ::1] states, const double[::1] params,
-                   const double[::1] latch, int flags):
-    """(n, 6): sum of the contact forces on the ball (N), floor x y z then ceiling x y z,
-    at each state row, for the contact laws selected by ``flags``."""
-    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latch", latch.shape[0], BALLC_N_LATCH)
-    out = np.empty((states.shape[0], 6))
+                   const double[::1] latch, long long flags):
+    """(n, 3 planes): sum of the contact forces on the ball (N), each plane's x y z in
+    turn, at each state row, for the contact laws selected by ``flags``."""
+    cdef int planes = _check_call(params, states.shape[1], latch.shape[0])
+    out = np.empty((states.shape[0], 3 * planes))
     cdef double[:, ::1] o = out
     cdef Py_ssize_t i
     for i in range(states.shape[0]):
@@ -317,41 +398,41 @@ def contact_forces(const double[:, ::1] states, const double[::1] params,
     return out
 
 
-def _plane_index(int plane):
-    if plane not in (0, 1):
-        raise ValueError(f"plane must be 0 (floor) or 1 (ceiling), got {plane}")
+cdef int _plane_index(int plane, int planes) except -1:
+    if not 0 <= plane < planes:
+        raise ValueError(f"plane must be 0 to {planes - 1} (an index of the plane table), "
+                         f"got {plane}")
     return plane
 
 
 def slip_map(const double[::1] params, int plane):
-    """(2, N_STATES): du/dx of the slip velocity u of ``plane``'s contact point, its
+    """(2, states): du/dx of the slip velocity u of ``plane``'s contact point, its
     components along the plane's tangents t1, t2 (plane_frames); u is linear in the
     state, u = slip_map . y."""
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _plane_index(plane)
+    cdef int planes = _planes_of(params)
+    _plane_index(plane, planes)
+    cdef int n = _states(planes)
     cdef double ys[BALLC_MAX_STATES]
-    out = np.empty(BALLC_SLIP_NOUT)
+    out = np.empty(BALLC_MAX_SLIP_NOUT)
     cdef double[::1] o = out
     cdef Py_ssize_t i
     cdef ballc_parameters_t prepared
     ballc_parameters_init(&prepared, &params[0])
-    for i in range(BALLC_N_STATES):
+    for i in range(n):
         ys[i] = 0.0
     ballc_slip_state(ys, &prepared, plane, &o[0])
-    return out[2:2 + 2 * BALLC_N_STATES].reshape(2, BALLC_N_STATES)
+    return out[2:2 + 2 * n].reshape(2, n)
 
 
 cdef void _check_plane_call(const double[::1] y, const double[::1] params,
                             const double[::1] latch, int plane) except *:
     """The lengths of a per-plane entry point's inputs, and its plane."""
-    _check("y", y.shape[0], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latch", latch.shape[0], BALLC_N_LATCH)
-    _plane_index(plane)
+    cdef int planes = _check_call(params, y.shape[0], latch.shape[0])
+    _plane_index(plane, planes)
 
 
 def stick_state(const double[::1] y, const double[::1] params, const double[::1] latch,
-                int flags, int plane):
+                long long flags, int plane):
     """(lambda_x, lambda_y, N, margin) of a sticking ``plane``: the constraint force (N)
     that holds the slip velocity, the friction share's normal force (N) and
     mu N - |lambda| (N); raises if it cannot be evaluated (flags must hold the plane's
@@ -380,13 +461,13 @@ def compliant_margins(const double[::1] y, const double[::1] params, const doubl
     return out
 
 
-def remove_slip(const double[::1] y, const double[::1] params, int flags, int plane):
+def remove_slip(const double[::1] y, const double[::1] params, long long flags, int plane):
     """The state with ``plane``'s slip velocity set to zero by a tangential impulse at
-    the contact point (for slip-to-stick transitions, where it is at rounding level)."""
-    _check("y", y.shape[0], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _plane_index(plane)
-    out = np.empty(BALLC_N_STATES)
+    the contact point (for slip-to-stick transitions, where it is at rounding level);
+    every other plane sticking under ``flags`` keeps its slip."""
+    cdef int planes = _check_call(params, y.shape[0], -1)
+    _plane_index(plane, planes)
+    out = np.empty(y.shape[0])
     cdef double[::1] o = out
     cdef int status = ballc_remove_slip(&y[0], &params[0], flags, plane, &o[0])
     if status != BALLC_OK:
@@ -395,15 +476,13 @@ def remove_slip(const double[::1] y, const double[::1] params, int flags, int pl
 
 
 def contact_forces_per_sample(const double[:, ::1] states, const double[::1] params,
-                              const double[:, ::1] latches, const int[::1] flags):
-    """(n, 6): as contact_forces, with each state row's own latched values (row of
-    ``latches``, (n, N_LATCH)) and flags -- one call for a whole run's samples."""
-    _check("states.shape[1]", states.shape[1], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latches.shape[1]", latches.shape[1], BALLC_N_LATCH)
+                              const double[:, ::1] latches, const long long[::1] flags):
+    """(n, 3 planes): as contact_forces, with each state row's own latched values (row of
+    ``latches``) and flags -- one call for a whole run's samples."""
+    cdef int planes = _check_call(params, states.shape[1], latches.shape[1])
     _check("latches.shape[0]", latches.shape[0], states.shape[0])
     _check("flags", flags.shape[0], states.shape[0])
-    out = np.empty((states.shape[0], 6))
+    out = np.empty((states.shape[0], 3 * planes))
     cdef double[:, ::1] o = out
     cdef Py_ssize_t i, j
     cdef bint params_finite = True
@@ -415,7 +494,7 @@ def contact_forces_per_sample(const double[:, ::1] states, const double[::1] par
         for i in range(states.shape[0]):
             if not params_finite or ballc_contact_forces_prepared(
                     &states[i, 0], &prepared, &latches[i, 0], flags[i], &o[i, 0]) != BALLC_OK:
-                for j in range(6):
+                for j in range(3 * planes):
                     o[i, j] = NAN
     return out
 # ---- the radau5 integrator (imported as ballc._radau5) ----
@@ -429,7 +508,7 @@ include "_driver_bridge.pxi"
 def parameter_constants(const double[::1] params):
     """The parameter constants (PARAMETER_CONSTANT_NAMES) of a parameter vector, as the
     kernels read them (computed in C, once per segment, by the integrator's adapter)."""
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _planes_of(params)
     out = np.empty(BALLC_N_PARAMETER_CONSTANTS)
     cdef double[::1] o = out
     if BALLC_N_PARAMETER_CONSTANTS:
@@ -439,7 +518,7 @@ def parameter_constants(const double[::1] params):
 
 def hertz_stiffness(const double[::1] params):
     """k0 (N/m^(3/2)) of the generated contact law, from the parameter vector."""
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    _planes_of(params)
     cdef double state[BALLC_MAX_STATES]
     cdef double k0
     cdef ballc_parameters_t prepared

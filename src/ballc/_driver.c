@@ -14,12 +14,13 @@
 #include "_integrator.h"
 #include "_system.h"
 
-#define N BALLC_N_STATES
-#define NL BALLC_N_LATCH
+#define N BALLC_MAX_STATES   /* room for a state; the run's are r->ns (params' planes) */
+#define NL BALLC_MAX_LATCH   /* room for a latch; the run's is r->nl */
 #define NLP BALLC_N_LATCH_PER_PLANE
-#define DRIVER_EVENTS 12  /* the driver's own events of a segment, at most */
-#define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
-#define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
+#define MAXP BALLC_MAX_PLANES
+#define EVENTS_PER_PLANE 6   /* the driver's own events of a segment per plane, at most */
+#define SLIP_D BALLC_LATCH_SLIP_DIRECTION_X   /* within a plane's latch block */
+#define KIN_PER_PLANE BALLC_CONTACT_KINEMATICS_PER_PLANE
 
 #define CLEAR_FACTOR BALLC_CLEAR_FACTOR
 #define PASS_FACTOR BALLC_PASS_FACTOR
@@ -66,19 +67,34 @@ void ballc_drive_free(ballc_drive_output *o)
 
 /* ---- the run: contacts, modes and latches between segments ---- */
 
+/* A plane's penetration as the driver's events take it: rho = coef . (x, y, z) + offset
+ * with coef = -n, offset = r + n . p (n the unit normal, p the plane's point); with
+ * ``axis`` >= 0 the normal is along that coordinate axis and rho = scale * y[axis] +
+ * offset (the event of one state: the seed's floor and ceiling, and exact flight's
+ * quadratic in one coordinate).  ``position``: the centre's coordinate where it touches
+ * an axis-aligned plane (compliantmodes.plane_position), whose ulps set the thresholds;
+ * a tilted plane's are set per segment from the state (plane_position below). */
+typedef struct {
+    double coef[3], offset, scale, position;
+    int axis;
+} plane_geometry;
+
 typedef struct {
     const ballc_drive_config *c;
     ballc_drive_output *o;
     ballc_parameters_t prepared;
+    int np, ns, nl;             /* the run's planes, states and latched values */
+    plane_geometry geometry[MAXP];
+    double gravity[3];          /* params' gravity vector (m/s^2) */
     double t, y[N], latch[NL];
-    int in_contact[2], coulomb[2];
-    double approach[2];
-    int has_approach[2];
-    long relatches[2], transitions[2], stalled;
+    int in_contact[MAXP], coulomb[MAXP];
+    double approach[MAXP];
+    int has_approach[MAXP];
+    long relatches[MAXP], transitions[MAXP], stalled;
     double last_transition;
     int has_last_transition;
-    double dissipated_at_start[2][2];
-    double rest_check[2];
+    double dissipated_at_start[MAXP][2];
+    double rest_check[MAXP];
     int status, stop_code, stop_plane;
     int failed_kernel;          /* a C kernel failed: the run is aborted */
     const char *why;            /* why the run was aborted (BALLC_DRIVE_ABORTED) */
@@ -95,14 +111,14 @@ typedef struct {
     double *ev_scale;                /*   and its coefficient */
     double *flight_s;                /* exact flight's hits (s, event), 2 per event, */
     int *flight_e, *flight_seen;     /*   and their counts */
-    int seg_flags;
+    ballc_flags seg_flags;
     /* the user's events: occurrences so far, a callback's error */
     long *user_seen;
     int user_failed;
     /* the compliant law's modes: per plane */
-    int compliant[2], armed[2], capacity_row[2];   /* COMPLIANT_*, bool, -1 or 4/5 */
-    int has_step[2];
-    double step_bound[2], step_until[2];           /* contact_step: (bound, until) */
+    int compliant[MAXP], armed[MAXP], capacity_row[MAXP];   /* COMPLIANT_*, bool, -1 or 4/5 */
+    int has_step[MAXP];
+    double step_bound[MAXP], step_until[MAXP];              /* contact_step: (bound, until) */
     int fired_row;
     /* the bridge's _ball_event cache: the last compliant margins computed */
     double margins_y[N], margins_out[6];
@@ -121,8 +137,12 @@ typedef struct {
 } run_t;
 
 enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
-#define CAPACITY_FIRST (2 + 2 * 4)    /* the capacity guards' event codes (rows 4, 5) */
-#define CAPACITY_SECOND (2 + 2 * 5)
+/* A compliant guard's event code: MARGIN_CODE + row * MAXP + plane (its margins' row);
+ * the capacity guards are rows 4 and 5.  Codes 0 .. MAXP - 1: a plane's stick release;
+ * <= -2: the user's callable -2 - k. */
+#define MARGIN_CODE MAXP
+#define CAPACITY_FIRST (MARGIN_CODE + 4 * MAXP)
+#define CAPACITY_SECOND (MARGIN_CODE + 5 * MAXP)
 
 enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE,
        K_ARM, K_YIELD, K_RESTICK, K_CAPACITY, K_USER };   /* from K_APPROACH on: CARRY_STEP */
@@ -154,7 +174,8 @@ static int plane_mode(const run_t *r, int p)
             ? BALLC_PLANE_PASSED_THROUGH : BALLC_PLANE_FLIGHT;
     if (r->o->end_kind != BALLC_END_NONE && r->o->end_plane == p)
         return r->o->end_kind == BALLC_END_REST ? BALLC_PLANE_RESTING
-            : r->o->end_kind == BALLC_END_ROLLING ? BALLC_PLANE_ROLLING
+            : r->o->end_kind == BALLC_END_ROLLING
+              || r->o->end_kind == BALLC_END_ACCELERATING ? BALLC_PLANE_ROLLING
             : BALLC_PLANE_FREE_SLIDING;
     switch (r->coulomb[p]) {
     case BALLC_MODE_SLIP: return BALLC_PLANE_SLIP;
@@ -175,7 +196,8 @@ static void log_open(run_t *r)
     g->t_start = r->t;
     g->plane = -1;
     g->rearm_kind = g->rearm_plane = g->rearm_before = g->rearm_after = -1;
-    for (int p = 0; p < 2; p++) g->before[p] = (signed char)plane_mode(r, p);
+    for (int p = 0; p < MAXP; p++)
+        g->before[p] = p < r->np ? (signed char)plane_mode(r, p) : (signed char)-1;
 }
 
 /* An event of plane p re-armed inside the segment, leaving it in mode ``before``. */
@@ -200,40 +222,113 @@ static int log_close(run_t *r, int end, int plane, double t_end)
     g->end = end;
     g->plane = plane;
     g->t_end = t_end;
-    for (int p = 0; p < 2; p++) g->after[p] = (signed char)plane_mode(r, p);
+    for (int p = 0; p < MAXP; p++)
+        g->after[p] = p < r->np ? (signed char)plane_mode(r, p) : (signed char)-1;
     o->log[o->n_log++] = *g;
     return 0;
 }
 
 /* the segment's right-hand-side flags: the observer's kernels (when it has mass), each
  * contact's laws and, ``with_coulomb``, its exact Coulomb mode or compliant mode */
-static int run_flags(const run_t *r, int with_coulomb)
+static ballc_flags run_flags(const run_t *r, int with_coulomb)
 {
     const ballc_drive_config *c = r->c;
-    int flags = c->observer_bits;
-    for (int p = 0; p < 2; p++) {
+    ballc_flags flags = c->observer_bits;
+    for (int p = 0; p < r->np; p++) {
         if (!r->in_contact[p]) continue;
         if (c->compliant_modes) {   /* the law's mode: sliding, elastic once armed */
-            if (r->compliant[p] == COMPLIANT_SLIDING) flags |= c->sliding_bits[p];
+            if (r->compliant[p] == COMPLIANT_SLIDING)
+                flags |= ballc_flag(BALLC_KIND_COMPLIANT_SLIDING, p);
             else if (r->compliant[p] == COMPLIANT_ELASTIC && r->armed[p])
-                flags |= c->elastic_bits[p];
-            else flags |= c->compliant_bits[p];
+                flags |= ballc_flag(BALLC_KIND_COMPLIANT_ELASTIC, p);
+            else flags |= ballc_flag(BALLC_KIND_COMPLIANT, p);
             continue;
         }
         flags |= c->contact_bits[p];
         if (with_coulomb) {
-            if (r->coulomb[p] == BALLC_MODE_SLIP) flags |= c->slip_bits[p];
-            else if (r->coulomb[p] == BALLC_MODE_SLIP_FIXED) flags |= c->slip_fixed_bits[p];
-            else if (r->coulomb[p] == BALLC_MODE_STICK) flags |= c->stick_bits[p];
+            if (r->coulomb[p] == BALLC_MODE_SLIP) flags |= ballc_flag(BALLC_KIND_SLIP, p);
+            else if (r->coulomb[p] == BALLC_MODE_SLIP_FIXED)
+                flags |= ballc_flag(BALLC_KIND_SLIP_FIXED, p);
+            else if (r->coulomb[p] == BALLC_MODE_STICK) flags |= ballc_flag(BALLC_KIND_STICK, p);
         }
     }
     return flags;
 }
 
-/* the plane's penetration rho (m): scale * y[z] + offset */
+/* Whether any plane has the flag of ``kind`` (the integrator's Jacobian options) */
+static int any_plane(const run_t *r, ballc_flags flags, int kind)
+{
+    for (int p = 0; p < r->np; p++)
+        if (flags & ballc_flag(kind, p)) return 1;
+    return 0;
+}
+
+/* the plane's penetration rho (m), as its events take it (plane_geometry) */
 static double rho_of(const run_t *r, int p, const double *y)
 {
-    return r->c->rho_scale[p] * y[BALLC_STATE_Z] + r->c->rho_offset[p];
+    const plane_geometry *g = &r->geometry[p];
+    if (g->axis >= 0) return g->scale * y[g->axis] + g->offset;
+    return g->coef[0] * y[BALLC_STATE_X] + g->coef[1] * y[BALLC_STATE_Y]
+           + g->coef[2] * y[BALLC_STATE_Z] + g->offset;
+}
+
+/* the penetration rate rho' = -n . v */
+static double rho_rate(const run_t *r, int p, const double *y)
+{
+    const plane_geometry *g = &r->geometry[p];
+    if (g->axis >= 0) return g->scale * y[g->axis + 6];
+    return g->coef[0] * y[BALLC_STATE_VX] + g->coef[1] * y[BALLC_STATE_VY]
+           + g->coef[2] * y[BALLC_STATE_VZ];
+}
+
+/* The magnitude of the centre's coordinate along the plane where it touches it
+ * (compliantmodes.plane_position), whose ulps set the contact thresholds and the
+ * compliant guards' rounding: an axis-aligned plane's constant; a tilted plane's, the
+ * terms rho sums at state y (its rounding grows with them). */
+static double plane_position(const run_t *r, int p, const double *y)
+{
+    const plane_geometry *g = &r->geometry[p];
+    if (g->axis >= 0) return g->position;
+    return fabs(g->coef[0] * y[BALLC_STATE_X]) + fabs(g->coef[1] * y[BALLC_STATE_Y])
+           + fabs(g->coef[2] * y[BALLC_STATE_Z]) + fabs(g->offset);
+}
+
+/* compliantmodes.arm_penetration at state y; 0 when contacts begin at rho = 0 */
+static double arm_depth(const run_t *r, int p, const double *y)
+{
+    if (!r->c->starts_armed) return 0.0;
+    return py_max(BALLC_ARM_ULPS * ulp(plane_position(r, p, y)), r->c->arm_force_depth);
+}
+
+/* The run's plane geometry (plane_geometry) and gravity vector, from the prepared
+ * parameters: once per run. */
+static void plane_setup(run_t *r)
+{
+    const double radius = r->c->radius;
+    for (int p = 0; p < r->np; p++) {
+        const ballc_plane_t *pl = &r->prepared.planes[p];
+        const double *n = pl->frame[2], *point = pl->point;
+        plane_geometry *g = &r->geometry[p];
+        g->axis = -1;
+        int zeros = 0, along = -1;
+        for (int i = 0; i < 3; i++) {
+            g->coef[i] = -n[i];
+            if (n[i] == 0.0) zeros++;
+            else along = i;
+        }
+        if (zeros == 2) {   /* along a coordinate axis: the event of one state */
+            g->axis = BALLC_STATE_X + along;
+            g->scale = -n[along];
+            g->offset = radius + n[along] * point[along];
+            /* the centre's coordinate where it touches: p + r along n */
+            g->position = fabs(point[along] + n[along] * radius);
+        } else {
+            g->scale = 0.0;
+            g->offset = radius + (n[0] * point[0] + n[1] * point[1] + n[2] * point[2]);
+            g->position = 0.0;
+        }
+    }
+    for (int i = 0; i < 3; i++) r->gravity[i] = r->c->params[BALLC_PARAMETER_GRAVITY_X + i];
 }
 
 /* keep a contact's deepest penetration and where it happened */
@@ -243,6 +338,7 @@ static void record_depth(ballc_contact_rec *k, double depth, const double *y)
         k->max_penetration = depth;
         k->contact_point[0] = y[BALLC_STATE_X];
         k->contact_point[1] = y[BALLC_STATE_Y];
+        k->contact_point[2] = y[BALLC_STATE_Z];
     }
 }
 
@@ -263,9 +359,9 @@ static double error_speed(const run_t *r, const double *y)
 static void slip_velocity(const run_t *r, int p, const double *y, double u[2])
 {
     for (int row = 0; row < 2; row++) {
-        const double *m = r->c->slip_map[p][row];
+        const double *m = r->prepared.slip_map[p] + row * r->ns;
         double s = 0.0;
-        for (int j = 0; j < N; j++)
+        for (int j = 0; j < r->ns; j++)
             if (m[j] != 0.0) s += m[j] * y[j];
         u[row] = s;
     }
@@ -335,19 +431,22 @@ static double force_scale(const run_t *r, double load)
  * force lies in the friction cone, else slip from rest along -lambda */
 static int settle(run_t *r, int p)
 {
-    int base = run_flags(r, 0);
+    /* the other planes keep their modes (a second one sticking keeps its slip) */
+    ballc_flags base = run_flags(r, 1) & ~(ballc_flag(BALLC_KIND_SLIP, p)
+                                           | ballc_flag(BALLC_KIND_SLIP_FIXED, p)
+                                           | ballc_flag(BALLC_KIND_STICK, p));
     double y0[N], out[4];
     if (ballc_remove_slip(r->y, r->c->params, base, p, y0) != BALLC_OK) {
         r->failed_kernel = 1;
         return -1;
     }
-    int stick_flags = base | r->c->stick_bits[p];
+    ballc_flags stick_flags = base | ballc_flag(BALLC_KIND_STICK, p);
     if (ballc_stick_state(y0, r->c->params, r->latch, stick_flags, p, out) != BALLC_OK) {
         r->failed_kernel = 1;
         return -1;
     }
     double size = hypot(out[0], out[1]);
-    memcpy(r->y, y0, sizeof y0);
+    memcpy(r->y, y0, r->ns * sizeof(double));
     if (out[3] >= -force_scale(r, out[2]) || size == 0)
         return set_mode(r, p, BALLC_MODE_STICK, NULL, 0, 0.0);
     double d[2] = {-out[0] / size, -out[1] / size};
@@ -372,13 +471,19 @@ static int start_coulomb(run_t *r, int p)
 
 static int deflection_x(int p)
 {
-    return p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X;
+    return ballc_plane_state(p);
 }
 
-/* the law's margins (ballc_compliant_margins); -1 when the kernel failed */
+/* the law's margins (ballc_compliant_margins, with every other plane in contact); -1
+ * when the kernel failed */
 static int margins_of(run_t *r, int p, const double *y, double *m)
 {
-    if (ballc_compliant_margins(y, r->c->params, r->latch, p, m) != BALLC_OK) {
+    int i, ok = 1;
+    for (i = 0; i < r->ns; i++) ok &= isfinite(y[i]) != 0;
+    for (i = 0; i < r->nl; i++) ok &= isfinite(r->latch[i]) != 0;
+    if (!ok || ballc_compliant_margins_prepared(y, &r->prepared, r->latch, run_flags(r, 1),
+                                                p, -1, m) != BALLC_OK) {
+        for (i = 0; i < BALLC_COMPLIANT_MARGINS; i++) m[i] = NAN;
         r->failed_kernel = 1;
         return -1;
     }
@@ -390,7 +495,7 @@ static int margins_of(run_t *r, int p, const double *y, double *m)
 static int at_cap(run_t *r, int p, const double *y, int only_down, double *out)
 {
     int sx = deflection_x(p);
-    memcpy(out, y, N * sizeof(double));
+    memcpy(out, y, r->ns * sizeof(double));
     double s[2] = {out[sx], out[sx + 1]};
     double size = hypot(s[0], s[1]);
     if (!(size > 0)) return 0;
@@ -436,7 +541,7 @@ static int decide(run_t *r, int p, const double *y, int arming, int *mode, doubl
         if (got < 0) return -1;
         if (!got) {
             *mode = COMPLIANT_ELASTIC;
-            memcpy(out, y, N * sizeof(double));
+            memcpy(out, y, r->ns * sizeof(double));
             return 0;
         }
         trial[sx] = along[0];
@@ -446,7 +551,7 @@ static int decide(run_t *r, int p, const double *y, int arming, int *mode, doubl
     if (margins_of(r, p, trial, m)) return -1;
     if (m[1] >= 0) {
         *mode = COMPLIANT_SLIDING;
-        memcpy(out, relaxed ? trial : y, N * sizeof(double));
+        memcpy(out, relaxed ? trial : y, r->ns * sizeof(double));
         return 0;
     }
     *mode = COMPLIANT_ELASTIC;
@@ -467,11 +572,11 @@ static int set_compliant(run_t *r, int p, int mode)
 static int start_compliant(run_t *r, int p, double rate)
 {
     const ballc_drive_config *c = r->c;
-    r->armed[p] = rho_of(r, p, r->y) >= 0.5 * c->arm_depth[p];
+    r->armed[p] = rho_of(r, p, r->y) >= 0.5 * arm_depth(r, p, r->y);
     int mode;
     double y[N];
     if (decide(r, p, r->y, 1, &mode, y)) return -1;
-    memcpy(r->y, y, sizeof y);
+    memcpy(r->y, y, r->ns * sizeof(double));
     if (set_compliant(r, p, mode)) return -1;
     double t_c = c->contact_time_base * pow(rate, -0.2);   /* Hertz's contact time */
     r->has_step[p] = 1;
@@ -484,7 +589,7 @@ static int start_compliant(run_t *r, int p, double rate)
 static double run_max_step(const run_t *r)
 {
     double step = r->c->max_step;
-    for (int p = 0; p < 2; p++)
+    for (int p = 0; p < r->np; p++)
         if (r->has_step[p] && r->step_until[p] > r->t) step = py_min(step, r->step_bound[p]);
     return step;
 }
@@ -494,12 +599,36 @@ static double step_bound_end(const run_t *r)
 {
     double end = INFINITY;
     int found = 0;
-    for (int p = 0; p < 2; p++)
+    for (int p = 0; p < r->np; p++)
         if (r->has_step[p] && r->step_until[p] > r->t) {
             end = found ? py_min(end, r->step_until[p]) : r->step_until[p];
             found = 1;
         }
     return end;
+}
+
+/* Whether plane p is an incline where rolling down may end in closed form: not the
+ * resting plane, gravity pressing the ball into it, and the rotation exact (massless
+ * observer, isotropic inertia: flight.scene_allows) */
+static int is_incline(const run_t *r, int p)
+{
+    const double *n = r->prepared.planes[p].frame[2], *g = r->gravity;
+    return r->c->rolls_allowed && p != r->c->resting_plane
+           && n[0] * g[0] + n[1] * g[1] + n[2] * g[2] < 0;
+}
+
+/* The plane whose rest checks apply in the segment starting now: the one plane in
+ * contact, when it is the resting plane or an incline; -1 when none */
+static int checked_plane(const run_t *r)
+{
+    int found = -1;
+    for (int p = 0; p < r->np; p++) {
+        if (!r->in_contact[p]) continue;
+        if (found >= 0) return -1;   /* two planes at once */
+        found = p;
+    }
+    if (found < 0 || !(found == r->c->resting_plane || is_incline(r, found))) return -1;
+    return found;
 }
 
 /* the automaton's "enter": latch rhodot^- and the dig-in direction (ballc.modes), relax
@@ -509,7 +638,7 @@ static int begin_contact(run_t *r, int p)
     const ballc_drive_config *c = r->c;
     ballc_drive_output *o = r->o;
     double *y = r->y;
-    double kin[BALLC_CONTACT_KINEMATICS_NOUT];
+    double kin[BALLC_MAX_CONTACT_KINEMATICS_NOUT];
     ballc_contact_kinematics(y, &r->prepared, kin);
     int k = p * KIN_PER_PLANE;
     double rho = kin[k], rate = kin[k + 1];
@@ -523,16 +652,15 @@ static int begin_contact(run_t *r, int p)
     double speed = norm3(v), direction[3];
     if (speed > 0) {
         for (int i = 0; i < 3; i++) direction[i] = v[i] / speed;
-    } else {
-        direction[0] = direction[1] = 0.0;
-        direction[2] = p == 0 ? -1.0 : 1.0;
+    } else {   /* into the plane, -n */
+        for (int i = 0; i < 3; i++) direction[i] = 0.0 - r->prepared.planes[p].frame[2][i];
     }
     if (MIN_IMPACT_RATE > rate) { rate = MIN_IMPACT_RATE; kernel_rate = 0; }
     int l = p * NLP;
     r->latch[l] = rate;
     for (int i = 0; i < 3; i++) r->latch[l + 1 + i] = direction[i];
-    y[p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_X : BALLC_STATE_CEILING_DEFLECTION_X] = 0.0;
-    y[p == 0 ? BALLC_STATE_FLOOR_DEFLECTION_Y : BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+    y[ballc_plane_state(p)] = 0.0;
+    y[ballc_plane_state(p) + 1] = 0.0;
     r->in_contact[p] = 1;
     if (grow((void **)&o->contacts, &o->cap_contacts, o->n_contacts + 1,
              sizeof(ballc_contact_rec)))
@@ -547,7 +675,7 @@ static int begin_contact(run_t *r, int p)
     rec->rate_is_kernel_value = kernel_rate;
     memcpy(rec->digin, direction, sizeof direction);
     rec->max_penetration = 0.0;
-    rec->contact_point[0] = rec->contact_point[1] = NAN;
+    rec->contact_point[0] = rec->contact_point[1] = rec->contact_point[2] = NAN;
     rec->t_end = NAN;
     record_depth(rec, rho_of(r, p, y), y);
     o->open[p] = (int)o->n_contacts;
@@ -555,7 +683,8 @@ static int begin_contact(run_t *r, int p)
     r->dissipated_at_start[p][0] = y[BALLC_STATE_DISSIPATED_NORMAL];
     r->dissipated_at_start[p][1] = y[BALLC_STATE_DISSIPATED_TANGENTIAL];
     r->relatches[p] = r->transitions[p] = 0;
-    r->rest_check[p] = p == c->resting_plane ? r->t + c->rest_period : INFINITY;
+    r->rest_check[p] = p == c->resting_plane || is_incline(r, p) ? r->t + c->rest_period
+                                                                  : INFINITY;
     if (c->exact && start_coulomb(r, p)) return -1;
     if (c->compliant_modes) return start_compliant(r, p, rate);
     return 0;
@@ -661,11 +790,11 @@ static int coulomb_event(run_t *r, int kind, int p)
             dir[1] = -out[1] / size;
             d = dir;
         }
-        if (ballc_remove_slip(r->y, r->c->params, run_flags(r, 0), p, y1) != BALLC_OK) {
+        if (ballc_remove_slip(r->y, r->c->params, run_flags(r, 1), p, y1) != BALLC_OK) {
             r->failed_kernel = 1;
             return -1;
         }
-        memcpy(r->y, y1, sizeof y1);
+        memcpy(r->y, y1, r->ns * sizeof(double));
         return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
     }
     }
@@ -695,19 +824,19 @@ static int compliant_event(run_t *r, int kind, int p)
     if (kind == K_ARM || kind == K_YIELD) {
         int mode;
         if (decide(r, p, r->y, kind == K_ARM, &mode, y)) return -1;
-        memcpy(r->y, y, sizeof y);
+        memcpy(r->y, y, r->ns * sizeof(double));
         return set_compliant(r, p, mode);
     }
     if (at_cap(r, p, r->y, 1, y)) return -1;   /* restick */
-    memcpy(r->y, y, sizeof y);
+    memcpy(r->y, y, r->ns * sizeof(double));
     return set_compliant(r, p, COMPLIANT_ELASTIC);
 }
 
 /* the row c of u . d = c . y (u is linear in the state) */
 static void stop_coefficients(const run_t *r, int p, const double *d, double *row)
 {
-    const double *a = r->c->slip_map[p][0], *b = r->c->slip_map[p][1];
-    for (int j = 0; j < N; j++) row[j] = d[0] * a[j] + d[1] * b[j];
+    const double *a = r->prepared.slip_map[p], *b = a + r->ns;
+    for (int j = 0; j < r->ns; j++) row[j] = d[0] * a[j] + d[1] * b[j];
 }
 
 /* ---- the integrator's callbacks ---- */
@@ -737,18 +866,18 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
         if (st) r->user_failed = 1;
         return st;
     }
-    if (code >= 2) {   /* a compliant guard: the bridge's _ball_event, with its cache */
-        int row = (code - 2) / 2, plane = code % 2;
+    if (code >= MARGIN_CODE) {   /* a compliant guard: the bridge's _ball_event, cached */
+        int row = (code - MARGIN_CODE) / MAXP, plane = (code - MARGIN_CODE) % MAXP;
         if (r->margins_plane == plane && (row != 1 || r->margins_solved)
-                && memcmp(r->margins_y, y, N * sizeof(double)) == 0) {
+                && memcmp(r->margins_y, y, r->ns * sizeof(double)) == 0) {
             g[0] = r->margins_out[row];
             return BALLC_OK;
         }
-        int st = ballc_compliant_margins_prepared(y, &r->prepared, r->latch, plane, row,
-                                                  r->margins_out);
+        int st = ballc_compliant_margins_prepared(y, &r->prepared, r->latch, r->seg_flags,
+                                                  plane, row, r->margins_out);
         r->margins_plane = st == BALLC_OK ? plane : -1;
         r->margins_solved = row == 1;
-        memcpy(r->margins_y, y, N * sizeof(double));
+        memcpy(r->margins_y, y, r->ns * sizeof(double));
         g[0] = r->margins_out[row];
         return st;
     }
@@ -763,11 +892,11 @@ static int note_rearm(run_t *r, double t)
 {
     if (grow((void **)&r->rearmed_t, &r->cap_rearmed, r->n_rearmed + 1, sizeof(double)))
         return -1;
-    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * NL * sizeof(double));
+    double *lat = realloc(r->rearmed_latch, (size_t)r->cap_rearmed * r->nl * sizeof(double));
     if (!lat) return -1;
     r->rearmed_latch = lat;
     r->rearmed_t[r->n_rearmed] = t;
-    memcpy(r->rearmed_latch + r->n_rearmed * NL, r->latch, NL * sizeof(double));
+    memcpy(r->rearmed_latch + r->n_rearmed * r->nl, r->latch, r->nl * sizeof(double));
     r->n_rearmed++;
     return 0;
 }
@@ -782,10 +911,10 @@ static int user_rearm(run_t *r, int e, double t, const double *y)
     int got = c->rearm_fun(c->user_ctx, r->ev_plane[e], t, y, coef, &offset, latch);
     if (got < 0) r->user_failed = 1;   /* the loop stops: the bridge raises it */
     if (got != 1 || note_rearm(r, t)) return 0;
-    memcpy(r->ev_coef + (size_t)e * N, coef, sizeof coef);
+    memcpy(r->ev_coef + (size_t)e * r->ns, coef, r->ns * sizeof(double));
     r->ev_offset[e] = offset;
     r->ev_index[e] = -1;
-    memcpy(r->latch, latch, sizeof latch);
+    memcpy(r->latch, latch, r->nl * sizeof(double));
     r->margins_plane = -1;   /* the margins read the latch */
     return 1;
 }
@@ -799,7 +928,7 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
     int code = r->ev_plane_code[e];
     int p = r->ev_plane[e];
     if (code >= CAPACITY_FIRST) {   /* the bridge's _ball_rearm: a capacity guard toggles */
-        r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + 2 : code - 2;
+        r->ev_plane_code[e] = code < CAPACITY_SECOND ? code + MAXP : code - MAXP;
         log_rearm(r, K_CAPACITY, p, plane_mode(r, p));
         return 1;
     }
@@ -819,7 +948,7 @@ static int drv_rearm(void *ctx, int e, double t, const double *y)
     int before = plane_mode(r, p);
     if (set_mode(r, p, BALLC_MODE_SLIP, d, 1, approach)) return 0;
     log_rearm(r, K_APPROACH, p, before);
-    stop_coefficients(r, p, d, r->ev_coef + (size_t)e * N);
+    stop_coefficients(r, p, d, r->ev_coef + (size_t)e * r->ns);
     r->ev_offset[e] = -approach;
     r->margins_plane = -1;   /* the margins read the latch */
     return 1;
@@ -831,10 +960,10 @@ static int add_event(run_t *r, int kind, int p, const double *coef, int state, d
                      double offset, int terminal, int direction)
 {
     int k = r->n_ev++;
-    double *row = r->ev_coef + (size_t)k * N;
-    if (coef) memcpy(row, coef, N * sizeof(double));
+    double *row = r->ev_coef + (size_t)k * r->ns;
+    if (coef) memcpy(row, coef, r->ns * sizeof(double));
     else {
-        memset(row, 0, N * sizeof(double));
+        memset(row, 0, r->ns * sizeof(double));
         if (state >= 0) row[state] = scale;
     }
     r->ev_offset[k] = offset;
@@ -850,28 +979,43 @@ static int add_event(run_t *r, int kind, int p, const double *coef, int state, d
     return k;
 }
 
-static int segment_events(run_t *r, int flags)
+/* An event of plane p's penetration, rho + shift (rate: of its rate rho' + shift):
+ * one state's when the plane is axis-aligned, else a row on x, y, z (v) */
+static int add_plane_event(run_t *r, int kind, int p, int rate, double shift, int terminal,
+                           int direction)
+{
+    const plane_geometry *g = &r->geometry[p];
+    double offset = rate ? shift : g->offset + shift;
+    if (g->axis >= 0)
+        return add_event(r, kind, p, NULL, g->axis + (rate ? 6 : 0), g->scale, offset,
+                         terminal, direction);
+    double row[N];
+    memset(row, 0, r->ns * sizeof(double));
+    for (int i = 0; i < 3; i++) row[(rate ? BALLC_STATE_VX : BALLC_STATE_X) + i] = g->coef[i];
+    return add_event(r, kind, p, row, -1, 0, offset, terminal, direction);
+}
+
+static int segment_events(run_t *r, ballc_flags flags)
 {
     const ballc_drive_config *c = r->c;
     const double *y0 = r->y;
     int have_clear = 0;
     double clear = 0.0;
     r->n_ev = 0;
-    for (int p = 0; p < 2; p++) {
-        double rho0 = c->rho_scale[p] * y0[BALLC_STATE_Z] + c->rho_offset[p];
-        double base = c->threshold_base[p];
+    for (int p = 0; p < r->np; p++) {
+        double rho0 = rho_of(r, p, y0);
+        double position = plane_position(r, p, y0);
+        double base = 4 * ulp(position);   /* events.threshold_base */
         if (r->in_contact[p]) {
             double threshold = py_max(base, -rho0 + base);
-            add_event(r, K_LEAVE, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
-                      c->rho_offset[p] + threshold, 1, -1);
-            add_event(r, K_THROUGH, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
-                      c->through_offset[p], 1, 1);
-            add_event(r, K_DEEPEST, p, NULL, BALLC_STATE_VZ, p == 0 ? -1.0 : 1.0, 0.0, 0, -1);
+            add_plane_event(r, K_LEAVE, p, 0, threshold, 1, -1);
+            add_plane_event(r, K_THROUGH, p, 0, -c->radius, 1, 1);
+            add_plane_event(r, K_DEEPEST, p, 1, 0.0, 0, -1);
         } else {
             double threshold = py_max(base, rho0 + base);
-            if (c->arm_depth[p] > 0) threshold = py_max(threshold, c->arm_depth[p]);
-            add_event(r, K_ENTER, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
-                      c->rho_offset[p] + (-threshold), 1, 1);
+            double arm = arm_depth(r, p, y0);
+            if (arm > 0) threshold = py_max(threshold, arm);
+            add_plane_event(r, K_ENTER, p, 0, -threshold, 1, 1);
         }
         int mode = r->coulomb[p];
         if (mode == BALLC_MODE_SLIP || mode == BALLC_MODE_SLIP_FIXED) {
@@ -902,17 +1046,17 @@ static int segment_events(run_t *r, int flags)
         }
         if (r->compliant[p] != COMPLIANT_NONE) {   /* the mode's guard */
             if (!r->armed[p]) {   /* the penetration rising through the arming depth */
-                add_event(r, K_ARM, p, NULL, BALLC_STATE_Z, c->rho_scale[p],
-                          c->rho_offset[p] + (-c->arm_depth[p]), 1, 1);
+                add_plane_event(r, K_ARM, p, 0, -arm_depth(r, p, y0), 1, 1);
                 continue;
             }
-            double rounding = py_max(64 * DBL_EPSILON, c->ulp8[p] / py_max(rho0, 1e-300));
+            double ulp8 = 8 * ulp(position);
+            double rounding = py_max(64 * DBL_EPSILON, ulp8 / py_max(rho0, 1e-300));
             int elastic = r->compliant[p] == COMPLIANT_ELASTIC;
             double offset = elastic ? rounding
                                     : rounding * speed_scale(r, y0) * c->restick_factor;
             int k = add_event(r, elastic ? K_YIELD : K_RESTICK, p, NULL, -1, 0, offset, 1, -1);
             r->ev_nonlinear[k] = 1;
-            r->ev_plane_code[k] = 2 + 2 * (elastic ? 0 : 1) + p;
+            r->ev_plane_code[k] = MARGIN_CODE + (elastic ? 0 : 1) * MAXP + p;
             if (elastic && c->damping_positive) {   /* the viscous capacity's kink */
                 double m[BALLC_COMPLIANT_MARGINS];
                 if (margins_of(r, p, y0, m)) return -1;
@@ -921,7 +1065,7 @@ static int segment_events(run_t *r, int flags)
                 k = add_event(r, K_CAPACITY, p, NULL, -1, 0, rounding * py_max(cap, 1e-12),
                               1, -1);
                 r->ev_nonlinear[k] = 1;
-                r->ev_plane_code[k] = 2 + 2 * row + p;
+                r->ev_plane_code[k] = MARGIN_CODE + row * MAXP + p;
                 r->ev_rearm[k] = 1;
             }
         }
@@ -931,7 +1075,7 @@ static int segment_events(run_t *r, int flags)
         int left = c->user_count[u] ? (int)(c->user_count[u] - r->user_seen[u]) : 0;
         double offset = c->user_offset[u];
         if (c->user_linear[u] && left != c->user_count[u]) offset = offset + 0.0;  /* shifted */
-        int k = add_event(r, K_USER, u, c->user_linear[u] ? c->user_coef + (size_t)u * N : NULL,
+        int k = add_event(r, K_USER, u, c->user_linear[u] ? c->user_coef + (size_t)u * r->ns : NULL,
                           -1, 0, offset, left, c->user_direction[u]);
         r->ev_index[k] = c->user_linear[u] ? c->user_index[u] : -1;
         r->ev_scale[k] = c->user_linear[u] ? c->user_scale[u] : 0.0;
@@ -946,33 +1090,37 @@ static int segment_events(run_t *r, int flags)
 
 /* ---- samples: per block of a segment, its flags and latch ---- */
 
-static int add_block(run_t *r, const double *t, const double *y, long count, int flags,
-                     const double *latch)
+static int add_block(run_t *r, const double *t, const double *y, long count,
+                     ballc_flags flags, const double *latch)
 {
     ballc_drive_output *o = r->o;
+    const int ns = r->ns, nl = r->nl;
+    long cap = o->cap;
     if (grow((void **)&o->t, &o->cap, o->n + count, sizeof(double))) return -1;
-    double *yy = realloc(o->y, (size_t)(o->cap ? o->cap : 1) * N * sizeof(double));
-    if (!yy) return -1;
-    o->y = yy;
+    if (o->cap != cap || !o->y) {
+        double *yy = realloc(o->y, (size_t)(o->cap ? o->cap : 1) * ns * sizeof(double));
+        if (!yy) return -1;
+        o->y = yy;
+    }
     long cb = o->cap_blocks;
     if (grow((void **)&o->block_count, &cb, o->n_blocks + 1, sizeof(long))) return -1;
     if (cb != o->cap_blocks) {
-        int *f = realloc(o->block_flags, (size_t)cb * sizeof(int));
+        ballc_flags *f = realloc(o->block_flags, (size_t)cb * sizeof(ballc_flags));
         if (!f) return -1;
         o->block_flags = f;
-        double *l = realloc(o->block_latch, (size_t)cb * NL * sizeof(double));
+        double *l = realloc(o->block_latch, (size_t)cb * nl * sizeof(double));
         if (!l) return -1;
         o->block_latch = l;
         o->cap_blocks = cb;
     }
     if (count) {
         memcpy(o->t + o->n, t, (size_t)count * sizeof(double));
-        memcpy(o->y + (size_t)o->n * N, y, (size_t)count * N * sizeof(double));
+        memcpy(o->y + (size_t)o->n * ns, y, (size_t)count * ns * sizeof(double));
     }
     o->n += count;
     o->block_count[o->n_blocks] = count;
     o->block_flags[o->n_blocks] = flags;
-    memcpy(o->block_latch + (size_t)o->n_blocks * NL, latch, NL * sizeof(double));
+    memcpy(o->block_latch + (size_t)o->n_blocks * nl, latch, nl * sizeof(double));
     o->n_blocks++;
     return 0;
 }
@@ -980,7 +1128,7 @@ static int add_block(run_t *r, const double *t, const double *y, long count, int
 /* a segment's samples later than ``after`` (without t_eval its first sample is its start,
  * stored already), in blocks split where a re-arm changed the latch */
 static int add_later_rows(run_t *r, long n, const double *t, const double *y_out,
-                          double after, int flags)
+                          double after, ballc_flags flags)
 {
     long first = r->c->t_eval ? 0 : 1;   /* simulate: skip */
     while (first < n && t[first] <= after) first++;
@@ -989,16 +1137,16 @@ static int add_later_rows(run_t *r, long n, const double *t, const double *y_out
         long cut = 0;   /* searchsorted(t, when, 'right') */
         while (cut < n && t[cut] <= when) cut++;
         if (cut < first) cut = first;
-        if (add_block(r, t + first, y_out + (size_t)first * N, cut - first, flags,
-                      r->rearmed_latch + (size_t)k * NL))
+        if (add_block(r, t + first, y_out + (size_t)first * r->ns, cut - first, flags,
+                      r->rearmed_latch + (size_t)k * r->nl))
             return -1;
         first = cut;
     }
-    return add_block(r, t + first, y_out + (size_t)first * N, n - first, flags,
+    return add_block(r, t + first, y_out + (size_t)first * r->ns, n - first, flags,
                      r->latch);
 }
 
-static int add_later(run_t *r, const radau5_result *res, double after, int flags)
+static int add_later(run_t *r, const radau5_result *res, double after, ballc_flags flags)
 {
     return add_later_rows(r, res->n_out, res->t_out, res->y_out, after, flags);
 }
@@ -1006,10 +1154,13 @@ static int add_later(run_t *r, const radau5_result *res, double after, int flags
 /* ---- exact free flight (ballc.flight) ---- */
 
 /* The exact solution's coefficients (ballc.flight's docstring): omega, the dissipated
- * work and the deflections constant, the centre a parabola, the quaternion turning at
- * omega, q(s) = cos(|omega| s / 2) q0 + sin(|omega| s / 2) [0, n] (x) q0 */
-void ballc_flight_init(ballc_flight *f, double t0, const double *y0, double gravity)
+ * work and the deflections constant, the centre a parabola under the gravity vector
+ * (3 values), the quaternion turning at omega, q(s) = cos(|omega| s / 2) q0
+ * + sin(|omega| s / 2) [0, n] (x) q0; n states */
+void ballc_flight_init(ballc_flight *f, double t0, const double *y0, const double *gravity,
+                       int n)
 {
+    f->n = n;
     f->t0 = t0;
     double wx = y0[BALLC_STATE_OMEGA_X], wy = y0[BALLC_STATE_OMEGA_Y], wz = y0[BALLC_STATE_OMEGA_Z];
     f->rate = sqrt(wx * wx + wy * wy + wz * wz);
@@ -1020,15 +1171,17 @@ void ballc_flight_init(ballc_flight *f, double t0, const double *y0, double grav
     double turned[4] = {-(nx * qx + ny * qy + nz * qz), nx * qw + ny * qz - nz * qy,
                         ny * qw + nz * qx - nx * qz, nz * qw + nx * qy - ny * qx};
     memset(f->c, 0, sizeof f->c);
-    memcpy(f->c[0], y0, N * sizeof(double));
+    memcpy(f->c[0], y0, n * sizeof(double));
     for (int i = 0; i < 4; i++) {
         f->c[0][BALLC_STATE_QW + i] = 0.0;
         f->c[3][BALLC_STATE_QW + i] = y0[BALLC_STATE_QW + i];
         f->c[4][BALLC_STATE_QW + i] = turned[i];
     }
     for (int i = 0; i < 3; i++) f->c[1][BALLC_STATE_X + i] = y0[BALLC_STATE_VX + i];
-    f->c[1][BALLC_STATE_VZ] = -gravity;
-    f->c[2][BALLC_STATE_Z] = -0.5 * gravity;
+    for (int i = 0; i < 3; i++) {   /* v0 + g s, c0 + v0 s + g s^2 / 2 */
+        f->c[1][BALLC_STATE_VX + i] = gravity[i];
+        f->c[2][BALLC_STATE_X + i] = 0.5 * gravity[i];
+    }
 }
 
 /* y(t): the 5 products of coefficients and basis (1, s, s^2, cos, sin), summed in order */
@@ -1037,11 +1190,58 @@ void ballc_flight_at(const ballc_flight *f, double t, double *y)
     double s = t - f->t0;
     double half = 0.5 * f->rate * s;
     double basis[5] = {1.0, s, s * s, cos(half), sin(half)};
-    for (int n = 0; n < N; n++) {
+    for (int n = 0; n < f->n; n++) {
         double acc = 0.0;
         for (int k = 0; k < 5; k++) acc += f->c[k][n] * basis[k];
         y[n] = acc;
     }
+}
+
+/* ---- rolling down an unbounded incline (the end state BALLC_END_ACCELERATING) ---- */
+
+void ballc_rolling_init(ballc_rolling *f, double t0, const double *y0,
+                        const double *acceleration, double radius, const double *normal,
+                        int n)
+{
+    f->n = n;
+    f->t0 = t0;
+    memcpy(f->y0, y0, n * sizeof(double));
+    const double *a = acceleration, *m = normal;
+    double e[3] = {m[1] * a[2] - m[2] * a[1], m[2] * a[0] - m[0] * a[2],
+                   m[0] * a[1] - m[1] * a[0]};   /* n x a */
+    double size = norm3(e), w0 = 0.0;
+    for (int i = 0; i < 3; i++) {
+        f->a[i] = a[i];
+        f->axis[i] = size > 0 ? e[i] / size : 0.0;
+        w0 += y0[BALLC_STATE_OMEGA_X + i] * f->axis[i];
+    }
+    f->w0 = w0;
+    f->spin_rate = norm3(a) / radius;   /* rad/s^2 */
+}
+
+double ballc_rolling_angle(const ballc_rolling *f, double t)
+{
+    double s = t - f->t0;
+    return f->w0 * s + 0.5 * f->spin_rate * s * s;
+}
+
+void ballc_rolling_at(const ballc_rolling *f, double t, double *y)
+{
+    double s = t - f->t0;
+    memcpy(y, f->y0, f->n * sizeof(double));
+    for (int i = 0; i < 3; i++) {
+        y[BALLC_STATE_X + i] += f->y0[BALLC_STATE_VX + i] * s + 0.5 * f->a[i] * s * s;
+        y[BALLC_STATE_VX + i] += f->a[i] * s;
+        y[BALLC_STATE_OMEGA_X + i] = f->axis[i] * (f->w0 + f->spin_rate * s);
+    }
+    /* q(s) = cos(theta / 2) q0 + sin(theta / 2) [0, e] (x) q0 */
+    double half = 0.5 * ballc_rolling_angle(f, t), c = cos(half), sn = sin(half);
+    const double *q = f->y0 + BALLC_STATE_QW, *e = f->axis;
+    double turned[4] = {-(e[0] * q[1] + e[1] * q[2] + e[2] * q[3]),
+                        e[0] * q[0] + e[1] * q[3] - e[2] * q[2],
+                        e[1] * q[0] + e[2] * q[1] - e[0] * q[3],
+                        e[2] * q[0] + e[0] * q[2] - e[1] * q[1]};
+    for (int i = 0; i < 4; i++) y[BALLC_STATE_QW + i] = c * q[i] + sn * turned[i];
 }
 
 /* the roots of c0 + c1 s + c2 s^2 in [0, s_max] where it changes sign in ``direction``
@@ -1085,9 +1285,10 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
                           radau5_result *res)
 {
     const ballc_drive_config *c = r->c;
-    double t0 = r->t, g = c->gravity;
+    double t0 = r->t;
+    const double *g = r->gravity;
     ballc_flight f;
-    ballc_flight_init(&f, t0, r->y, g);
+    ballc_flight_init(&f, t0, r->y, g, r->ns);
     memset(res, 0, sizeof *res);
     res->stiff_at = NAN;
     res->method_end = -1;
@@ -1104,19 +1305,24 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
         double c0, c1, c2;
         if (k >= 0) {
             double scale = r->ev_scale[e], y0k = r->y[k];
+            int position = k >= BALLC_STATE_X && k <= BALLC_STATE_Z;
+            int velocity = k >= BALLC_STATE_VX && k <= BALLC_STATE_VZ;
             c0 = scale * y0k + r->ev_offset[e];
-            c1 = scale * (k >= BALLC_STATE_X && k <= BALLC_STATE_Z ? r->y[k + 6]
-                          : k == BALLC_STATE_VZ ? -g : 0.0);
-            c2 = k == BALLC_STATE_Z ? -0.5 * scale * g : 0.0;
+            c1 = scale * (position ? r->y[k + 6] : velocity ? g[k - BALLC_STATE_VX] : 0.0);
+            c2 = position ? 0.5 * scale * g[k - BALLC_STATE_X] : 0.0;
         } else {   /* several states (none of the quaternion's): plain C dots */
-            const double *row = r->ev_coef + (size_t)e * N;
+            const double *row = r->ev_coef + (size_t)e * r->ns;
             c0 = 0.0;
-            for (int i = 0; i < N; i++) c0 += row[i] * r->y[i];
+            for (int i = 0; i < r->ns; i++) c0 += row[i] * r->y[i];
             c0 += r->ev_offset[e];
             c1 = 0.0;
             for (int i = 0; i < 3; i++) c1 += row[BALLC_STATE_X + i] * r->y[BALLC_STATE_VX + i];
-            c1 -= row[BALLC_STATE_VZ] * g;
-            c2 = -0.5 * row[BALLC_STATE_Z] * g;
+            c2 = 0.0;
+            for (int i = 0; i < 3; i++) {   /* gravity's share (its zero components none) */
+                if (g[i] == 0.0) continue;
+                c1 += row[BALLC_STATE_VX + i] * g[i];
+                c2 += 0.5 * row[BALLC_STATE_X + i] * g[i];
+            }
         }
         double roots[2];
         int n = ballc_flight_crossings(c0, c1, c2, r->ev_direction[e], span, roots);
@@ -1185,19 +1391,19 @@ static int flight_segment(run_t *r, double t1, const double *ev, long n_eval,
     }
     res->t_out = times;
     res->n_out = n;
-    res->y_out = malloc((size_t)(n ? n : 1) * N * sizeof(double));
+    res->y_out = malloc((size_t)(n ? n : 1) * r->ns * sizeof(double));
     res->hit_event = malloc((size_t)(kept ? kept : 1) * sizeof(int));
     res->hit_t = malloc((size_t)(kept ? kept : 1) * sizeof(double));
-    res->hit_y = malloc((size_t)(kept ? kept : 1) * N * sizeof(double));
+    res->hit_y = malloc((size_t)(kept ? kept : 1) * r->ns * sizeof(double));
     if (!res->y_out || !res->hit_event || !res->hit_t || !res->hit_y) return -2;
-    for (long i = 0; i < n; i++) ballc_flight_at(&f, times[i], res->y_out + (size_t)i * N);
+    for (long i = 0; i < n; i++) ballc_flight_at(&f, times[i], res->y_out + (size_t)i * r->ns);
     for (int h = 0, m = 0; h < nh && m < kept; h++) {
         if (stop >= 0 && !(hs[h] < hs[stop] || (hs[h] == hs[stop] && he[h] <= he[stop])))
             continue;
         double when = h == stop ? t_end : py_min(t0 + hs[h], t1);
         res->hit_event[m] = he[h];
         res->hit_t[m] = when;
-        ballc_flight_at(&f, when, res->hit_y + (size_t)m * N);
+        ballc_flight_at(&f, when, res->hit_y + (size_t)m * r->ns);
         m++;
     }
     res->n_hits = kept;
@@ -1215,11 +1421,14 @@ static void energy_of(const run_t *r, const double *y, double *e)
 /* the energy y has above ``new`` added to new's dissipated_normal */
 static void booked(const run_t *r, const double *y, double *new_y)
 {
-    double a[BALLC_ENERGY_NOUT], b[BALLC_ENERGY_NOUT];
+    double a[BALLC_MAX_ENERGY_NOUT], b[BALLC_MAX_ENERGY_NOUT];
     energy_of(r, y, a);
     energy_of(r, new_y, b);
-    double before = a[0] + a[1] + a[2] + a[3] + a[4] + a[5];
-    double after = b[0] + b[1] + b[2] + b[3] + b[4] + b[5];
+    double before = a[0], after = b[0];
+    for (int i = 1; i < BALLC_ENERGY_NOUT(r->np); i++) {
+        before += a[i];
+        after += b[i];
+    }
     new_y[BALLC_STATE_DISSIPATED_NORMAL] += before - after;
 }
 
@@ -1229,24 +1438,60 @@ static double normal_above(const ballc_drive_config *c, double x)
     return c->rest_weight * c->rho_eq * (0.4 * expm1(2.5 * log1p(x)) - x);
 }
 
-/* whether the contact is at rest (ballc.resting's criteria 2-4) */
-static int at_rest(const run_t *r, const double *y, double t_start, double t)
+/* the compliant law's tangential springs' energy, every plane's (J) */
+static double tangential_springs(const run_t *r, const double *e)
+{
+    double spring = e[2 + r->np];
+    for (int q = 1; q < r->np; q++) spring += e[2 + r->np + q];
+    return spring;
+}
+
+/* The resting plane p's state: y with the centre at the static equilibrium's height
+ * above the plane (r - rho_eq along its normal, which is opposite gravity) and no
+ * velocity along the normal, every deflection 0 */
+static void at_equilibrium(const run_t *r, int p, double *y)
+{
+    const plane_geometry *g = &r->geometry[p];
+    const ballc_plane_t *pl = &r->prepared.planes[p];
+    if (g->axis >= 0) {   /* along a coordinate axis: set that coordinate */
+        int k = g->axis - BALLC_STATE_X;
+        y[g->axis] = pl->point[k] + pl->frame[2][k] * r->c->z_eq;
+        y[g->axis + 6] = 0.0;
+    } else {
+        const double *n = pl->frame[2];
+        double height = 0.0, along = 0.0;
+        for (int i = 0; i < 3; i++) {
+            height += n[i] * (y[BALLC_STATE_X + i] - pl->point[i]);
+            along += n[i] * y[BALLC_STATE_VX + i];
+        }
+        for (int i = 0; i < 3; i++) {
+            y[BALLC_STATE_X + i] += (r->c->z_eq - height) * n[i];
+            y[BALLC_STATE_VX + i] -= along * n[i];
+        }
+    }
+    for (int q = 0; q < r->np; q++)
+        y[ballc_plane_state(q)] = y[ballc_plane_state(q) + 1] = 0.0;
+}
+
+/* whether the contact with plane p is at rest (ballc.resting's criteria 2-4) */
+static int at_rest(const run_t *r, int p, const double *y, double t_start, double t)
 {
     const ballc_drive_config *c = r->c;
     if (t - t_start < c->rest_period) return 0;
     double across = 0.0, up = 0.0;
-    if (c->observer_massive) {   /* the observer's offset from the centre */
-        double where[BALLC_OBSERVER_POSITION_NOUT], d[3];
+    if (c->observer_massive) {   /* the observer's offset from the centre, plane's frame */
+        double where[BALLC_OBSERVER_POSITION_NOUT], d[3], local[3];
         ballc_observer_position(y, c->params, r->prepared.constants, NULL, where);
         for (int i = 0; i < 3; i++) d[i] = where[i] - y[BALLC_STATE_X + i];
-        across = hypot(d[0], d[1]);
-        up = d[2];
+        ballc_plane_to_local(&r->prepared.planes[p], d, local);
+        across = hypot(local[0], local[1]);
+        up = local[2];
         if (up >= 0) return 0;
     }
-    double e[BALLC_ENERGY_NOUT];
+    double e[BALLC_MAX_ENERGY_NOUT];
     energy_of(r, y, e);
-    double kinetic = e[0], spring = e[4] + e[5];
-    double rho = c->radius - y[BALLC_STATE_Z];
+    double kinetic = e[0], spring = tangential_springs(r, e);
+    double rho = rho_of(r, p, y);
     double x = (rho - c->rho_eq) / c->rho_eq;
     double normal = INFINITY;
     if (x > -1) normal = normal_above(c, x);   /* deep: inf, not at rest */
@@ -1270,26 +1515,24 @@ static double max_abs(const double *v, int n)
     return m;
 }
 
-/* uniform rolling or sliding (ballc.resting): BALLC_END_ROLLING / SLIDING with ``roll``
- * the uniform state, 0 none, -1 when a kernel failed */
-static int rolls(run_t *r, const double *y, double t_start, double t,
+/* uniform rolling or sliding on plane p (ballc.resting): BALLC_END_ROLLING / SLIDING
+ * with ``roll`` the uniform state, 0 none, -1 when a kernel failed */
+static int rolls(run_t *r, int p, const double *y, double t_start, double t,
                  double slip_speed, double *roll)
 {
     const ballc_drive_config *c = r->c;
     if (t - t_start < c->rest_period || !c->rolls_allowed) return 0;
-    double e[BALLC_ENERGY_NOUT];
+    double e[BALLC_MAX_ENERGY_NOUT];
     energy_of(r, y, e);
-    double x = (c->radius - y[BALLC_STATE_Z] - c->rho_eq) / c->rho_eq;
+    double x = (rho_of(r, p, y) - c->rho_eq) / c->rho_eq;
     if (!(x > -1)) return 0;
     double normal = normal_above(c, x);
-    double above = c->half_mass * (y[BALLC_STATE_VZ] * y[BALLC_STATE_VZ]) + (e[4] + e[5])
+    double rate_n = rho_rate(r, p, y);
+    double above = c->half_mass * (rate_n * rate_n) + tangential_springs(r, e)
                    + py_max(normal, 0.0);
     if (!(above <= c->rest_threshold)) return 0;
-    memcpy(roll, y, N * sizeof(double));   /* the uniform state, energy booked */
-    roll[BALLC_STATE_Z] = c->z_eq;
-    roll[BALLC_STATE_VZ] = 0.0;
-    roll[BALLC_STATE_FLOOR_DEFLECTION_X] = roll[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
-    roll[BALLC_STATE_CEILING_DEFLECTION_X] = roll[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+    memcpy(roll, y, r->ns * sizeof(double));   /* the uniform state, energy booked */
+    at_equilibrium(r, p, roll);
     booked(r, y, roll);
     double rate[N];
     if (ballc_rhs(roll, c->params, r->latch, run_flags(r, 1), rate) != BALLC_OK) {
@@ -1298,10 +1541,10 @@ static int rolls(run_t *r, const double *y, double t_start, double t,
     }
     double level = c->rolls_level;
     if (max_abs(rate + BALLC_STATE_VX, 3) > level
-            || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level
-            || max_abs(rate + BALLC_STATE_FLOOR_DEFLECTION_X, 2) > level
-            || max_abs(rate + BALLC_STATE_CEILING_DEFLECTION_X, 2) > level)
+            || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level)
         return 0;
+    for (int q = 0; q < r->np; q++)
+        if (max_abs(rate + ballc_plane_state(q), 2) > level) return 0;
     return slip_speed <= c->rolls_dv ? BALLC_END_ROLLING : BALLC_END_SLIDING;
 }
 
@@ -1364,7 +1607,7 @@ static int trial_add(run_t *r, const radau5_result *res, double t0, double t1, i
     }
     if (!res->n_dense) return 0;   /* nothing integrated */
     return ballc_dense_add(d, t0, t1, res->n_dense, res->dense_t, res->dense_c,
-                           res->dense_kind, res->dense_terms, N) ? -2 : 0;
+                           res->dense_kind, res->dense_terms, r->ns) ? -2 : 0;
 }
 
 /* when this check ends the trial under way, the relative periodic
@@ -1388,7 +1631,7 @@ static int check_orbit(run_t *r, int p)
     const ballc_piecewise *solution = ballc_dense_view(d);
     if (!solution) return -2;
     double atol[N];
-    for (int i = 0; i < N; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
+    for (int i = 0; i < r->ns; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
     ballc_orbit_tolerances tol = {c->rtol, atol, c->rest_factor, c->rest_threshold,
                                   c->params};
     ballc_orbit orbit;
@@ -1409,6 +1652,91 @@ static int check_orbit(run_t *r, int p)
     return sticking || speed <= c->rest_factor * error ? BALLC_END_ROLLING : BALLC_END_SLIDING;
 }
 
+/* At a rest check on an incline p: BALLC_END_ACCELERATING (r->y the rolling state,
+ * r->o->end_acceleration its acceleration) when the ball rolls down it uniformly
+ * accelerated and nothing else is reached before t_end, else 0 (the next check
+ * scheduled).  The closed form is exact for a massless observer and isotropic inertia
+ * (checked before: is_incline) once the normal oscillation has settled (its energy about
+ * the static equilibrium under the load M g_n below the rest threshold), the contact
+ * point does not slip, the centre moves along gravity's component in the plane g_t and
+ * the ball does not spin about the normal: then a = g_t / (1 + I / (M r^2)) and the spin
+ * turns about the fixed axis n x a / |a| at |a| / r per second (the lever arm r). */
+static int incline_state(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    const ballc_contact_rec *k = &r->o->contacts[r->o->open[p]];
+    r->seg.end = BALLC_SEG_UNIFORM_CHECK;   /* the log */
+    r->rest_check[p] = r->t + py_max(c->rest_period, BALLC_CHECK_GROWTH * (r->t - k->t_start));
+    if (r->t - k->t_start < c->rest_period) return 0;
+    const double *y = r->y, *n = r->prepared.planes[p].frame[2], *g = r->gravity;
+    const double M = c->total_mass, radius = c->radius;
+    double gn = -(n[0] * g[0] + n[1] * g[1] + n[2] * g[2]);   /* the load per mass */
+    double gt[3], size = 0.0;
+    for (int i = 0; i < 3; i++) {
+        gt[i] = g[i] + gn * n[i];
+        size += gt[i] * gt[i];
+    }
+    size = sqrt(size);
+    if (!(gn > 0) || !(size > 0)) return 0;
+    /* the normal motion settled at the static equilibrium under M g_n */
+    double rho_eq = pow(M * gn / c->hertz_k, 2.0 / 3.0);
+    double x = (rho_of(r, p, y) - rho_eq) / rho_eq;
+    if (!(x > -1)) return 0;
+    double normal = M * gn * rho_eq * (0.4 * expm1(2.5 * (x == 0.0 ? x : log1p(x))) - x);
+    double e[BALLC_MAX_ENERGY_NOUT];
+    energy_of(r, y, e);
+    double above = 0.5 * M * pow(rho_rate(r, p, y), 2.0) + tangential_springs(r, e)
+                   + py_max(normal, 0.0);
+    if (!(above <= c->rest_threshold)) return 0;
+    /* rolling along g_t, no spin about n */
+    double u[2], speed, error, clear;
+    slip(r, p, y, u, &speed, &error, &clear);
+    if (!(speed <= c->rolls_dv)) return 0;
+    const double *v = y + BALLC_STATE_VX, *w = y + BALLC_STATE_OMEGA_X;
+    double vn = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+    double along = 0.0, across = 0.0, spin = n[0] * w[0] + n[1] * w[1] + n[2] * w[2];
+    for (int i = 0; i < 3; i++) along += (v[i] - vn * n[i]) * gt[i] / size;
+    for (int i = 0; i < 3; i++) {
+        double d = v[i] - vn * n[i] - along * gt[i] / size;
+        across += d * d;
+    }
+    if (!(sqrt(across) <= c->rolls_dv) || !(radius * fabs(spin) <= c->rolls_dv)) return 0;
+    double factor = 1.0 / (1.0 + c->params[BALLC_PARAMETER_INERTIA_XX] / (M * radius * radius));
+    double a[3];
+    for (int i = 0; i < 3; i++) a[i] = factor * gt[i];
+    /* unbounded: no other plane reached on the way before t_end */
+    for (int q = 0; q < r->np; q++) {
+        if (q == p) continue;
+        const plane_geometry *h = &r->geometry[q];
+        double c1 = 0.0, c2 = 0.0, roots[2];
+        for (int i = 0; i < 3; i++) {
+            c1 += h->coef[i] * along * gt[i] / size;
+            c2 += 0.5 * h->coef[i] * a[i];
+        }
+        if (ballc_flight_crossings(rho_of(r, q, y), c1, c2, 1, c->t_end - r->t, roots)) return 0;
+    }
+    /* the rolling state: at the equilibrium height, moving along g_t, rolling exactly */
+    double roll[N];
+    memcpy(roll, y, r->ns * sizeof(double));
+    const ballc_plane_t *pl = &r->prepared.planes[p];
+    double height = 0.0;
+    for (int i = 0; i < 3; i++) height += n[i] * (y[BALLC_STATE_X + i] - pl->point[i]);
+    for (int i = 0; i < 3; i++) {
+        roll[BALLC_STATE_X + i] += (radius - rho_eq - height) * n[i];
+        roll[BALLC_STATE_VX + i] = along * gt[i] / size;
+    }
+    const double *rv = roll + BALLC_STATE_VX;   /* omega = n x v / r */
+    roll[BALLC_STATE_OMEGA_X] = (n[1] * rv[2] - n[2] * rv[1]) / radius;
+    roll[BALLC_STATE_OMEGA_Y] = (n[2] * rv[0] - n[0] * rv[2]) / radius;
+    roll[BALLC_STATE_OMEGA_Z] = (n[0] * rv[1] - n[1] * rv[0]) / radius;
+    for (int q = 0; q < r->np; q++)
+        roll[ballc_plane_state(q)] = roll[ballc_plane_state(q) + 1] = 0.0;
+    booked(r, y, roll);
+    memcpy(r->y, roll, r->ns * sizeof(double));
+    memcpy(r->o->end_acceleration, a, sizeof a);
+    return BALLC_END_ACCELERATING;
+}
+
 /* a rest check on plane p at (r->t, r->y): BALLC_END_* when the run
  * finishes in closed form from here (r->y the new state, or the state of the orbit's
  * start), 0 to go on (the next check scheduled), -1 when a kernel failed, -2 out of
@@ -1418,28 +1746,27 @@ static int end_state(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
     const ballc_contact_rec *k = &r->o->contacts[r->o->open[p]];
-    int rest = at_rest(r, r->y, k->t_start, r->t);
+    if (p != c->resting_plane) return incline_state(r, p);
+    int rest = at_rest(r, p, r->y, k->t_start, r->t);
     if (rest < 0) return -1;
     r->seg.end = rest ? BALLC_SEG_REST_CHECK : BALLC_SEG_UNIFORM_CHECK;   /* the log */
     if (rest) {   /* the rest state: static equilibrium, energy booked */
         double new_y[N];
-        memcpy(new_y, r->y, sizeof new_y);
+        memcpy(new_y, r->y, r->ns * sizeof(double));
         for (int i = 0; i < 3; i++) new_y[BALLC_STATE_VX + i] = new_y[BALLC_STATE_OMEGA_X + i] = 0.0;
-        new_y[BALLC_STATE_Z] = c->z_eq;
-        new_y[BALLC_STATE_FLOOR_DEFLECTION_X] = new_y[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
-        new_y[BALLC_STATE_CEILING_DEFLECTION_X] = new_y[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+        at_equilibrium(r, p, new_y);
         booked(r, r->y, new_y);
-        memcpy(r->y, new_y, sizeof new_y);
+        memcpy(r->y, new_y, r->ns * sizeof(double));
         return BALLC_END_REST;
     }
     /* the next check */
     r->rest_check[p] = r->t + py_max(c->rest_period, BALLC_CHECK_GROWTH * (r->t - k->t_start));
     double u[2], speed, error, clear, roll[N];
     slip(r, p, r->y, u, &speed, &error, &clear);
-    int kind = rolls(r, r->y, k->t_start, r->t, speed, roll);
+    int kind = rolls(r, p, r->y, k->t_start, r->t, speed, roll);
     if (kind < 0) return -1;
     if (kind) {
-        memcpy(r->y, roll, sizeof roll);
+        memcpy(r->y, roll, r->ns * sizeof(double));
         return kind;
     }
     if (!c->orbit_applies) return 0;
@@ -1450,7 +1777,8 @@ static int end_state(run_t *r, int p)
 
 /* The closed-form end state ``kind`` found at (r->t, r->y) on plane p, to t_end: its
  * samples (rest: t_end alone; uniform motion: the free flight without gravity, the turn
- * at most BALLC_FLIGHT_MAX_TURN per interval; an orbit: 32 per period; at least 32
+ * at most BALLC_FLIGHT_MAX_TURN per interval; rolling down an incline: ballc_rolling,
+ * likewise; an orbit: 32 per period; at least 32
  * intervals and at most BALLC_MAX_ROLL_SAMPLES samples, evenly spaced after r->t) in a
  * block with the last one's flags and latch, and the contact's record of its end.
  * 0, -1 (the orbit's base could not be evaluated), -2 out of memory. */
@@ -1460,35 +1788,44 @@ static int end_samples(run_t *r, int kind, int p)
     ballc_drive_output *o = r->o;
     double t0 = r->t, t1 = c->t_end, span = t1 - t0;
     long n = 1;
+    ballc_rolling rolling;
+    if (kind == BALLC_END_ACCELERATING)
+        ballc_rolling_init(&rolling, t0, r->y, o->end_acceleration, c->radius,
+                           r->prepared.planes[p].frame[2], r->ns);
     if (kind != BALLC_END_REST) {
         double wanted = o->end_orbit
             ? ceil(32 * span / o->orbit.period)
+            : kind == BALLC_END_ACCELERATING
+            ? ceil(fabs(ballc_rolling_angle(&rolling, t1)) / BALLC_FLIGHT_MAX_TURN)
             : ceil(norm3(r->y + BALLC_STATE_OMEGA_X) * span / BALLC_FLIGHT_MAX_TURN);
         wanted = py_max((double)BALLC_FLIGHT_MIN_INTERVALS, wanted);
         n = (long)py_min((double)BALLC_MAX_ROLL_SAMPLES, wanted);
     }
     double *t = malloc((size_t)n * sizeof(double));
-    double *y = malloc((size_t)n * N * sizeof(double));
+    double *y = malloc((size_t)n * r->ns * sizeof(double));
     int rc = t && y ? 0 : -2;
     if (!rc) {
         for (long k = 1; k <= n; k++) t[k - 1] = t0 + span * (double)k / (double)n;
         t[n - 1] = t1;
         if (kind == BALLC_END_REST) {
-            memcpy(y, r->y, N * sizeof(double));
+            memcpy(y, r->y, r->ns * sizeof(double));
         } else if (o->end_orbit) {
             const ballc_piecewise *base = ballc_dense_view(&o->orbit_base);
             rc = !base ? -2 : ballc_orbit_states(&o->orbit, ballc_piecewise_states,
                                                  (void *)base, n, t, y);
             if (rc == -1) r->why = "the orbit's base solution could not be evaluated";
+        } else if (kind == BALLC_END_ACCELERATING) {
+            for (long k = 0; k < n; k++) ballc_rolling_at(&rolling, t[k], y + (size_t)k * r->ns);
         } else {
+            const double none[3] = {0.0, 0.0, 0.0};
             ballc_flight f;
-            ballc_flight_init(&f, t0, r->y, 0.0);
-            for (long k = 0; k < n; k++) ballc_flight_at(&f, t[k], y + (size_t)k * N);
+            ballc_flight_init(&f, t0, r->y, none, r->ns);
+            for (long k = 0; k < n; k++) ballc_flight_at(&f, t[k], y + (size_t)k * r->ns);
         }
     }
     if (!rc) {
         long last = o->n_blocks - 1;
-        rc = add_block(r, t, y, n, o->block_flags[last], o->block_latch + (size_t)last * NL)
+        rc = add_block(r, t, y, n, o->block_flags[last], o->block_latch + (size_t)last * r->nl)
              ? -2 : 0;
     }
     free(t);
@@ -1500,7 +1837,8 @@ static int end_samples(run_t *r, int kind, int p)
         ballc_phase_rec *k = &o->phases[o->n_phases++];
         k->contact = o->open[p];
         k->t = t0;
-        k->phase = 1 + kind;   /* BALLC_PHASE_REST, _ROLLING, _FREE_SLIDING */
+        k->phase = kind == BALLC_END_ACCELERATING ? BALLC_PHASE_ROLLING
+                   : 1 + kind;   /* BALLC_PHASE_REST, _ROLLING, _FREE_SLIDING */
     }
     return rc;
 }
@@ -1520,14 +1858,14 @@ static int add_piece(run_t *r, const radau5_result *res, double t0, double t1, i
         k->t1 = t1;
         if (flown) {   /* exact flight: FreeFlight(t0, y0, ...) */
             k->flight = 1;
-            memcpy(k->y0, r->y, sizeof k->y0);
+            memcpy(k->y0, r->y, r->ns * sizeof(double));
         } else {       /* kept by the integrator (scipy's) */
             k->own = 1;
             k->interpolant = r->seg_interpolant;
         }
         return 0;
     }
-    long m = res->n_dense, width = (long)(1 + res->dense_terms) * N;
+    long m = res->n_dense, width = (long)(1 + res->dense_terms) * r->ns;
     if (grow((void **)&o->pieces, &o->cap_pieces, o->n_pieces + 1, sizeof(ballc_piece_rec)))
         return -1;
     long cs = o->cap_steps;
@@ -1601,7 +1939,7 @@ static int drv_poll(void *ctx, double t)
  * of memory (free_events frees what was allocated) */
 static int alloc_events(run_t *r, int n_user)
 {
-    size_t cap = DRIVER_EVENTS + (size_t)(n_user > 0 ? n_user : 0);
+    size_t cap = EVENTS_PER_PLANE * MAXP + (size_t)(n_user > 0 ? n_user : 0);
     double *d = malloc(cap * (N + 4) * sizeof(double));
     int *k = malloc(cap * 11 * sizeof(int));
     r->user_seen = calloc(n_user > 0 ? (size_t)n_user : 1, sizeof(long));
@@ -1653,21 +1991,34 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         free(r);
         return BALLC_DRIVE_NO_MEMORY;
     }
-    o->open[0] = o->open[1] = -1;
+    for (int p = 0; p < MAXP; p++) {
+        o->open[p] = -1;
+        r->rest_check[p] = INFINITY;
+        r->capacity_row[p] = -1;
+    }
     o->stiff_at = NAN;
     r->c = c;
     r->o = o;
-    ballc_parameters_init(&r->prepared, c->params);
-    memcpy(r->y, y0, sizeof r->y);
-    r->rest_check[0] = r->rest_check[1] = INFINITY;
-    r->capacity_row[0] = r->capacity_row[1] = -1;
+    if (ballc_parameters_init(&r->prepared, c->params) != BALLC_OK) {   /* Python checks */
+        free_events(r);
+        free(r);
+        o->status = -1;
+        snprintf(o->message, sizeof o->message, "%s",
+                 "the parameters' plane table is not valid (1 to 6 planes, unit normals)");
+        return o->stop_code = BALLC_DRIVE_ABORTED;
+    }
+    r->np = o->n_planes = r->prepared.n_planes;
+    r->ns = o->n_states = r->prepared.n_states;
+    r->nl = o->n_latch = r->prepared.n_latch;
+    memcpy(r->y, y0, r->ns * sizeof(double));
     r->margins_plane = -1;
     r->polled = wall_seconds();
     r->seg_interpolant = -1;
     int rc = 0;
-    for (int i = 0; i < BALLC_N_PARAMETERS; i++)
+    for (int i = 0; i < r->prepared.n_parameters; i++)
         if (!isfinite(c->params[i])) { rc = -1; r->why = "a parameter is not finite"; }
-    for (int p = 0; p < 2 && !rc; p++)
+    if (!rc) plane_setup(r);
+    for (int p = 0; p < r->np && !rc; p++)
         if (rho_of(r, p, r->y) > 0) rc = begin_contact(r, p);
     double t0 = 0.0;
     if (!rc && !c->t_eval) rc = add_block(r, &t0, r->y, 1, run_flags(r, 1), r->latch);
@@ -1675,7 +2026,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     if (!rc && c->t_eval) {   /* the points at 0 (t_eval == 0.0), each the initial state */
         long keep = 0;
         for (long i = 0; i < c->n_eval; i++) keep += c->t_eval[i] == 0.0;
-        double *rows = malloc((size_t)(keep ? keep : 1) * N * sizeof(double));
+        double *rows = malloc((size_t)(keep ? keep : 1) * r->ns * sizeof(double));
         double *times = malloc((size_t)(keep ? keep : 1) * sizeof(double));
         if (!rows || !times) rc = -2;
         else {
@@ -1683,7 +2034,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             for (long i = 0; i < c->n_eval; i++)
                 if (c->t_eval[i] == 0.0) {
                     times[j] = c->t_eval[i];
-                    memcpy(rows + j * N, r->y, N * sizeof(double));
+                    memcpy(rows + j * r->ns, r->y, r->ns * sizeof(double));
                     j++;
                 }
             rc = add_block(r, times, rows, keep, run_flags(r, 1), r->latch) ? -2 : 0;
@@ -1692,7 +2043,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         free(times);
     }
     double atol[N];
-    for (int i = 0; i < N; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
+    for (int i = 0; i < r->ns; i++) atol[i] = c->atol_states ? c->atol_states[i] : c->atol;
     double first = c->first_step;
     int has_first = c->has_first_step;
     int implicit = 0;   /* method "auto": the segment starts with radau5 */
@@ -1704,21 +2055,20 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             r->stop_code = BALLC_DRIVE_USER_ERROR;
             break;
         }
-        int flags = run_flags(r, 1);
+        ballc_flags flags = run_flags(r, 1);
         int trial = r->trial_on;   /* an orbit's trial needs dense output */
         r->seg_flags = flags;
         if (segment_events(r, flags)) { rc = -1; break; }
         r->n_rearmed = 0;
         double t_check = INFINITY;
-        if (c->checks_rest && c->resting_plane >= 0 && r->in_contact[c->resting_plane]
-                && !r->in_contact[1 - c->resting_plane])
-            t_check = r->rest_check[c->resting_plane];
+        int checked = c->checks_rest ? checked_plane(r) : -1;   /* its rest checks */
+        if (checked >= 0) t_check = r->rest_check[checked];
         /* a rest check, or the end of a compliant contact's step bound, ends it */
         double t_stop = py_min(py_min(t_check, c->t_end), step_bound_end(r));
         double max_step = run_max_step(r);
-        for (int i = 0; i < N; i++)
+        for (int i = 0; i < r->ns; i++)
             if (!isfinite(r->y[i])) rc = -1;
-        for (int i = 0; i < NL; i++)
+        for (int i = 0; i < r->nl; i++)
             if (!isfinite(r->latch[i])) rc = -1;
         if (rc) r->why = "the state or the latched values are not finite";
         if (rc) break;
@@ -1742,7 +2092,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         } else {
         radau5_problem pr;
         memset(&pr, 0, sizeof pr);
-        pr.n = N;
+        pr.n = r->ns;
         pr.fun = drv_fun;
         pr.jac = drv_jac;
         pr.ctx = r;
@@ -1786,12 +2136,12 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.ev_rearm = r->ev_rearm;
         pr.rearm = drv_rearm;
         pr.method = c->method;
-        pr.jacobian_ahead = (flags & c->compliant_any) != 0;
-        pr.jacobian_every_step = (flags & c->compliant_sliding_any) != 0;
+        pr.jacobian_ahead = any_plane(r, flags, BALLC_KIND_COMPLIANT);
+        pr.jacobian_every_step = any_plane(r, flags, BALLC_KIND_COMPLIANT_SLIDING);
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
         pr.poll = drv_poll;
-        ballc_segment seg = {flags, r->latch, c->params, -1};   /* the integrator interface */
+        ballc_segment seg = {flags, r->latch, c->params, -1, r->nl};   /* the integrator interface */
         memset(&res, 0, sizeof res);
         solved = (c->integrate ? c->integrate : ballc_compiled_integrator)(
             c->integrate_ctx, &pr, &seg, &res);
@@ -1862,7 +2212,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                 int p = r->ev_plane[e];
                 for (long h = 0; h < res.n_hits; h++)
                     if (res.hit_event[h] == e) {
-                        const double *yy = res.hit_y + (size_t)h * N;
+                        const double *yy = res.hit_y + (size_t)h * r->ns;
                         record_depth(&o->contacts[o->open[p]], rho_of(r, p, yy), yy);
                     }
             } else if (r->ev_terminal[e] > 0 && r->ev_terminal[e] <= count
@@ -1882,14 +2232,15 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             if (cu != o->cap_user_hits) {
                 int *ue = realloc(o->user_hit_event, (size_t)cu * sizeof(int));
                 if (ue) o->user_hit_event = ue;
-                double *uy = realloc(o->user_hit_y, (size_t)cu * N * sizeof(double));
+                double *uy = realloc(o->user_hit_y, (size_t)cu * r->ns * sizeof(double));
                 if (uy) o->user_hit_y = uy;
                 if (!ue || !uy) { rc = -2; break; }
                 o->cap_user_hits = cu;
             }
             o->user_hit_event[m] = u;
             o->user_hit_t[m] = res.hit_t[h];
-            memcpy(o->user_hit_y + (size_t)m * N, res.hit_y + (size_t)h * N, N * sizeof(double));
+            memcpy(o->user_hit_y + (size_t)m * r->ns, res.hit_y + (size_t)h * r->ns,
+                   r->ns * sizeof(double));
             o->n_user_hits++;
         }
         if (rc) { radau5_free(&res); break; }
@@ -1922,21 +2273,21 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
                     rc = -1;
                     break;
                 }
-                memcpy(r->y, res.y_out + (size_t)(res.n_out - 1) * N, sizeof r->y);
+                memcpy(r->y, res.y_out + (size_t)(res.n_out - 1) * r->ns, r->ns * sizeof(double));
                 radau5_free(&res);
                 if (t_stop != t_check) {   /* only a step bound ended: a fresh step */
                     implicit = ended_implicit;
                     if (log_close(r, BALLC_SEG_STEP_BOUND, -1, r->t)) { rc = -2; break; }
                     continue;
                 }
-                int p = c->resting_plane;
+                int p = checked;
                 int kind = end_state(r, p);
                 if (kind < 0) { rc = kind; break; }
                 if (kind) {   /* to t_end in closed form */
                     o->end_kind = kind;
                     o->end_plane = p;
                     o->end_t = r->t;
-                    memcpy(o->end_y, r->y, sizeof r->y);
+                    memcpy(o->end_y, r->y, r->ns * sizeof(double));
                     rc = end_samples(r, kind, p);
                     if (!rc && log_close(r, r->seg.end, p, r->t)) rc = -2;
                     break;
@@ -1960,7 +2311,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         }
         double h_next = res.h_next;
         r->t = t_fired;
-        memcpy(r->y, res.hit_y + (size_t)fired_hit * N, sizeof r->y);
+        memcpy(r->y, res.hit_y + (size_t)fired_hit * r->ns, r->ns * sizeof(double));
         radau5_free(&res);
         const double *q = r->y + BALLC_STATE_QW;
         double h = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
@@ -1973,7 +2324,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
             break;
         }
         if (kind == K_CAPACITY)   /* its row may have toggled inside the segment */
-            r->fired_row = (r->ev_plane_code[fired] - 2) / 2;
+            r->fired_row = (r->ev_plane_code[fired] - MARGIN_CODE) / MAXP;
         int handled = 0;
         switch (kind) {
         case K_ENTER: handled = begin_contact(r, p); break;
@@ -1994,8 +2345,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     }
     if (rc != -2 && o->n_blocks && o->block_count[o->n_blocks - 1]) {
         /* the contacts still open at the end: their depth at the last sample */
-        const double *last = o->y + (size_t)(o->n - 1) * N;
-        for (int p = 0; p < 2; p++)
+        const double *last = o->y + (size_t)(o->n - 1) * r->ns;
+        for (int p = 0; p < r->np; p++)
             if (o->open[p] >= 0) record_depth(&o->contacts[o->open[p]], rho_of(r, p, last), last);
     }
     if (rc == -1) {   /* aborted where it cannot go on: status -1, and why */
@@ -2013,10 +2364,10 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
     o->status = r->status;
     o->stop_plane = r->stop_plane;
     o->t_run = r->t;
-    o->in_contact[0] = r->in_contact[0];
-    o->in_contact[1] = r->in_contact[1];
-    o->transitions[0] = r->transitions[0];
-    o->transitions[1] = r->transitions[1];
+    for (int p = 0; p < r->np; p++) {
+        o->in_contact[p] = r->in_contact[p];
+        o->transitions[p] = r->transitions[p];
+    }
     o->stalled = r->stalled;
     o->nfev = nfev;
     o->njev = njev;

@@ -17,6 +17,7 @@
 #include "ballc_kernels.h"
 #include "_orbit.h"
 #include "_integrator.h"
+#include "_system.h"
 
 /* The automaton's constants (ballc.stickslip, ballc.compliantmodes, ballc.resting,
  * ballc.flight and ballc.modes document them; Python reads them from ballc._core) */
@@ -34,13 +35,33 @@
 #define BALLC_FLIGHT_MIN_INTERVALS 32 /* closed-form samples: at least 32 intervals, */
 #define BALLC_FLIGHT_MAX_TURN (3.14159265358979323846 / 16)  /* a turn of pi/16 at most */
 #define BALLC_MAX_ROLL_SAMPLES 4096   /* at most 4096 samples of a closed-form end state */
+#define BALLC_ARM_ULPS 1048576.0      /* a compliant contact is armed at 2^20 ulp of the
+                                       * plane's position (and ARM_FORCE's depth) */
 #define BALLC_FLIGHT_MAX_SAMPLES 100000000L   /* an exact flight's samples, at most */
 
-/* The exact free-flight solution from (t0, y0) under ``gravity`` (ballc.flight): y(t)
- * = c0 + c1 s + c2 s^2 + c3 cos(|omega| s / 2) + c4 sin(|omega| s / 2), s = t - t0 */
-typedef struct { double t0, rate, c[5][BALLC_N_STATES]; } ballc_flight;
-void ballc_flight_init(ballc_flight *f, double t0, const double *y0, double gravity);
+/* The exact free-flight solution from (t0, y0) (n states) under ``gravity`` (the
+ * acceleration vector, 3 values; ballc.flight): y(t) = c0 + c1 s + c2 s^2
+ * + c3 cos(|omega| s / 2) + c4 sin(|omega| s / 2), s = t - t0 */
+typedef struct { double t0, rate, c[5][BALLC_MAX_STATES]; int n; } ballc_flight;
+void ballc_flight_init(ballc_flight *f, double t0, const double *y0, const double *gravity,
+                       int n);
 void ballc_flight_at(const ballc_flight *f, double t, double *y);
+/* Rolling down an unbounded incline, uniformly accelerated (ballc.resting.AcceleratedRolling):
+ * from (t0, y0) (n states), rolling without slip with no spin about the plane's unit
+ * normal ``normal``, the centre's acceleration ``acceleration`` (3): the centre
+ * c0 + v0 s + a s^2 / 2, the velocity v0 + a s, the angular velocity (w0 + |a| s / r) e
+ * about the fixed axis e = n x a / |a| (w0 = omega0 . e), the quaternion turned about e
+ * by w0 s + |a| s^2 / (2 r), the rest constant; s = t - t0 */
+typedef struct {
+    double t0, w0, spin_rate, axis[3], a[3], y0[BALLC_MAX_STATES];
+    int n;
+} ballc_rolling;
+void ballc_rolling_init(ballc_rolling *f, double t0, const double *y0,
+                        const double *acceleration, double radius, const double *normal,
+                        int n);
+void ballc_rolling_at(const ballc_rolling *f, double t, double *y);
+/* its turn about e by t (rad) */
+double ballc_rolling_angle(const ballc_rolling *f, double t);
 /* the roots of c0 + c1 s + c2 s^2 in [0, s_max] where it changes sign in ``direction``
  * (> 0 rising, < 0 falling, 0 either; a tangency is none), increasing, cancellation-
  * free: at most 2 into out, their number returned */
@@ -84,10 +105,11 @@ enum {
  * when it failed with an exception it keeps for the bridge to raise (scipy's methods:
  * the bridge's _scipy_integrate, which evaluates the events with radau5_event_value). */
 typedef struct {
-    int flags;                 /* the segment's ballc_rhs flags */
-    const double *latch;       /* the latched values (N_LATCH) at its start */
+    ballc_flags flags;         /* the segment's ballc_rhs flags */
+    const double *latch;       /* the latched values (the run's latch) at its start */
     const double *params;      /* the parameter vector */
     long interpolant;          /* out: the integrator's own interpolant's id, or -1 */
+    int n_latch;               /* the latch's length */
 } ballc_segment;
 
 typedef int (*ballc_integrator)(void *ctx, const radau5_problem *problem,
@@ -96,7 +118,7 @@ typedef int (*ballc_integrator)(void *ctx, const radau5_problem *problem,
 enum { BALLC_INTEGRATOR_RAISED = -100 };
 
 /* An integrator's own interpolant ``id`` (segment->interpolant) at n times t into y (n
- * rows of N_STATES), with the integrator's ctx: 0, or nonzero when it cannot (an
+ * rows of the run's states), with the integrator's ctx: 0, or nonzero when it cannot (an
  * exception kept for the bridge).  For C code that evaluates a segment's dense output
  * (ballc.orbit's trial) when the integrator keeps it itself; the compiled integrators'
  * dense steps are in their result instead. */
@@ -110,32 +132,29 @@ int ballc_compiled_integrator(void *ctx, const radau5_problem *problem,
 enum { BALLC_MODE_NONE = 0, BALLC_MODE_SLIP, BALLC_MODE_SLIP_FIXED, BALLC_MODE_STICK };
 
 typedef struct {                       /* constants of one run, filled by the bridge */
-    const double *params;              /* BALLC_N_PARAMETERS */
+    const double *params;              /* the parameter vector, its plane table included:
+                                        * the run's planes, states and latch follow from it */
     double rtol, atol;                 /* one atol for all states */
     double t_end, max_step, first_step;
     int has_first_step;
     long max_nfev;                     /* 0: none */
     int method, controller;
-    int observer_bits;                 /* the observer's flag when it has mass */
-    int contact_bits[2];               /* friction | digin of a plane in contact */
-    int slip_bits[2], slip_fixed_bits[2], stick_bits[2];
+    ballc_flags observer_bits;         /* the observer's flag when it has mass */
+    ballc_flags contact_bits[BALLC_MAX_PLANES];   /* friction | digin of a plane in contact */
     int exact;                         /* stickslip.uses_exact_coulomb */
     double radius, weight, hertz_k, total_mass, rest_period;   /* rest: 20 T0 */
     int resting_plane, checks_rest;    /* -1: none */
-    double rho_scale[2], rho_offset[2], through_offset[2], threshold_base[2];
-    double slip_map[2][2][BALLC_N_STATES];   /* du/dy of each plane's slip velocity */
     /* t_eval (sorted, within [0, t_end]; NULL: none) and dense output */
     const double *t_eval;
     long n_eval;
     int dense_output;
     /* exact flight (options.exact_flight and flight.scene_allows) */
     int exact_flight;
-    double gravity;                    /* params[gravity] */
     /* the user's events, in order: LinearEvents (a row, offset;
      * index and scale when one state) or callables (called back through user_fun,
      * the bridge's, with user_ctx: it keeps an exception for the bridge to raise) */
     int n_user;
-    const double *user_coef;           /* n_user x N */
+    const double *user_coef;           /* n_user x the run's states */
     const double *user_offset, *user_scale;
     const int *user_linear, *user_index, *user_count, *user_direction;
     int user_flight;                   /* every one lets exact flight apply */
@@ -146,11 +165,9 @@ typedef struct {                       /* constants of one run, filled by the br
     int (*interrupted)(void *ctx);
     /* the compliant law's exact modes (ballc.compliantmodes) */
     int compliant_modes;               /* compliantmodes.uses_modes */
-    int compliant_bits[2], elastic_bits[2], sliding_bits[2];   /* the modes' bits per plane */
-    int compliant_any;                 /* FLOOR_COMPLIANT | CEILING_COMPLIANT */
-    int compliant_sliding_any;         /* FLOOR_COMPLIANT_SLIDING | CEILING_COMPLIANT_SLIDING */
-    double arm_depth[2];               /* arm_penetration; 0: contacts begin at rho = 0 (compliantmodes.starts_armed) */
-    double ulp8[2];                    /* 8 ulp(plane_position): _rounding */
+    int starts_armed;                  /* compliantmodes.starts_armed: contacts begin at the
+                                        * arming depth (else at rho = 0) */
+    double arm_force_depth;            /* (ARM_FORCE / k0)^(2/3): arm_penetration's floor */
     double restick_factor;             /* max(1, mu / max(tangential_stiffness_ratio, 1e-300)) */
     int damping_positive;              /* tangential_damping_ratio > 0: capacity guards */
     double contact_time_base;          /* 3.2145 (m_total / k0)^0.4: contact_time */
@@ -160,8 +177,8 @@ typedef struct {                       /* constants of one run, filled by the br
     int orbit_applies;                 /* orbit.applies: a check finding nothing tries an orbit */
     double rest_threshold;             /* resting.energy_threshold */
     double rho_eq, z_eq;               /* equilibrium_penetration, radius - rho_eq */
-    double rest_weight;                /* total_mass * gravity */
-    double observer_weight;            /* observer_mass * gravity */
+    double rest_weight;                /* total_mass * |gravity| */
+    double observer_weight;            /* observer_mass * |gravity| */
     double rolls_dv, rolls_level, half_mass;   /* resting.rolls: dv, 1e3 eps g, 0.5 M */
     /* ballc.orbit, run at the rest checks when orbit_applies (_orbit.c) */
     double orbit_axis[3];              /* orbit.body_axis */
@@ -170,7 +187,7 @@ typedef struct {                       /* constants of one run, filled by the br
     ballc_integrator integrate;        /* NULL: ballc_compiled_integrator */
     void *integrate_ctx;
     ballc_interpolant_fn interpolant;  /* its own interpolants (NULL: none) */
-    const double *atol_states;         /* N values (NULL: atol for each); atol is then
+    const double *atol_states;         /* one per state (NULL: atol for each); atol is then
                                         * their largest (stickslip.error_speed's) */
     /* may be NULL: the simulated time reached, reported at most every poll_interval s of
      * wall time (the bridge's: the progress bar), with user_ctx */
@@ -187,17 +204,19 @@ typedef struct {                       /* constants of one run, filled by the br
 } ballc_drive_config;
 
 /* how a run ended at a rest check (ballc.resting): the state from end_t on is end_y */
-enum { BALLC_END_NONE = 0, BALLC_END_REST, BALLC_END_ROLLING, BALLC_END_SLIDING };
+enum { BALLC_END_NONE = 0, BALLC_END_REST, BALLC_END_ROLLING, BALLC_END_SLIDING,
+       BALLC_END_ACCELERATING };   /* rolling down an unbounded incline: end_acceleration */
 
 typedef struct {
     int plane, ended, passed_through, rate_is_kernel_value;
     double t_start, t_end, v_before[3], w_before[3], v_after[3], w_after[3];
-    double rate, digin[3], max_penetration, contact_point[2], lost[2];
+    double rate, digin[3], max_penetration, contact_point[3], lost[2];   /* the centre at
+                                                                         * max. penetration */
 } ballc_contact_rec;
 
 /* a contact's phases: when each starts (slip, stick) and its closed-form end state */
 enum { BALLC_PHASE_SLIP = 0, BALLC_PHASE_STICK, BALLC_PHASE_REST, BALLC_PHASE_ROLLING,
-       BALLC_PHASE_FREE_SLIDING };
+       BALLC_PHASE_FREE_SLIDING };   /* an end state's: 1 + BALLC_END_* (ACCELERATING: ROLLING) */
 typedef struct { long contact; double t; int phase; } ballc_phase_rec;
 
 /* dense output: one piece (t0, t1) per segment, its steps [step0, step0 + n_steps) of
@@ -207,7 +226,7 @@ typedef struct {
     long step0, n_steps, coef0;
     int terms;
     int flight;                /* exact flight: FreeFlight(t0, y0, gravity, t_max = t1) */
-    double y0[BALLC_N_STATES];
+    double y0[BALLC_MAX_STATES];
     int own;                   /* nonzero: the integrator's own interpolant, by its id */
     long interpolant;
 } ballc_piece_rec;
@@ -253,29 +272,31 @@ typedef struct {
                                  * (auto: radau5 or dop853), -1 an exact flight */
     int switches;               /* method "auto": switches inside the segment */
     int end;                    /* BALLC_SEG_* */
-    int plane;                  /* the event's plane (0 floor, 1 ceiling), a user event's
-                                 * index, or -1 (no event) */
+    int plane;                  /* the event's plane (its index in the plane table), a
+                                 * user event's index, or -1 (no event) */
     int rearms;                 /* events re-armed inside the segment (a free slip's
                                  * approach re-latched, the capacity guard toggled) */
-    signed char before[2], after[2];   /* BALLC_PLANE_* of each plane during the segment
-                                        * and after its end was handled */
+    signed char before[BALLC_MAX_PLANES], after[BALLC_MAX_PLANES];
+                                /* BALLC_PLANE_* of each plane during the segment and
+                                 * after its end was handled (-1: no such plane) */
     signed char rearm_kind, rearm_plane;    /* the last re-arm: BALLC_SEG_APPROACH or
                                              * _CAPACITY and its plane; -1 none */
     signed char rearm_before, rearm_after;  /* the plane's mode before / after it */
 } ballc_segment_rec;
 
 typedef struct {
-    long n, cap;                        /* samples: t (n), y (n x N_STATES) */
+    int n_planes, n_states, n_latch;    /* the run's (its parameters' plane table) */
+    long n, cap;                        /* samples: t (n), y (n x n_states) */
     double *t, *y;
-    long n_blocks, cap_blocks;          /* blocks: count, flags, latch (N_LATCH) */
+    long n_blocks, cap_blocks;          /* blocks: count, flags, latch (n_latch) */
     long *block_count;
-    int *block_flags;
+    ballc_flags *block_flags;
     double *block_latch;
     long n_contacts, cap_contacts;
     ballc_contact_rec *contacts;
     long n_phases, cap_phases;
     ballc_phase_rec *phases;
-    int open[2];                        /* open contact per plane, -1 none */
+    int open[BALLC_MAX_PLANES];         /* open contact per plane, -1 none */
     long n_user_hits, cap_user_hits;    /* the user's events' hits, in order */
     int *user_hit_event;
     double *user_hit_t, *user_hit_y;
@@ -291,8 +312,8 @@ typedef struct {
     int stop_code, status, stop_plane;
     double t_run;                       /* run.t at the end */
     double fail_end;                    /* FAILED: t[-1] of the segment, or run.t */
-    int in_contact[2];
-    long transitions[2], stalled;
+    int in_contact[BALLC_MAX_PLANES];
+    long transitions[BALLC_MAX_PLANES], stalled;
     int unsettled_compliant;            /* UNSETTLED: the compliant law's modes */
     long nfev, njev, nlu;
     double stiff_at;                    /* NaN: none */
@@ -301,7 +322,8 @@ typedef struct {
     long segments;
     int end_kind, end_plane;            /* BALLC_END_*: rest / uniform motion found;
                                          * its closed-form samples are the last block */
-    double end_t, end_y[BALLC_N_STATES];
+    double end_t, end_y[BALLC_MAX_STATES];
+    double end_acceleration[3];         /* ACCELERATING: the centre's (m/s^2) */
     /* a -DRADAU5_PROFILE build: thread CPU time (ns) inside radau5_solve, summed over
      * the segments, and in the whole of ballc_drive; zeros otherwise */
     int profiled;

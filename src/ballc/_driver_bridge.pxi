@@ -9,15 +9,21 @@ from libc.stdlib cimport free
 
 cdef extern from "_driver.h":
     double BALLC_CLEAR_FACTOR, BALLC_PASS_FACTOR, BALLC_STOP_FACTOR, BALLC_APPROACH_FRACTION
-    double BALLC_MIN_IMPACT_RATE, BALLC_CHECK_GROWTH, BALLC_FLIGHT_MAX_TURN
+    double BALLC_MIN_IMPACT_RATE, BALLC_CHECK_GROWTH, BALLC_FLIGHT_MAX_TURN, BALLC_ARM_ULPS
     long BALLC_FLIGHT_MAX_SAMPLES
     int BALLC_MAX_RELATCH, BALLC_MAX_TRANSITIONS, BALLC_MAX_STALLED
     int BALLC_STEPS_PER_CONTACT, BALLC_IMPACT_SPAN, BALLC_FLIGHT_MIN_INTERVALS
     int BALLC_MAX_ROLL_SAMPLES
     ctypedef struct ballc_flight:
         double t0, rate
-    void ballc_flight_init(ballc_flight *, double, const double *, double) nogil
+    void ballc_flight_init(ballc_flight *, double, const double *, const double *, int) nogil
     void ballc_flight_at(const ballc_flight *, double, double *) nogil
+    ctypedef struct ballc_rolling:
+        double t0, w0, spin_rate
+    void ballc_rolling_init(ballc_rolling *, double, const double *, const double *, double,
+                            const double *, int) nogil
+    void ballc_rolling_at(const ballc_rolling *, double, double *) nogil
+    double ballc_rolling_angle(const ballc_rolling *, double) nogil
     int ballc_flight_crossings(double, double, double, int, double, double *) nogil
     enum:
         BALLC_DRIVE_OK, BALLC_DRIVE_FAILED, BALLC_DRIVE_UNSETTLED, BALLC_DRIVE_THROUGH,
@@ -30,24 +36,15 @@ cdef extern from "_driver.h":
         int has_first_step
         long max_nfev
         int method, controller
-        int observer_bits
-        int contact_bits[2]
-        int slip_bits[2]
-        int slip_fixed_bits[2]
-        int stick_bits[2]
+        ballc_flags observer_bits
+        ballc_flags contact_bits[6]
         int exact
         double radius, weight, hertz_k, total_mass, rest_period
         int resting_plane, checks_rest
-        double rho_scale[2]
-        double rho_offset[2]
-        double through_offset[2]
-        double threshold_base[2]
-        double slip_map[2][2][19]
         const double *t_eval
         long n_eval
         int dense_output
         int exact_flight
-        double gravity
         int n_user
         const double *user_coef
         const double *user_offset
@@ -61,13 +58,8 @@ cdef extern from "_driver.h":
         void *user_ctx
         int (*interrupted)(void *) noexcept nogil
         int compliant_modes
-        int compliant_bits[2]
-        int elastic_bits[2]
-        int sliding_bits[2]
-        int compliant_any
-        int compliant_sliding_any
-        double arm_depth[2]
-        double ulp8[2]
+        int starts_armed
+        double arm_force_depth
         double restick_factor
         int damping_positive
         double contact_time_base
@@ -96,7 +88,7 @@ cdef extern from "_driver.h":
         double rate
         double digin[3]
         double max_penetration
-        double contact_point[2]
+        double contact_point[3]
         double lost[2]
     ctypedef struct ballc_phase_rec:
         long contact
@@ -107,7 +99,7 @@ cdef extern from "_driver.h":
         long step0, n_steps, coef0
         int terms
         int flight
-        double y0[19]
+        double y0[27]
         int own
         long interpolant
     enum: BALLC_N_PLANE_MODES, BALLC_N_SEGMENT_ENDS
@@ -117,22 +109,23 @@ cdef extern from "_driver.h":
         double t_start, t_end
         long nfev, njev, nlu, nstep, nreject
         int method, method_end, switches, end, plane, rearms
-        signed char before[2]
-        signed char after[2]
+        signed char before[6]
+        signed char after[6]
         signed char rearm_kind, rearm_plane, rearm_before, rearm_after
     ctypedef struct ballc_drive_output:
+        int n_planes, n_states, n_latch
         long n
         double *t
         double *y
         long n_blocks
         long *block_count
-        int *block_flags
+        ballc_flags *block_flags
         double *block_latch
         long n_contacts
         ballc_contact_rec *contacts
         long n_phases
         ballc_phase_rec *phases
-        int open[2]
+        int open[6]
         long n_user_hits
         int *user_hit_event
         double *user_hit_t
@@ -148,8 +141,8 @@ cdef extern from "_driver.h":
         int *dense_kind
         int stop_code, status, stop_plane
         double t_run, fail_end
-        int in_contact[2]
-        long transitions[2]
+        int in_contact[6]
+        long transitions[6]
         long stalled
         int unsettled_compliant
         long nfev, njev, nlu
@@ -158,7 +151,8 @@ cdef extern from "_driver.h":
         long segments
         int end_kind, end_plane
         double end_t
-        double end_y[19]
+        double end_y[27]
+        double end_acceleration[3]
         int profiled
         double integrator_ns, drive_ns
         int end_orbit
@@ -187,6 +181,7 @@ STEPS_PER_CONTACT, IMPACT_SPAN = BALLC_STEPS_PER_CONTACT, BALLC_IMPACT_SPAN
 CHECK_GROWTH = BALLC_CHECK_GROWTH
 FLIGHT_MIN_INTERVALS, FLIGHT_MAX_TURN = BALLC_FLIGHT_MIN_INTERVALS, BALLC_FLIGHT_MAX_TURN
 FLIGHT_MAX_SAMPLES, MAX_ROLL_SAMPLES = BALLC_FLIGHT_MAX_SAMPLES, BALLC_MAX_ROLL_SAMPLES
+ARM_ULPS = BALLC_ARM_ULPS
 #: A contact's phases in Drive.phases(): slip, stick, then its closed-form end state
 PHASE_NAMES = ("slip", "stick", "rest", "rolling", "free_sliding")
 
@@ -264,26 +259,28 @@ cdef int _drive_user_rearm(void *ctx, int k, double t, const double *y, double *
     cdef double[::1] yv
     cdef const double[::1] cv, lv
     cdef double off
+    cdef int width, n_latch
     with gil:
         errors = (<list>ctx)[1]
         if errors:
             return -1
         try:
-            state = np.empty(BALLC_N_STATES)
+            width, n_latch = (<list>ctx)[4]   # the run's states and latched values
+            state = np.empty(width)
             yv = state
-            memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+            memcpy(&yv[0], y, width * sizeof(double))
             out = (<list>ctx)[2][k](t, state)
             if out is None:
                 return 0
             coefficients, new_offset, new_latch = out
-            cv = _checked_row("rearm coefficients", coefficients, BALLC_N_STATES)
-            lv = _checked_row("rearm latch", new_latch, BALLC_N_LATCH)
+            cv = _checked_row("rearm coefficients", coefficients, width)
+            lv = _checked_row("rearm latch", new_latch, n_latch)
             off = float(new_offset)
             if not isfinite(off):
                 raise ValueError(f"rearm offset = {new_offset!r} is not allowed: must be "
                                  "finite")
-            memcpy(coef, &cv[0], BALLC_N_STATES * sizeof(double))
-            memcpy(latch, &lv[0], BALLC_N_LATCH * sizeof(double))
+            memcpy(coef, &cv[0], width * sizeof(double))
+            memcpy(latch, &lv[0], n_latch * sizeof(double))
             offset[0] = off
             return 1
         except BaseException as error:
@@ -297,15 +294,17 @@ cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
     it: ctx is [the events (simulate's CheckedEvent), the exceptions kept]; an exception
     is kept for drive to raise and the event reads as NaN meanwhile."""
     cdef double[::1] yv
+    cdef int width
     with gil:
         events, errors = (<list>ctx)[0], (<list>ctx)[1]
         if errors:
             g[0] = NAN
             return -1
         try:
-            state = np.empty(BALLC_N_STATES)
+            width = (<list>ctx)[4][0]
+            state = np.empty(width)
             yv = state
-            memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+            memcpy(&yv[0], y, width * sizeof(double))
             g[0] = float(events[k](t, state))
             return 0
         except BaseException as error:
@@ -314,22 +313,63 @@ cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
             return -1
 
 
-def flight_states(double t0, const double[::1] y0, double gravity, t):
-    """The exact free flight from (t0, y0) under ``gravity`` (m/s^2) at the times t
-    (_driver.c's ballc_flight): (N_STATES,) for a scalar t, (N_STATES, len(t)) for a 1-D
-    array."""
+cdef int _state_width(const double[::1] y0) except -1:
+    """The length of a state (a scene's: the ball's states and 2 per plane), checked."""
+    cdef Py_ssize_t n = y0.shape[0]
+    if n < BALLC_N_BALL_STATES + 2 or n > BALLC_MAX_STATES or (n - BALLC_N_BALL_STATES) % 2:
+        raise ValueError(f"y0 must have {BALLC_N_BALL_STATES} + 2 per plane values (1 to "
+                         f"{BALLC_MAX_PLANES} planes), got {n}")
+    return <int>n
+
+
+def flight_states(double t0, const double[::1] y0, const double[::1] gravity, t):
+    """The exact free flight from (t0, y0) (a scene's state) under ``gravity`` (the
+    acceleration vector, m/s^2) at the times t (_driver.c's ballc_flight): (states,) for a
+    scalar t, (states, len(t)) for a 1-D array."""
     cdef ballc_flight f
     cdef Py_ssize_t i
-    if y0.shape[0] != BALLC_N_STATES:
-        raise ValueError(f"y0 must have length {BALLC_N_STATES}")
+    cdef int n = _state_width(y0)
+    _check("gravity", gravity.shape[0], 3)
     times = np.asarray(t, dtype=float)
     cdef const double[::1] tv = np.ascontiguousarray(times.ravel())
-    out = np.empty((tv.shape[0], BALLC_N_STATES))
+    out = np.empty((tv.shape[0], n))
     cdef double[:, ::1] o = out
-    ballc_flight_init(&f, t0, &y0[0], gravity)
+    ballc_flight_init(&f, t0, &y0[0], &gravity[0], n)
     for i in range(tv.shape[0]):
         ballc_flight_at(&f, tv[i], &o[i, 0])
     return out[0] if times.ndim == 0 else out.T
+
+
+def rolling_states(double t0, const double[::1] y0, const double[::1] acceleration,
+                   double radius, const double[::1] normal, t):
+    """Rolling down an unbounded incline from (t0, y0), its centre's ``acceleration``
+    (m/s^2) along the plane of unit ``normal`` (_driver.c's ballc_rolling, the end state
+    ACCELERATING), at the times t: (states,) for a scalar t, (states, len(t)) for a 1-D
+    array."""
+    cdef ballc_rolling f
+    cdef Py_ssize_t i
+    cdef int n = _state_width(y0)
+    _check("acceleration", acceleration.shape[0], 3)
+    _check("normal", normal.shape[0], 3)
+    times = np.asarray(t, dtype=float)
+    cdef const double[::1] tv = np.ascontiguousarray(times.ravel())
+    out = np.empty((tv.shape[0], n))
+    cdef double[:, ::1] o = out
+    ballc_rolling_init(&f, t0, &y0[0], &acceleration[0], radius, &normal[0], n)
+    for i in range(tv.shape[0]):
+        ballc_rolling_at(&f, tv[i], &o[i, 0])
+    return out[0] if times.ndim == 0 else out.T
+
+
+def rolling_angle(double t0, const double[::1] y0, const double[::1] acceleration,
+                  double radius, const double[::1] normal, double t):
+    """The turn (rad) about its fixed axis of the rolling of :func:`rolling_states` by t."""
+    cdef ballc_rolling f
+    cdef int n = _state_width(y0)
+    _check("acceleration", acceleration.shape[0], 3)
+    _check("normal", normal.shape[0], 3)
+    ballc_rolling_init(&f, t0, &y0[0], &acceleration[0], radius, &normal[0], n)
+    return ballc_rolling_angle(&f, t)
 
 
 def flight_crossings(double c0, double c1, double c2, int direction, double s_max):
@@ -343,21 +383,22 @@ def flight_crossings(double c0, double c1, double c2, int direction, double s_ma
 cdef class DriveScene:
     """The constants of the C loop that depend on the scene alone (ballc_drive_config's
     scene part), converted once from ``k`` (ballc.loop_constants); ``params`` (the
-    parameter vector, N_PARAMETERS) is kept for the runs, ``python`` for Python's own."""
+    parameter vector, its plane table included) is kept for the runs, with the run's
+    ``n_planes``, ``n_states`` and ``n_latch`` it sets, ``python`` for Python's own."""
     cdef ballc_drive_config c
     cdef readonly object params
+    cdef readonly int n_planes, n_states, n_latch
     cdef public dict python   # what Python keeps of the scene's constants (loop_constants)
 
     def __init__(self, params, dict k):
-        cdef int p, row, j
-        cdef const double[:, :, ::1] smap = k["slip_map"]
+        cdef int p, j
         cdef const double[::1] pv
         self.params = np.array(params, dtype=float)
         self.params.flags.writeable = False
         self.python = {}
         pv = self.params
-        if pv.shape[0] != BALLC_N_PARAMETERS:
-            raise ValueError("params of the wrong length")
+        self.n_planes = _planes_of(pv)   # checks the parameters' length and plane table
+        self.n_states, self.n_latch = _states(self.n_planes), _latches(self.n_planes)
         memset(&self.c, 0, sizeof(ballc_drive_config))
         self.c.params = &pv[0]
         self.c.observer_bits = k["observer_bits"]
@@ -368,10 +409,9 @@ cdef class DriveScene:
         self.c.total_mass = k["total_mass"]
         self.c.rest_period = k["rest_period"]
         self.c.resting_plane = k["resting_plane"]
-        self.c.gravity = k["gravity"]
         self.c.compliant_modes = k["compliant_modes"]
-        self.c.compliant_any = k["compliant_any"]
-        self.c.compliant_sliding_any = k["compliant_sliding_any"]
+        self.c.starts_armed = k["starts_armed"]
+        self.c.arm_force_depth = k["arm_force_depth"]
         self.c.restick_factor = k["restick_factor"]
         self.c.damping_positive = k["damping_positive"]
         self.c.contact_time_base = k["contact_time_base"]
@@ -387,23 +427,9 @@ cdef class DriveScene:
         self.c.rest_factor = k["rest_factor"]
         for j in range(3):
             self.c.orbit_axis[j] = k["orbit_axis"][j]
-        for p in range(2):
-            self.c.compliant_bits[p] = k["compliant_bits"][p]
-            self.c.elastic_bits[p] = k["elastic_bits"][p]
-            self.c.sliding_bits[p] = k["sliding_bits"][p]
-            self.c.arm_depth[p] = k["arm_depth"][p]
-            self.c.ulp8[p] = k["ulp8"][p]
+        _check("contact_bits", len(k["contact_bits"]), self.n_planes)
+        for p in range(self.n_planes):
             self.c.contact_bits[p] = k["contact_bits"][p]
-            self.c.slip_bits[p] = k["slip_bits"][p]
-            self.c.slip_fixed_bits[p] = k["slip_fixed_bits"][p]
-            self.c.stick_bits[p] = k["stick_bits"][p]
-            self.c.rho_scale[p] = k["rho_scale"][p]
-            self.c.rho_offset[p] = k["rho_offset"][p]
-            self.c.through_offset[p] = k["through_offset"][p]
-            self.c.threshold_base[p] = k["threshold_base"][p]
-            for row in range(2):
-                for j in range(BALLC_N_STATES):
-                    self.c.slip_map[p][row][j] = smap[p, row, j]
 
 
 def drive(DriveScene scene, const double[::1] y0, dict k, progress=None):
@@ -422,10 +448,11 @@ def drive(DriveScene scene, const double[::1] y0, dict k, progress=None):
     cdef const int[::1] ulinear, uindex, ucount, udirection, urearm
     cdef const double[::1] atol_states = k["atol_states"]   # None: one atol
     users = k["users"]   # None: no user events
+    cdef int width = scene.n_states
     cdef list user_ctx = [users["user_events"] if users else None, [],
-                          users["user_rearms"] if users else None, progress]
-    if y0.shape[0] != BALLC_N_STATES:
-        raise ValueError("y0 of the wrong length")
+                          users["user_rearms"] if users else None, progress,
+                          (width, scene.n_latch)]
+    _check("y0", y0.shape[0], width)
     c.rtol = k["rtol"]
     c.atol = k["atol"]
     c.t_end = k["t_end"]
@@ -475,6 +502,7 @@ def drive(DriveScene scene, const double[::1] y0, dict k, progress=None):
     c.user_rearm = NULL
     if users:
         ucoef = users["user_coef"]
+        _check("user_coef's columns", ucoef.shape[1], width)
         uoffset = users["user_offset"]
         uscale = users["user_scale"]
         ulinear = users["user_linear"]
@@ -492,6 +520,7 @@ def drive(DriveScene scene, const double[::1] y0, dict k, progress=None):
         c.user_index = &uindex[0]
         c.user_count = &ucount[0]
         c.user_direction = &udirection[0]
+    run.n_planes, run.width, run.n_latch = scene.n_planes, width, scene.n_latch
     with nogil:
         rc = ballc_drive(&c, &y0[0], &run.o)
     run.owns = 1
@@ -505,10 +534,11 @@ def drive(DriveScene scene, const double[::1] y0, dict k, progress=None):
 
 cdef class Drive:
     """One run of the C loop (ballc_drive_output): its samples ``t`` (n,) and ``rows``
-    (n, N_STATES), its scalars as attributes, the rest read on demand (the C buffers
-    are freed with it)."""
+    (n, the scene's states), its scalars as attributes, the rest read on demand (the C
+    buffers are freed with it)."""
     cdef ballc_drive_output o
     cdef int owns
+    cdef readonly int n_planes, width, n_latch   # the scene's planes, states, latch
     cdef _ScipyRun scipy_run
     cdef readonly object t, rows
 
@@ -522,12 +552,12 @@ cdef class Drive:
         cdef double[::1] tv
         cdef double[:, ::1] rv
         t = np.empty(n)
-        rows = np.empty((n, BALLC_N_STATES))
+        rows = np.empty((n, self.width))
         if n:
             tv = t
             rv = rows
             memcpy(&tv[0], self.o.t, n * sizeof(double))
-            memcpy(&rv[0, 0], self.o.y, n * BALLC_N_STATES * sizeof(double))
+            memcpy(&rv[0, 0], self.o.y, n * self.width * sizeof(double))
         free(self.o.t)
         free(self.o.y)
         self.o.t = self.o.y = NULL
@@ -546,9 +576,11 @@ cdef class Drive:
     @property
     def message(self): return self.o.message.decode()
     @property
-    def in_contact(self): return (bool(self.o.in_contact[0]), bool(self.o.in_contact[1]))
+    def in_contact(self):
+        return tuple(bool(self.o.in_contact[p]) for p in range(self.n_planes))
     @property
-    def transitions(self): return (self.o.transitions[0], self.o.transitions[1])
+    def transitions(self):
+        return tuple(self.o.transitions[p] for p in range(self.n_planes))
     @property
     def stalled(self): return self.o.stalled
     @property
@@ -571,7 +603,11 @@ cdef class Drive:
     def end_t(self): return self.o.end_t
     @property
     def end_y(self):
-        return np.array([self.o.end_y[j] for j in range(BALLC_N_STATES)])
+        return np.array([self.o.end_y[j] for j in range(self.width)])
+    @property
+    def end_acceleration(self):
+        """ACCELERATING (rolling down an incline): the centre's acceleration (m/s^2)."""
+        return np.array([self.o.end_acceleration[j] for j in range(3)])
     @property
     def profiled(self): return bool(self.o.profiled)
     @property
@@ -587,31 +623,32 @@ cdef class Drive:
                         [self.o.integrator_prof[j] for j in range(7)]))
 
     def blocks(self):
-        """(counts (blocks,), flags (blocks,) int32, latches (blocks, N_LATCH)): the
-        samples' blocks, each computed with one segment's flags and latch."""
+        """(counts (blocks,), flags (blocks,) int64, latches (blocks, the scene's latch)):
+        the samples' blocks, each computed with one segment's flags and latch."""
         cdef long m = self.o.n_blocks
         cdef double[:, ::1] lv
         counts = np.array([self.o.block_count[i] for i in range(m)], dtype=np.intp)
-        flags = np.array([self.o.block_flags[i] for i in range(m)], dtype=np.int32)
-        latches = np.empty((m, BALLC_N_LATCH))
+        flags = np.array([self.o.block_flags[i] for i in range(m)], dtype=np.int64)
+        latches = np.empty((m, self.n_latch))
         if m:
             lv = latches
-            memcpy(&lv[0, 0], self.o.block_latch, m * BALLC_N_LATCH * sizeof(double))
+            memcpy(&lv[0, 0], self.o.block_latch, m * self.n_latch * sizeof(double))
         return counts, flags, latches
 
     def contacts(self):
         """The contacts' records as arrays, one row per contact: "plane", "ended",
         "passed_through", "kernel_rate" (ints), "t_start", "t_end", "rate",
         "max_penetration" (n,), "v_before", "w_before", "v_after", "w_after", "digin"
-        (n, 3), "contact_point", "lost" (normal, tangential) (n, 2); a contact that did
-        not end has NaN for t_end, v_after, w_after and lost."""
+        (n, 3), "contact_point" (the centre at the deepest penetration, x, y, z) (n, 3),
+        "lost" (normal, tangential) (n, 2); a contact that did not end has NaN for t_end,
+        v_after, w_after and lost."""
         cdef long n = self.o.n_contacts, i
         cdef int j
         cdef ballc_contact_rec *rec
         ints = np.empty((4, n), dtype=np.intc)
         scalars = np.empty((4, n))
-        vectors = np.empty((5, n, 3))
-        pairs = np.empty((2, n, 2))
+        vectors = np.empty((6, n, 3))
+        pairs = np.empty((1, n, 2))
         cdef int[:, ::1] iv = ints
         cdef double[:, ::1] sv = scalars
         cdef double[:, :, ::1] vv = vectors, pv = pairs
@@ -627,20 +664,20 @@ cdef class Drive:
                 vv[2, i, j] = rec.v_after[j]
                 vv[3, i, j] = rec.w_after[j]
                 vv[4, i, j] = rec.digin[j]
+                vv[5, i, j] = rec.contact_point[j]
             for j in range(2):
-                pv[0, i, j] = rec.contact_point[j]
-                pv[1, i, j] = rec.lost[j]
+                pv[0, i, j] = rec.lost[j]
             if not rec.ended:
                 sv[1, i] = NAN
                 for j in range(3):
                     vv[2, i, j] = NAN
                     vv[3, i, j] = NAN
-                pv[1, i, 0] = pv[1, i, 1] = NAN
+                pv[0, i, 0] = pv[0, i, 1] = NAN
         return dict(plane=ints[0], ended=ints[1], passed_through=ints[2], kernel_rate=ints[3],
                     t_start=scalars[0], t_end=scalars[1], rate=scalars[2],
                     max_penetration=scalars[3], v_before=vectors[0], w_before=vectors[1],
                     v_after=vectors[2], w_after=vectors[3], digin=vectors[4],
-                    contact_point=pairs[0], lost=pairs[1])
+                    contact_point=vectors[5], lost=pairs[0])
 
     def phases(self):
         """[(contact index, t, phase code: PHASE_NAMES)], in order."""
@@ -648,19 +685,20 @@ cdef class Drive:
                 for i in range(self.o.n_phases)]
 
     def open_contacts(self):
-        """The open contact's index per plane (floor, ceiling), -1 none."""
-        return (self.o.open[0], self.o.open[1])
+        """The open contact's index per plane (the scene's planes, in order), -1 none."""
+        return tuple(self.o.open[p] for p in range(self.n_planes))
 
     def user_hits(self):
-        """(event index (m,) intc, t (m,), states (m, N_STATES)): the user's events' hits."""
+        """(event index (m,) intc, t (m,), states (m, the scene's states)): the user's
+        events' hits."""
         cdef long m = self.o.n_user_hits
         cdef double[:, ::1] rv
         event = np.array([self.o.user_hit_event[i] for i in range(m)], dtype=np.intc)
         times = np.array([self.o.user_hit_t[i] for i in range(m)], dtype=float)
-        states = np.empty((m, BALLC_N_STATES))
+        states = np.empty((m, self.width))
         if m:
             rv = states
-            memcpy(&rv[0, 0], self.o.user_hit_y, m * BALLC_N_STATES * sizeof(double))
+            memcpy(&rv[0, 0], self.o.user_hit_y, m * self.width * sizeof(double))
         return event, times, states
 
     def switches(self):
@@ -703,10 +741,10 @@ cdef class Drive:
                 continue
             if piece.flight:
                 pieces.append((piece.t0, piece.t1,
-                               np.array([piece.y0[j] for j in range(BALLC_N_STATES)])))
+                               np.array([piece.y0[j] for j in range(self.width)])))
                 continue
             dense_t = np.empty((piece.n_steps, 2))
-            dense_c = np.empty((piece.n_steps, (1 + piece.terms) * BALLC_N_STATES))
+            dense_c = np.empty((piece.n_steps, (1 + piece.terms) * self.width))
             dense_kind = np.empty(piece.n_steps, dtype=np.intc)
             if piece.n_steps:
                 dtv = dense_t
@@ -715,7 +753,7 @@ cdef class Drive:
                 memcpy(&dtv[0, 0], self.o.dense_t + 2 * piece.step0,
                        piece.n_steps * 2 * sizeof(double))
                 memcpy(&dcv[0, 0], self.o.dense_c + piece.coef0,
-                       piece.n_steps * (1 + piece.terms) * BALLC_N_STATES * sizeof(double))
+                       piece.n_steps * (1 + piece.terms) * self.width * sizeof(double))
                 memcpy(&dkv[0], self.o.dense_kind + piece.step0, piece.n_steps * sizeof(int))
             pieces.append((piece.t0, piece.t1, dense_t, dense_c, piece.terms, dense_kind))
         return pieces

@@ -7,7 +7,21 @@
 #include "_orbit.h"
 #include "_system.h"
 
-#define N BALLC_N_STATES
+#define N BALLC_MAX_STATES   /* room for a row; a run has n_states of them */
+
+/* the number of states of G's scene */
+static int states_of(const ballc_motion *g)
+{
+    return BALLC_N_BALL_STATES + BALLC_N_PLANE_STATES * g->n_planes;
+}
+
+void ballc_motion_planes(ballc_motion *g, const double *params)
+{
+    ballc_parameters_t prepared;
+    g->n_planes = ballc_parameters_init(&prepared, params) == BALLC_OK ? prepared.n_planes : 0;
+    for (int p = 0; p < g->n_planes; p++)
+        g->sense[p] = prepared.planes[p].frame[2][2] < 0 ? -1.0 : 1.0;
+}
 
 /* Hamilton product a (x) b, scalar first (orientation.quaternion_multiply) */
 static void quaternion_multiply(const double *a, const double *b, double *out)
@@ -48,16 +62,19 @@ void ballc_motion_power(const ballc_motion *g, double k, ballc_motion *out)
 
 void ballc_motion_apply(const ballc_motion *g, const double *y, int rate, double *out)
 {
-    static const int planar[] = {BALLC_STATE_X, BALLC_STATE_OMEGA_X, BALLC_STATE_VX,
-                                 BALLC_STATE_FLOOR_DEFLECTION_X,
-                                 BALLC_STATE_CEILING_DEFLECTION_X};
     /* how each pair turns with the scene: inertial components with it; a plane's
      * deflection lives in its own frame (_plane.h), whose (t1, t2) turn by phi n_z: the
      * floor's (normal +z) with it, the ceiling's (normal -z: t1 = x, t2 = -y) against it */
-    static const double sense[] = {1.0, 1.0, 1.0, 1.0, -1.0};
+    int planar[3 + BALLC_MAX_PLANES] = {BALLC_STATE_X, BALLC_STATE_OMEGA_X, BALLC_STATE_VX};
+    double sense[3 + BALLC_MAX_PLANES] = {1.0, 1.0, 1.0};
+    int pairs = 3, n = states_of(g);
+    for (int p = 0; p < g->n_planes; p++, pairs++) {
+        planar[pairs] = ballc_plane_state(p);
+        sense[pairs] = g->sense[p];
+    }
     double in[N], turned[4];
-    memcpy(in, y, sizeof in);
-    memcpy(out, in, sizeof in);
+    memcpy(in, y, n * sizeof(double));
+    memcpy(out, in, n * sizeof(double));
     double c = cos(g->phi), s = sin(g->phi);
     double half = 0.5 * g->phi, spin_half = 0.5 * g->psi, spin_sin = sin(spin_half);
     double vertical[4] = {cos(half), 0.0, 0.0, sin(half)};
@@ -66,7 +83,7 @@ void ballc_motion_apply(const ballc_motion *g, const double *y, int rate, double
     /* the scene turned about the vertical, the ball about its own axis */
     quaternion_multiply(vertical, in + BALLC_STATE_QW, turned);
     quaternion_multiply(turned, spin, out + BALLC_STATE_QW);
-    for (size_t b = 0; b < sizeof planar / sizeof planar[0]; b++) {
+    for (int b = 0; b < pairs; b++) {
         double x = in[planar[b]], yy = in[planar[b] + 1];
         out[planar[b]] = c * x - sense[b] * s * yy;
         out[planar[b] + 1] = sense[b] * s * x + c * yy;
@@ -90,17 +107,21 @@ double ballc_orbit_tilt(const double *y, const double *axis)
     return (r0 * axis[0] + r1 * axis[1] + r2 * axis[2]) / norm2;
 }
 
-int ballc_orbit_equivariant(const double *params, const double *latch, int flags,
+int ballc_orbit_equivariant(const double *params, const double *latch, long long flags,
                             const double *y, const double *axis)
 {
-    ballc_motion test = {1.0, {0.37, -0.21}, 0.7, {axis[0], axis[1], axis[2]}, {0.0, 0.0}};
+    ballc_motion test = {1.0, {0.37, -0.21}, 0.7, {axis[0], axis[1], axis[2]}, {0.0, 0.0},
+                         0, {0}};
+    ballc_motion_planes(&test, params);
+    if (!test.n_planes) return 0;
+    const int n = states_of(&test);
     double f[N], moved[N], f_moved[N], expected[N];
     if (ballc_rhs(y, params, latch, flags, f) != BALLC_OK) return 0;
     ballc_motion_apply(&test, y, 0, moved);
     if (ballc_rhs(moved, params, latch, flags, f_moved) != BALLC_OK) return 0;
     ballc_motion_apply(&test, f, 1, expected);
     double largest = 0.0, worst = 0.0;
-    for (int i = 0; i < N; i++) {
+    for (int i = 0; i < n; i++) {
         double miss = fabs(f_moved[i] - expected[i]);
         if (isnan(f[i]) || isnan(miss)) return 0;
         if (fabs(f[i]) > largest) largest = fabs(f[i]);
@@ -250,10 +271,10 @@ static void even(double t0, double t1, long n, double *times)
 static double mechanical_energy(const double *y, const ballc_parameters_t *prepared,
                                 double *kinetic)
 {
-    double e[BALLC_ENERGY_NOUT];
+    double e[BALLC_MAX_ENERGY_NOUT];
     ballc_energy(y, prepared, e);
     double sum = 0.0;
-    for (int i = 0; i < BALLC_ENERGY_NOUT; i++) sum += e[i];
+    for (int i = 0; i < BALLC_ENERGY_NOUT(prepared->n_planes); i++) sum += e[i];
     *kinetic = e[0];
     return sum;
 }
@@ -265,10 +286,13 @@ int ballc_orbit_measure(ballc_states_fn states, void *ctx, double t0, double t1,
     const long grid = BALLC_ORBIT_TILT_SAMPLES + 1;   /* the test's samples per period */
     double span = BALLC_ORBIT_TILT_SAMPLES * (t1 - t0) / guess;
     if (!(span >= 0 && span < 1e7)) return 0;
+    ballc_parameters_t prepared;
+    if (ballc_parameters_init(&prepared, tol->params) != BALLC_OK) return -1;
+    const int n = prepared.n_states;   /* the solution's rows: the run's states */
     long samples = (long)span + 2;
     long rows = samples > 2 * grid ? samples : 2 * grid;
     double *times = malloc((size_t)rows * sizeof(double));
-    double *ys = malloc((size_t)rows * N * sizeof(double));
+    double *ys = malloc((size_t)rows * n * sizeof(double));
     int found = 0;
     if (!times || !ys) { found = -2; goto done; }
     /* criterion 3: the tilt's upward crossings of its middle level */
@@ -276,9 +300,9 @@ int ballc_orbit_measure(ballc_states_fn states, void *ctx, double t0, double t1,
     if (states(ctx, samples, times, ys)) { found = -1; goto done; }
     double highest = -INFINITY, lowest = INFINITY;
     for (long i = 0; i < samples; i++) {
-        double a_z = ballc_orbit_tilt(ys + (size_t)i * N, axis);
+        double a_z = ballc_orbit_tilt(ys + (size_t)i * n, axis);
         if (isnan(a_z)) goto done;
-        ys[(size_t)i * N] = a_z;   /* kept in the row's first slot */
+        ys[(size_t)i * n] = a_z;   /* kept in the row's first slot */
         if (a_z > highest) highest = a_z;
         if (a_z < lowest) lowest = a_z;
     }
@@ -287,7 +311,7 @@ int ballc_orbit_measure(ballc_states_fn states, void *ctx, double t0, double t1,
     double ups[3];
     int n_ups = 0;
     for (long i = 0; i + 1 < samples && n_ups < 3; i++) {
-        double before = ys[(size_t)i * N] - g.level, after = ys[(size_t)(i + 1) * N] - g.level;
+        double before = ys[(size_t)i * n] - g.level, after = ys[(size_t)(i + 1) * n] - g.level;
         if (!(before < 0 && 0 <= after)) continue;
         int got = brent(&g, times[i], times[i + 1], before, after, &ups[n_ups]);
         if (got < 0) { found = -1; goto done; }
@@ -304,12 +328,13 @@ int ballc_orbit_measure(ballc_states_fn states, void *ctx, double t0, double t1,
     double speed = 0.0, atol_max = tol->atol[0];
     for (int i = 0; i < 3; i++)
         if (fabs(y1[BALLC_STATE_VX + i]) > speed) speed = fabs(y1[BALLC_STATE_VX + i]);
-    for (int i = 1; i < N; i++)
+    for (int i = 1; i < n; i++)
         if (tol->atol[i] > atol_max) atol_max = tol->atol[i];
     if (fabs((c2 - c1) - period) * speed > tol->rest_factor * (atol_max + tol->rtol)) goto done;
     /* criterion 4: G from c0 to c1 moves the integrated second period onto the third */
     ballc_motion motion;
     fit(y0, y1, axis, &motion);
+    ballc_motion_planes(&motion, tol->params);
     even(0.0, period, grid, times);
     for (long j = 0; j < grid; j++) {
         double s = times[j];
@@ -320,9 +345,9 @@ int ballc_orbit_measure(ballc_states_fn states, void *ctx, double t0, double t1,
     double worst = 0.0;
     for (long j = 0; j < grid; j++) {
         double moved[N];
-        const double *second = ys + (size_t)(grid + j) * N;
-        ballc_motion_apply(&motion, ys + (size_t)j * N, 0, moved);
-        for (int i = 0; i < N; i++) {
+        const double *second = ys + (size_t)(grid + j) * n;
+        ballc_motion_apply(&motion, ys + (size_t)j * n, 0, moved);
+        for (int i = 0; i < n; i++) {
             if (i == BALLC_STATE_DISSIPATED_NORMAL || i == BALLC_STATE_DISSIPATED_TANGENTIAL)
                 continue;   /* the work is checked as energy (criterion 5) */
             double misfit = fabs(moved[i] - second[i]) / (tol->atol[i]
@@ -333,8 +358,6 @@ int ballc_orbit_measure(ballc_states_fn states, void *ctx, double t0, double t1,
     }
     if (!(worst <= tol->rest_factor)) goto done;
     /* criterion 5: the mechanical energy changed by no more than the tolerance allows */
-    ballc_parameters_t prepared;
-    ballc_parameters_init(&prepared, tol->params);
     double kinetic, unused;
     double change = mechanical_energy(y2, &prepared, &unused)
                     - mechanical_energy(y0, &prepared, &kinetic);
@@ -371,7 +394,7 @@ int ballc_orbit_states(const ballc_orbit *orbit, ballc_states_fn base, void *ctx
     for (long i = 0; i < n; i++) {
         ballc_motion g;
         ballc_motion_power(&orbit->g, power[i], &g);
-        ballc_motion_apply(&g, y + (size_t)i * N, 0, y + (size_t)i * N);
+        ballc_motion_apply(&g, y + (size_t)i * states_of(&g), 0, y + (size_t)i * states_of(&g));
     }
 done:
     free(at);

@@ -11,6 +11,7 @@
 #define BALLC_ORBIT_H
 
 #include "_dense.h"
+#include "ballc_kernels.h"
 
 /* orbit.TRIAL_PERIODS: the periods a trial integrates (the stretch before the first
  * crossing, one to measure G, one to test it); TILT_SAMPLES: samples of the tilt per
@@ -20,7 +21,15 @@
 
 typedef struct {
     double phi, d[2], psi, axis[3], work[2];
+    /* the scene's planes (all horizontal: the orbit needs the symmetry about the
+     * vertical): how many, and how each one's deflection turns with the scene, +1 (its
+     * frame's t1, t2 turn with it: normal +z) or -1 (against it: normal -z) */
+    int n_planes;
+    double sense[BALLC_MAX_PLANES];
 } ballc_motion;
+
+/* G's planes (n_planes, sense) from a prepared parameter vector's plane table. */
+void ballc_motion_planes(ballc_motion *g, const double *params);
 
 /* G^k (k any integer, as a double): phi and psi times k, the shift summed in closed form,
  * d (e^(i k phi) - 1) / (e^(i phi) - 1), the work times k */
@@ -33,7 +42,7 @@ double ballc_orbit_tilt(const double *y, const double *axis);
 
 /* criterion 2: f(G y) = G_* f(y) to rounding, for a G that turns, shifts and spins:
  * 1 yes, 0 no (or the right-hand side could not be evaluated) */
-int ballc_orbit_equivariant(const double *params, const double *latch, int flags,
+int ballc_orbit_equivariant(const double *params, const double *latch, long long flags,
                             const double *y, const double *axis);
 
 typedef struct {
@@ -44,7 +53,7 @@ typedef struct {
 
 typedef struct {           /* the tolerances the trial was integrated to */
     double rtol;
-    const double *atol;    /* BALLC_N_STATES */
+    const double *atol;    /* one per state of the run (params' plane table) */
     double rest_factor;    /* resting.REST_FACTOR */
     double energy_threshold;   /* resting.energy_threshold */
     const double *params;
@@ -57,8 +66,8 @@ int ballc_orbit_measure(ballc_states_fn states, void *ctx, double t0, double t1,
                         const double *axis, double guess, const ballc_orbit_tolerances *tol,
                         ballc_orbit *out);
 
-/* y(t) = G^k base(c0 + s), t = c0 + k T + s, 0 <= s < T, at n times (rows of
- * BALLC_N_STATES): base(t') over [c0, c0 + T] is the trial's integrated solution.
+/* y(t) = G^k base(c0 + s), t = c0 + k T + s, 0 <= s < T, at n times (rows of the run's
+ * states, G's planes): base(t') over [c0, c0 + T] is the trial's integrated solution.
  * 0, -1 when base failed, -2 out of memory. */
 int ballc_orbit_states(const ballc_orbit *orbit, ballc_states_fn base, void *ctx, long n,
                        const double *t, double *y);

@@ -1,7 +1,7 @@
 # Included by _core.pyx before _driver_bridge.pxi.  Bridge to the compiled interpolants'
 # evaluation (_dense.c) and to the relative periodic orbit (_orbit.c): arrays in, C
 # called, arrays out.  A solution given as a Python callable (sol(t) of an array of
-# times -> (N_STATES, len(t))) is called back in batches.
+# times -> (states, len(t))) is called back in batches.
 
 cdef extern from "_dense.h":
     ctypedef int (*ballc_states_fn)(void *, long, const double *, double *) noexcept
@@ -33,10 +33,13 @@ cdef extern from "_orbit.h":
         double psi
         double axis[3]
         double work[2]
+        int n_planes
+        double sense[6]
     void ballc_motion_power(const ballc_motion *, double, ballc_motion *) nogil
     void ballc_motion_apply(const ballc_motion *, const double *, int, double *) nogil
+    void ballc_motion_planes(ballc_motion *, const double *) nogil
     double ballc_orbit_tilt(const double *, const double *) nogil
-    int ballc_orbit_equivariant(const double *, const double *, int, const double *,
+    int ballc_orbit_equivariant(const double *, const double *, long long, const double *,
                                 const double *) nogil
     ctypedef struct ballc_orbit:
         double c0, period
@@ -56,8 +59,10 @@ cdef extern from "_orbit.h":
 #: orbit.TRIAL_PERIODS and TILT_SAMPLES, from _orbit.h
 ORBIT_TRIAL_PERIODS = BALLC_ORBIT_TRIAL_PERIODS
 ORBIT_TILT_SAMPLES = BALLC_ORBIT_TILT_SAMPLES
-#: G as an array: phi, dx, dy, psi, the axis (3), the work (normal, tangential)
-MOTION_SIZE = 9
+#: G as an array: phi, dx, dy, psi, the axis (3), the work (normal, tangential), the
+#: number of planes, how each plane's deflection turns (MAX_PLANES: +1 with the scene,
+#: -1 against it; ballc_motion)
+MOTION_SIZE = 10 + BALLC_MAX_PLANES
 
 
 def dense_states(const double[:, ::1] steps, const double[:, ::1] coefficients,
@@ -98,24 +103,44 @@ cdef void _motion_of(const double[::1] m, ballc_motion *g) except *:
     g.axis[2] = m[6]
     g.work[0] = m[7]
     g.work[1] = m[8]
+    if not (1 <= m[9] <= BALLC_MAX_PLANES):
+        raise ValueError(f"motion: {m[9]} planes is not allowed")
+    g.n_planes = int(m[9])
+    cdef int p
+    for p in range(BALLC_MAX_PLANES):
+        g.sense[p] = m[10 + p]
 
 
 cdef tuple _motion_tuple(const ballc_motion *g):
     return (g.phi, g.d[0], g.d[1], g.psi, g.axis[0], g.axis[1], g.axis[2], g.work[0],
-            g.work[1])
+            g.work[1], g.n_planes) + tuple(g.sense[p] if p < g.n_planes else 0.0
+                                           for p in range(BALLC_MAX_PLANES))
+
+
+def motion_planes(const double[::1] params):
+    """The planes' part of a motion G of the scene with parameters ``params`` (the
+    number of planes, how each one's deflection turns: MOTION_SIZE's last numbers)."""
+    _planes_of(params)
+    cdef ballc_motion g
+    ballc_motion_planes(&g, &params[0])
+    return _motion_tuple(&g)[9:]
 
 
 def motion_apply(const double[::1] motion, y, k=1, bint rate=False):
-    """G^k y for states y, (N_STATES,) or (N_STATES, n); k an integer, or one per column;
-    with ``rate``, G_* of a time derivative (no shift, no work added)."""
+    """G^k y for states y, (states,) or (states, n) (G's scene's states); k an integer,
+    or one per column; with ``rate``, G_* of a time derivative (no shift, no work
+    added)."""
     cdef ballc_motion g, gk
     _motion_of(motion, &g)
+    cdef int width = _states(g.n_planes)
     states = np.asarray(y, dtype=float)
     single = states.ndim == 1
-    cdef double[:, ::1] rows = np.ascontiguousarray(states.reshape(BALLC_N_STATES, -1).T)
+    if states.shape[0] != width:
+        raise ValueError(f"y must have {width} states (rows), got {states.shape[0]}")
+    cdef double[:, ::1] rows = np.ascontiguousarray(states.reshape(width, -1).T)
     cdef Py_ssize_t i, n = rows.shape[0]
     powers = np.broadcast_to(np.asarray(k, dtype=float), (n,))
-    out = np.empty((n, BALLC_N_STATES))
+    out = np.empty((n, width))
     cdef double[:, ::1] o = out
     for i in range(n):
         ballc_motion_power(&g, powers[i], &gk)
@@ -124,10 +149,10 @@ def motion_apply(const double[::1] motion, y, k=1, bint rate=False):
 
 
 def orbit_tilt(y, const double[::1] axis):
-    """a_z, the vertical component of the ball's axis, of states (N_STATES, ...)."""
+    """a_z, the vertical component of the ball's axis, of states (states, ...)."""
     _check("axis", axis.shape[0], 3)
     states = np.asarray(y, dtype=float)
-    cdef double[:, ::1] rows = np.ascontiguousarray(states.reshape(BALLC_N_STATES, -1).T)
+    cdef double[:, ::1] rows = np.ascontiguousarray(states.reshape(states.shape[0], -1).T)
     out = np.empty(rows.shape[0])
     cdef double[::1] o = out
     cdef Py_ssize_t i
@@ -136,22 +161,21 @@ def orbit_tilt(y, const double[::1] axis):
     return float(out[0]) if states.ndim == 1 else out.reshape(states.shape[1:])
 
 
-def orbit_equivariant(const double[::1] params, const double[::1] latch, int flags,
+def orbit_equivariant(const double[::1] params, const double[::1] latch, long long flags,
                       const double[::1] y, const double[::1] axis):
     """Criterion 2 of ballc.orbit: f(G y) = G_* f(y) to rounding."""
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
-    _check("latch", latch.shape[0], BALLC_N_LATCH)
-    _check("y", y.shape[0], BALLC_N_STATES)
+    _check_call(params, y.shape[0], latch.shape[0])
     _check("axis", axis.shape[0], 3)
     return bool(ballc_orbit_equivariant(&params[0], &latch[0], flags, &y[0], &axis[0]))
 
 
 cdef int _python_states(void *ctx, long n, const double *t, double *y) noexcept:
-    """ballc_states_fn of a Python solution: ctx is [sol, the exceptions kept].  Called
-    from C with the GIL held (the bridge's callers below do not release it)."""
+    """ballc_states_fn of a Python solution: ctx is [sol, the exceptions kept, the
+    number of states].  Called from C with the GIL held (the bridge's callers below do
+    not release it)."""
     cdef double[::1] tv
     cdef double[:, ::1] yv
-    sol, errors = (<list>ctx)[0], (<list>ctx)[1]
+    sol, errors, width = (<list>ctx)[0], (<list>ctx)[1], (<list>ctx)[2]
     if errors:
         return -1
     try:
@@ -159,9 +183,9 @@ cdef int _python_states(void *ctx, long n, const double *t, double *y) noexcept:
         tv = times
         memcpy(&tv[0], t, n * sizeof(double))
         values = np.ascontiguousarray(np.asarray(sol(times), dtype=float)
-                                      .reshape(BALLC_N_STATES, n).T)
+                                      .reshape(width, n).T)
         yv = values
-        memcpy(y, &yv[0, 0], n * BALLC_N_STATES * sizeof(double))
+        memcpy(y, &yv[0, 0], n * width * sizeof(double))
         return 0
     except BaseException as error:
         errors.append(error)
@@ -175,11 +199,11 @@ def orbit_measure(sol, double t0, double t1, const double[::1] axis, double gues
     [t0, t1]): (c0, period, G as MOTION_SIZE numbers, the mechanical energy's rate of
     change (W)), or None."""
     _check("axis", axis.shape[0], 3)
-    _check("atol", atol.shape[0], BALLC_N_STATES)
-    _check("params", params.shape[0], BALLC_N_PARAMETERS)
+    cdef int width = _states(_planes_of(params))
+    _check("atol", atol.shape[0], width)
     cdef ballc_orbit_tolerances tol
     cdef ballc_orbit found
-    cdef list ctx = [sol, []]
+    cdef list ctx = [sol, [], width]
     tol.rtol = rtol
     tol.atol = &atol[0]
     tol.rest_factor = rest_factor
@@ -198,15 +222,16 @@ def orbit_measure(sol, double t0, double t1, const double[::1] axis, double gues
 
 def orbit_states(const double[::1] t, double c0, double period, const double[::1] motion,
                  base):
-    """y(t) = G^k base(c0 + s), t = c0 + k T + s (0 <= s < T): (N_STATES, len(t));
+    """y(t) = G^k base(c0 + s), t = c0 + k T + s (0 <= s < T): (states, len(t));
     ``base``: a callable y(t') over [c0, c0 + T]."""
     cdef ballc_orbit orbit
     orbit.c0 = c0
     orbit.period = period
     orbit.rate = 0.0
     _motion_of(motion, &orbit.g)
-    cdef list ctx = [base, []]
-    out = np.empty((t.shape[0], BALLC_N_STATES))
+    cdef int width = _states(orbit.g.n_planes)
+    cdef list ctx = [base, [], width]
+    out = np.empty((t.shape[0], width))
     cdef double[:, ::1] o = out
     if t.shape[0] == 0:
         return out.T

@@ -32,10 +32,10 @@ void ballc_plane_init(ballc_plane_t *plane, const double *point, const double *n
 }
 
 void ballc_plane_state_columns(const ballc_plane_t *plane, const double *local, int rows,
-                               double *jac)
+                               int n_states, double *jac)
 {
     const double (*f)[3] = plane->frame;
-    const int NC = BALLC_N_CONTACT_STATES, NS = BALLC_N_STATES;
+    const int NC = BALLC_N_CONTACT_STATES, NS = n_states;
     for (int r = 0; r < rows; r++, local += NC, jac += NS) {
         for (int j = 0; j < NS; j++) jac[j] = 0.0;
         const double *w = local + BALLC_CONTACT_STATE_OMEGA_X, *v = local + BALLC_CONTACT_STATE_VX;

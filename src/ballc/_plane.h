@@ -84,9 +84,9 @@ static inline void ballc_plane_to_inertial(const ballc_plane_t *plane, double *v
 }
 
 /* A plane kernel's Jacobian rows ``local`` (rows x BALLC_N_CONTACT_STATES, row-major) as
- * derivatives by the ball's state: ``jac`` (rows x BALLC_N_STATES, written). */
+ * derivatives by the run's state: ``jac`` (rows x n_states, written). */
 void ballc_plane_state_columns(const ballc_plane_t *plane, const double *local, int rows,
-                               double *jac);
+                               int n_states, double *jac);
 
 /* Rows of ``m`` (each ``columns`` long, row-major) from the plane's frame to inertial
  * components: ``count`` consecutive triples of rows from ``first_row`` on, each turned

@@ -106,21 +106,22 @@ ctypedef struct ball_ctx:
     const double *params
     ballc_parameters_t prepared   # params and their constants, prepared once per segment
     double *latch            # writable: a re-armed event may change it
-    int flags
-    int *event_plane         # per event: 0/1 stick release of that plane, 2 + 2 row +
-                             # plane row ``row`` of the compliant margins (0 yield,
-                             # 1 re-stick, 4/5 the capacity margin and its negative), -1
-                             # linear, -2 - k the user's Python event k (writable: a
-                             # capacity guard toggles between rows 4 and 5)
+    ballc_flags flags
+    int n_states, n_latch    # the run's (its parameters' plane table)
+    int *event_plane         # per event: 0 .. MAX_PLANES - 1 stick release of that plane,
+                             # margin_event_code(row, plane) row ``row`` of the compliant
+                             # margins (0 yield, 1 re-stick, 4/5 the capacity margin and
+                             # its negative), -1 linear, -2 - k the user's Python event k
+                             # (writable: a capacity guard toggles between rows 4 and 5)
     void *user_events        # list of the user's event callables (borrowed)
     void *errors             # list collecting exceptions raised by them (borrowed)
     void *rearms             # per event: its ``rearm`` callable or None (borrowed)
-    double *ev_coef_w        # the event arrays radau5 reads (events x N_STATES, events)
+    double *ev_coef_w        # the event arrays radau5 reads (events x n_states, events)
     double *ev_offset_w
     # the last compliant margins computed (a segment's yield and capacity guards read the
     # same kernel at the same state): the state, the plane (-1: none), whether the
     # re-stick margin's solve was made, the margins
-    double *margins_y        # N_STATES (a buffer solve_system holds)
+    double *margins_y        # n_states (a buffer solve_system holds)
     int margins_plane
     int margins_solved
     double margins_out[6]
@@ -144,18 +145,18 @@ cdef int _ball_event(void *ctx, int e, double t, const double *y, double *g) noe
     if plane <= -2:
         with gil:
             return _user_event(c, -2 - plane, t, y, g)
-    if plane >= 2:
-        row = (plane - 2) // 2
-        plane = plane % 2
+    if plane >= _MARGIN_CODE:
+        row = (plane - _MARGIN_CODE) // BALLC_MAX_PLANES
+        plane = (plane - _MARGIN_CODE) % BALLC_MAX_PLANES
         if (c.margins_plane == plane and (row != 1 or c.margins_solved)
-                and memcmp(c.margins_y, y, BALLC_N_STATES * sizeof(double)) == 0):
+                and memcmp(c.margins_y, y, c.n_states * sizeof(double)) == 0):
             g[0] = c.margins_out[row]   # the same kernel at the same state: its values
             return BALLC_OK
-        status = ballc_compliant_margins_prepared(y, &c.prepared, c.latch, plane, row,
-                                                  c.margins_out)
+        status = ballc_compliant_margins_prepared(y, &c.prepared, c.latch, c.flags, plane,
+                                                  row, c.margins_out)
         c.margins_plane = plane if status == BALLC_OK else -1
         c.margins_solved = row == 1
-        memcpy(c.margins_y, y, BALLC_N_STATES * sizeof(double))
+        memcpy(c.margins_y, y, c.n_states * sizeof(double))
         g[0] = c.margins_out[row]
         return status
     status = ballc_stick_state(y, c.params, c.latch, c.flags, plane, out)
@@ -172,9 +173,9 @@ cdef int _user_event(ball_ctx *c, int k, double t, const double *y, double *g) n
         g[0] = NAN
         return -1
     try:
-        state = np.empty(BALLC_N_STATES)
+        state = np.empty(c.n_states)
         yv = state
-        memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+        memcpy(&yv[0], y, c.n_states * sizeof(double))
         g[0] = float((<list>c.user_events)[k](t, state))
         return 0
     except BaseException as error:
@@ -182,11 +183,24 @@ cdef int _user_event(ball_ctx *c, int k, double t, const double *y, double *g) n
         g[0] = NAN
         return -1
 
-#: The codes of the capacity guards (compliant margin rows 4 and 5, per plane): a capacity
-#: guard that fires is re-armed in C to watch the way back (row 4 <-> 5).
-cdef enum:
-    _CAPACITY_FIRST = 2 + 2 * 4
-    _CAPACITY_SECOND = 2 + 2 * 5
+#: The codes of the system's events: 0 .. MAX_PLANES - 1 a plane's stick release, from
+#: _MARGIN_CODE on row ``row`` of a plane's compliant margins (margin_event_code); the
+#: capacity guards (rows 4 and 5, per plane): a capacity guard that fires is re-armed in
+#: C to watch the way back (row 4 <-> 5).
+cdef int _MARGIN_CODE = BALLC_MAX_PLANES
+cdef int _CAPACITY_FIRST = BALLC_MAX_PLANES + 4 * BALLC_MAX_PLANES
+cdef int _CAPACITY_SECOND = BALLC_MAX_PLANES + 5 * BALLC_MAX_PLANES
+
+
+def margin_event_code(int row, int plane):
+    """The ``system_event`` code of row ``row`` of the compliant margins of the plane with
+    index ``plane`` (solve_system's events)."""
+    return _MARGIN_CODE + row * BALLC_MAX_PLANES + plane
+
+
+def margin_event_row(int code):
+    """The margins' row of a ``system_event`` code (margin_event_code's inverse)."""
+    return (code - _MARGIN_CODE) // BALLC_MAX_PLANES
 
 cdef int _ball_rearm(void *ctx, int e, double t, const double *y) noexcept nogil:
     """Re-arm event e at its hit: a capacity guard toggles its row (no Python, no change
@@ -195,7 +209,8 @@ cdef int _ball_rearm(void *ctx, int e, double t, const double *y) noexcept nogil
     cdef ball_ctx *c = <ball_ctx *>ctx
     cdef int code = c.event_plane[e]
     if code >= _CAPACITY_FIRST:
-        c.event_plane[e] = code + 2 if code < _CAPACITY_SECOND else code - 2
+        c.event_plane[e] = (code + BALLC_MAX_PLANES if code < _CAPACITY_SECOND
+                            else code - BALLC_MAX_PLANES)
         return 1
     with gil:
         return _rearm_event(c, e, t, y)
@@ -213,22 +228,22 @@ cdef int _rearm_event(ball_ctx *c, int e, double t, const double *y) noexcept:
     if errors:
         return 0
     try:
-        state = np.empty(BALLC_N_STATES)
+        state = np.empty(c.n_states)
         yv = state
-        memcpy(&yv[0], y, BALLC_N_STATES * sizeof(double))
+        memcpy(&yv[0], y, c.n_states * sizeof(double))
         out = (<list>c.rearms)[e](t, state)
         if out is None:
             return 0
         coefficients, offset, latch = out
-        cv = _checked_row("rearm coefficients", coefficients, BALLC_N_STATES)
-        lv = _checked_row("rearm latch", latch, BALLC_N_LATCH)
+        cv = _checked_row("rearm coefficients", coefficients, c.n_states)
+        lv = _checked_row("rearm latch", latch, c.n_latch)
         off = float(offset)
         if not isfinite(off):
             raise ValueError(f"rearm offset = {offset!r} is not allowed: must be finite")
-        memcpy(c.ev_coef_w + <size_t>e * BALLC_N_STATES, &cv[0],
-               BALLC_N_STATES * sizeof(double))
+        memcpy(c.ev_coef_w + <size_t>e * c.n_states, &cv[0],
+               c.n_states * sizeof(double))
         c.ev_offset_w[e] = off
-        memcpy(c.latch, &lv[0], BALLC_N_LATCH * sizeof(double))
+        memcpy(c.latch, &lv[0], c.n_latch * sizeof(double))
         c.margins_plane = -1   # the margins read the latch
         return 1
     except BaseException as error:
@@ -359,8 +374,9 @@ def terminal_count(terminal) -> int:
 
 def _event_arrays(events, int n):
     """Linear events (``coefficients``, ``offset``), events the system evaluates in C
-    (``system_event``, ``offset``: 0/1 the stick release mu N - |lambda| + offset of the
-    floor/ceiling, 2/3 the compliant yield margin, 4/5 its re-stick margin) and, for
+    (``system_event``, ``offset``: a plane's index, the stick release mu N - |lambda| +
+    offset of that plane; margin_event_code(row, plane): a row of the compliant
+    margins, 0 the yield margin, 1 the re-stick margin) and, for
     ballc's system, any other callable g(t, y) (a user event, called from C).
     Returns (m, coef, offset, ints, user callables, rearms); ``ints`` (5 rows):
     terminal, direction, plane (-1 linear, 0..5 a system event, -2 - k the user's event
@@ -659,11 +675,12 @@ cdef int _method_code(method) except -1:
                      "'auto'")
 
 
-def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
+def solve_system(params, latch, long long flags, t_span, y0, *, rtol, atol,
                  max_step=np.inf, t_eval=None, events=(), first_step=None, max_nfev=None,
                  dense_output=False, controller=None, refine_events=True, method="radau5",
                  auto_implicit=False):
-    """Integrate ballc's equations (N_STATES states) over ``t_span`` with radau5.
+    """Integrate ballc's equations (the run's states: its parameters' plane table) over
+    ``t_span`` with radau5.
 
     ``method``: "radau5" (Radau IIA, order 5: scipy's Radau), "dop853" (Dormand &
     Prince's explicit pair of order 8: scipy's DOP853, for scenes that are not stiff;
@@ -674,12 +691,13 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     Also returned: ``switches`` [(t, method switched to)], ``method_end`` (the method
     in use at the end) and ``nstep_implicit`` (the radau5 steps of nstep).
 
-    ``params`` (N_PARAMETERS), ``latch`` (N_LATCH) and ``flags`` are as for
-    ``_core.System``.  ``events``: objects with ``coefficients`` (N_STATES),
-    ``offset``, ``terminal`` and ``direction`` -- g(y) = coefficients . y + offset --
-    or with ``system_event`` instead of ``coefficients``: a margin evaluated in C plus
-    ``offset`` (0/1: the stick-to-slip margin mu N - |lambda| of the floor/ceiling;
-    2/3: the compliant law's yield margin, 4/5: its re-stick margin); or
+    ``params``, ``latch`` and ``flags`` are as for ``_core.System``.  ``events``:
+    objects with ``coefficients`` (one per state), ``offset``, ``terminal`` and
+    ``direction`` -- g(y) = coefficients . y + offset -- or with ``system_event``
+    instead of ``coefficients``: a margin evaluated in C plus ``offset`` (a plane's
+    index: the stick-to-slip margin mu N - |lambda| of that plane;
+    margin_event_code(row, plane): the compliant law's yield margin (row 0) or its
+    re-stick margin (row 1)); or
     any other callable g(t, y) with optional ``terminal``/``direction`` (called from C
     with the GIL; an exception it raises is re-raised after the integration).  A
     terminal linear event may carry ``rearm``: a callable (t, y) -> None or
@@ -691,9 +709,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     size, Jacobian and history, and the hit is not reported (``n_rearmed`` counts them).
     Returns a solve_ivp-shaped OptimizeResult (t, y, t_events, y_events, status,
     message, success, nfev, njev, nlu) plus nstep and nreject (``y`` is the transpose of
-    the solver's rows: shape (N_STATES, samples), Fortran order), and ``dense``: with
+    the solver's rows: shape (states, samples), Fortran order), and ``dense``: with
     ``dense_output``, (dense_t (steps x 2: t_old, t), dense_c (steps x (1 + terms)
-    N_STATES: y_old, then ``terms`` rows of N_STATES: radau5 3, y = y_old + sum_j
+    states: y_old, then ``terms`` rows of states: radau5 3, y = y_old + sum_j
     row_j x^(j+1); dop853 7, scipy's Dop853DenseOutput F), terms, kinds (steps,):
     each step's own number of terms -- with "auto" a radau5 step (3) in rows as wide as
     dop853's (7, the rest zeros)), else None.
@@ -705,8 +723,9 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     (a cubic, as in solve_ivp); False: solve_ivp's.
     """
     cdef ball_ctx ctx
-    params = _vector("params", params, BALLC_N_PARAMETERS)
-    latch = np.array(_vector("latch", latch, BALLC_N_LATCH))   # own copy: re-arming writes it
+    cdef int n_planes = _planes_of(np.ascontiguousarray(params, dtype=float))
+    params = _vector("params", params, BALLC_PARAMETER_PLANES + n_planes * BALLC_N_PLANE_FIELDS)
+    latch = np.array(_vector("latch", latch, _latches(n_planes)))   # own copy: re-arming writes it
     cdef double[::1] pv = params, lv = latch
     planes_array = np.empty(max(len(events or ()), 1), dtype=np.intc)
     planes_array.fill(-1)
@@ -715,23 +734,27 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
     ballc_parameters_init(&ctx.prepared, &pv[0])
     ctx.latch = &lv[0]
     ctx.flags = flags
+    ctx.n_states = _states(n_planes)
+    ctx.n_latch = _latches(n_planes)
     ctx.event_plane = &planes[0]
-    margins_state = np.empty(BALLC_N_STATES)
+    margins_state = np.empty(ctx.n_states)
     cdef double[::1] margins_y = margins_state
     ctx.margins_y = &margins_y[0]
     ctx.margins_plane = -1
     users, errors = [], []
     ctx.user_events = <void *>users
     ctx.errors = <void *>errors
-    sol = _solve(_ball_fun, _ball_jac, &ctx, BALLC_N_STATES, t_span, y0, rtol, atol,
+    cdef ballc_flags compliant = 0, sliding = 0
+    cdef int p
+    for p in range(n_planes):
+        compliant |= ballc_flag(BALLC_KIND_COMPLIANT, p)
+        sliding |= ballc_flag(BALLC_KIND_COMPLIANT_SLIDING, p)
+    sol = _solve(_ball_fun, _ball_jac, &ctx, ctx.n_states, t_span, y0, rtol, atol,
                  max_step, t_eval, events, first_step, max_nfev, _ball_event, planes,
                  users, bool(dense_output), controller,
                  True,   # ballc_rhs/ballc_jacobian report non-finite outputs themselves
-                 bool(refine_events), &ctx, method,
-                 (flags & (BALLC_FLOOR_COMPLIANT | BALLC_CEILING_COMPLIANT)) != 0,
-                 bool(auto_implicit),
-                 (flags & (BALLC_FLOOR_COMPLIANT_SLIDING
-                           | BALLC_CEILING_COMPLIANT_SLIDING)) != 0)
+                 bool(refine_events), &ctx, method, (flags & compliant) != 0,
+                 bool(auto_implicit), (flags & sliding) != 0)
     if errors:
         raise errors[0]
     # each system event's code at the end (a capacity guard re-armed in C has toggled)

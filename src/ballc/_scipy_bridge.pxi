@@ -17,10 +17,11 @@ cdef extern from "_driver.h":
 
 cdef extern from "_driver.h":
     ctypedef struct ballc_segment:
-        int flags
+        ballc_flags flags
         const double *latch
         const double *params
         long interpolant
+        int n_latch
     int BALLC_INTEGRATOR_RAISED
 
 cdef extern from "_integrator.h":
@@ -54,8 +55,8 @@ cdef class _Guard:
             v = y
         except (TypeError, ValueError):
             v = np.ascontiguousarray(y, dtype=float)
-        if v.shape[0] != BALLC_N_STATES:
-            raise ValueError(f"y must have {BALLC_N_STATES} values, got {v.shape[0]}")
+        if v.shape[0] != self.p.n:
+            raise ValueError(f"y must have {self.p.n} values, got {v.shape[0]}")
         g = radau5_event_value(self.p, self.e, t, &v[0], &status)
         if status and self.errors:   # a user's callable raised: stop solve_ivp
             raise _Kept()
@@ -69,10 +70,12 @@ cdef class _ScipyRun:
     cdef object method, atol, solve
     cdef list errors, interpolants
     cdef object params
+    cdef int n_states
 
     def __init__(self, method, atol, params, list errors):
         from . import scipy_segment
         self.method, self.atol, self.params = method, atol, params
+        self.n_states = layout_of(params)[1]
         self.errors = errors
         self.interpolants = []
         self.solve = scipy_segment.solve
@@ -96,8 +99,8 @@ cdef int _scipy_segment(_ScipyRun run, const radau5_problem *p, ballc_segment *s
     res.status = RADAU5_FAILED
     seg.interpolant = -1
     try:
-        latch = np.empty(BALLC_N_LATCH)
-        for e in range(BALLC_N_LATCH):
+        latch = np.empty(seg.n_latch)
+        for e in range(seg.n_latch):
             latch[e] = seg.latch[e]
         system = System(run.params, latch, seg.flags)
         for e in range(m):
@@ -108,8 +111,8 @@ cdef int _scipy_segment(_ScipyRun run, const radau5_problem *p, ballc_segment *s
             guard.terminal = p.ev_terminal[e] if p.ev_terminal[e] > 1 else p.ev_terminal[e] == 1
             guard.direction = p.ev_direction[e]
             guards.append(guard)
-        y0 = np.empty(BALLC_N_STATES)
-        for e in range(BALLC_N_STATES):
+        y0 = np.empty(p.n)
+        for e in range(p.n):
             y0[e] = p.y0[e]
         t_eval = None
         if p.t_eval != NULL:
@@ -119,7 +122,7 @@ cdef int _scipy_segment(_ScipyRun run, const radau5_problem *p, ballc_segment *s
                         max_nfev=p.max_nfev if p.max_nfev > 0 else None,
                         first_step=p.first_step if p.first_step > 0 else None,
                         dense_output=bool(p.dense_output))
-        if not _fill_result(sol, m, res):
+        if not _fill_result(sol, m, p.n, res):
             return RADAU5_OUT_OF_MEMORY
         if p.dense_output and sol.sol is not None:
             run.interpolants.append(sol.sol)
@@ -147,22 +150,23 @@ cdef int _scipy_interpolant(void *ctx, long id, long n, const double *t,
             times = np.array([t[i] for i in range(n)], dtype=float)
             values = np.ascontiguousarray(
                 np.asarray(run.interpolants[id](times), dtype=float).reshape(
-                    BALLC_N_STATES, n).T)
+                    run.n_states, n).T)
             if n:
-                memcpy(y, &values[0, 0], n * BALLC_N_STATES * sizeof(double))
+                memcpy(y, &values[0, 0], n * run.n_states * sizeof(double))
             return 0
         except BaseException as error:
             run.errors.append(error)
             return -1
 
 
-def _scipy_interpolant_rows(interpolant, t):
+def _scipy_interpolant_rows(interpolant, t, params):
     """``interpolant`` (a scipy OdeSolution) at the times t as C code reads a scipy
-    run's interpolant (_scipy_interpolant): rows (len(t), N_STATES) (tests)."""
+    run's interpolant (_scipy_interpolant): rows (len(t), states) (tests); ``params``:
+    the run's parameter vector (its states)."""
     cdef const double[::1] tv = np.ascontiguousarray(t, dtype=float)
-    run = _ScipyRun("Radau", 1.0, np.zeros(BALLC_N_PARAMETERS), [])
+    run = _ScipyRun("Radau", 1.0, np.ascontiguousarray(params, dtype=float), [])
     run.interpolants.append(interpolant)
-    out = np.empty((tv.shape[0], BALLC_N_STATES))
+    out = np.empty((tv.shape[0], run.n_states))
     cdef double[:, ::1] ov = out
     if _scipy_interpolant(<void *>run, 0, tv.shape[0], &tv[0] if tv.shape[0] else NULL,
                           &ov[0, 0] if tv.shape[0] else NULL):
@@ -170,29 +174,29 @@ def _scipy_interpolant_rows(interpolant, t):
     return out
 
 
-cdef bint _fill_result(sol, int m, radau5_result *res) except -1:
+cdef bint _fill_result(sol, int m, int n_states, radau5_result *res) except -1:
     """solve_ivp's solution as radau5_solve's result (its buffers malloc'd: radau5_free
     frees them); False when out of memory."""
     cdef const double[::1] tv
     cdef const double[:, ::1] yv
     cdef Py_ssize_t n, h, k, i, hits
     t = np.ascontiguousarray(sol.t, dtype=float)
-    y = np.ascontiguousarray(np.asarray(sol.y, dtype=float).T)   # samples x N_STATES
+    y = np.ascontiguousarray(np.asarray(sol.y, dtype=float).T)   # samples x states
     n = t.shape[0]
     res.t_out = <double *>malloc(max(n, 1) * sizeof(double))
-    res.y_out = <double *>malloc(max(n, 1) * BALLC_N_STATES * sizeof(double))
+    res.y_out = <double *>malloc(max(n, 1) * n_states * sizeof(double))
     if res.t_out == NULL or res.y_out == NULL:
         return False
     if n:
         tv = t
         yv = y
         memcpy(res.t_out, &tv[0], n * sizeof(double))
-        memcpy(res.y_out, &yv[0, 0], n * BALLC_N_STATES * sizeof(double))
+        memcpy(res.y_out, &yv[0, 0], n * n_states * sizeof(double))
     res.n_out = n
     hits = sum(len(te) for te in sol.t_events)
     res.hit_event = <int *>malloc(max(hits, 1) * sizeof(int))
     res.hit_t = <double *>malloc(max(hits, 1) * sizeof(double))
-    res.hit_y = <double *>malloc(max(hits, 1) * BALLC_N_STATES * sizeof(double))
+    res.hit_y = <double *>malloc(max(hits, 1) * n_states * sizeof(double))
     if res.hit_event == NULL or res.hit_t == NULL or res.hit_y == NULL:
         return False
     h = 0
@@ -200,13 +204,13 @@ cdef bint _fill_result(sol, int m, radau5_result *res) except -1:
         te = sol.t_events[k]
         if not len(te):
             continue
-        ye = np.ascontiguousarray(sol.y_events[k], dtype=float).reshape(-1, BALLC_N_STATES)
+        ye = np.ascontiguousarray(sol.y_events[k], dtype=float).reshape(-1, n_states)
         yv = ye
         for i in range(len(te)):
             res.hit_event[h] = k
             res.hit_t[h] = te[i]
-            memcpy(res.hit_y + h * BALLC_N_STATES, &yv[i, 0],
-                   BALLC_N_STATES * sizeof(double))
+            memcpy(res.hit_y + h * n_states, &yv[i, 0],
+                   n_states * sizeof(double))
             h += 1
     res.n_hits = h
     status = int(sol.status)

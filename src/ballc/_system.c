@@ -5,11 +5,12 @@
 
 #include "_system.h"
 
-#define NS BALLC_N_STATES
+#define MAXS BALLC_MAX_STATES
+#define NB BALLC_N_BALL_STATES   /* the ball's states: the generated dynamics' columns */
 #define NQ 7  /* coordinates: quaternion (4) and centre (3) */
 #define NU 6  /* speeds: angular velocity (3) and centre velocity (3) */
 #define NC BALLC_N_CONTACT_STATES
-#define NP BALLC_N_PLANES
+#define MAXP BALLC_MAX_PLANES
 
 typedef void (*kernel_fn)(const double *restrict, const double *restrict,
                           const double *restrict, const double *restrict, double *restrict);
@@ -17,27 +18,40 @@ typedef void (*kernel_fn)(const double *restrict, const double *restrict,
 /* A kernel's parameter arguments: the parameters and their constants. */
 #define PARAMS(p) (p)->values, (p)->constants
 
-/* Each plane's deflection states (x; y next). */
-static const int DEFLECTION[NP] = {BALLC_STATE_FLOOR_DEFLECTION_X,
-                                   BALLC_STATE_CEILING_DEFLECTION_X};
+int ballc_plane_count(const double *params)
+{
+    double count = params[BALLC_PARAMETER_PLANE_COUNT];
+    if (!(count >= 1 && count <= MAXP) || count != (double)(int)count) return -1;
+    return (int)count;
+}
 
-void ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
+int ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
 {
     prepared->values = params;
+    int n = ballc_plane_count(params);
+    if (n < 0) {
+        prepared->n_planes = 0;
+        return BALLC_BAD_PLANES;
+    }
+    prepared->n_planes = n;
+    prepared->n_states = NB + BALLC_N_PLANE_STATES * n;
+    prepared->n_latch = BALLC_N_LATCH_PER_PLANE * n;
+    prepared->n_parameters = BALLC_PARAMETER_PLANES + BALLC_N_PLANE_FIELDS * n;
     ballc_parameter_constants(params, prepared->constants);
     const double anywhere[NC] = {0};   /* the slip maps are constants (codegen checks) */
     double maps[BALLC_PLANE_SLIP_MAP_NOUT];
     ballc_plane_slip_map(anywhere, PARAMS(prepared), NULL, maps);
-    for (int p = 0; p < NP; p++) {
+    for (int p = 0; p < n; p++) {
         const double *entry = params + BALLC_PARAMETER_PLANES + p * BALLC_N_PLANE_FIELDS;
         ballc_plane_t *pl = &prepared->planes[p];
         ballc_plane_init(pl, entry + BALLC_PLANE_POINT_X, entry + BALLC_PLANE_NORMAL_X,
-                         params + BALLC_PARAMETER_GRAVITY_X, DEFLECTION[p]);
+                         params + BALLC_PARAMETER_GRAVITY_X, ballc_plane_state(p));
         /* the plane's slip map by the ball's state, its force map in inertial components */
-        ballc_plane_state_columns(pl, maps, 2, prepared->slip_map[p]);
+        ballc_plane_state_columns(pl, maps, 2, prepared->n_states, prepared->slip_map[p]);
         memcpy(prepared->slip_force_map[p], maps + 2 * NC, sizeof prepared->slip_force_map[p]);
         ballc_plane_rows_to_inertial(pl, prepared->slip_force_map[p], 2, 0, 2);
     }
+    return BALLC_OK;
 }
 
 /* Contact laws: which flag switches them on, per plane, their kernels (in a plane's own
@@ -46,29 +60,31 @@ void ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
  * coefficients of the exact penetration acceleration rho'' (codegen:
  * contact.ACCELERATION_LAWS). */
 static const struct {
-    int flag[NP]; kernel_fn value, jac, normal, normal_jac, acceleration;
+    int kind; kernel_fn value, jac, normal, normal_jac, acceleration;
 } CONTACT_LAWS[] = {
-    {{BALLC_FLOOR_FRICTION, BALLC_CEILING_FRICTION}, ballc_plane_friction,
-     ballc_plane_friction_jac, ballc_plane_friction_normal, ballc_plane_friction_normal_jac,
-     NULL},
-    {{BALLC_FLOOR_DIGIN, BALLC_CEILING_DIGIN}, ballc_plane_digin, ballc_plane_digin_jac,
-     NULL, NULL, NULL},
-    {{BALLC_FLOOR_COMPLIANT, BALLC_CEILING_COMPLIANT}, ballc_plane_compliant,
-     ballc_plane_compliant_jac, NULL, NULL, NULL},
-    {{BALLC_FLOOR_COMPLIANT_SLIDING, BALLC_CEILING_COMPLIANT_SLIDING},
-     ballc_plane_compliant_sliding, ballc_plane_compliant_sliding_jac, NULL, NULL,
-     ballc_plane_compliant_sliding_acceleration},
-    {{BALLC_FLOOR_COMPLIANT_ELASTIC, BALLC_CEILING_COMPLIANT_ELASTIC},
-     ballc_plane_compliant_elastic, ballc_plane_compliant_elastic_jac, NULL, NULL, NULL},
+    {BALLC_KIND_FRICTION, ballc_plane_friction, ballc_plane_friction_jac,
+     ballc_plane_friction_normal, ballc_plane_friction_normal_jac, NULL},
+    {BALLC_KIND_DIGIN, ballc_plane_digin, ballc_plane_digin_jac, NULL, NULL, NULL},
+    {BALLC_KIND_COMPLIANT, ballc_plane_compliant, ballc_plane_compliant_jac, NULL, NULL, NULL},
+    {BALLC_KIND_COMPLIANT_SLIDING, ballc_plane_compliant_sliding,
+     ballc_plane_compliant_sliding_jac, NULL, NULL, ballc_plane_compliant_sliding_acceleration},
+    {BALLC_KIND_COMPLIANT_ELASTIC, ballc_plane_compliant_elastic,
+     ballc_plane_compliant_elastic_jac, NULL, NULL, NULL},
 };
 #define N_CONTACT_LAWS (sizeof CONTACT_LAWS / sizeof CONTACT_LAWS[0])
 #define LAW_NOUT BALLC_CONTACT_LAW_NOUT
 
-/* Whether any law of ``plane`` acts under ``flags``: the plane is in contact. */
-static int in_contact(int flags, int plane)
+/* Whether law k acts on ``plane`` under ``flags``. */
+static int law_acts(ballc_flags flags, size_t k, int plane)
 {
-    int any = 0;
-    for (size_t k = 0; k < N_CONTACT_LAWS; k++) any |= CONTACT_LAWS[k].flag[plane];
+    return (flags & ballc_flag(CONTACT_LAWS[k].kind, plane)) != 0;
+}
+
+/* Whether any law of ``plane`` acts under ``flags``: the plane is in contact. */
+static int in_contact(ballc_flags flags, int plane)
+{
+    ballc_flags any = 0;
+    for (size_t k = 0; k < N_CONTACT_LAWS; k++) any |= ballc_flag(CONTACT_LAWS[k].kind, plane);
     return (flags & any) != 0;
 }
 
@@ -116,26 +132,21 @@ static int all_finite(const double *v, int n)
     return s == 0.0;
 }
 
-/* Every input the equations may read must be finite: a NaN would otherwise slip
- * through branch-free code (e.g. a NaN height reads as "no contact"). */
-static int inputs_finite(const double *state, const double *params, const double *latch)
+/* The number of parameters of ``params`` (its plane table's count), or -1. */
+static int parameter_count(const double *params)
 {
-    return all_finite(state, NS) && all_finite(params, BALLC_N_PARAMETERS)
-        && all_finite(latch, BALLC_N_LATCH);
+    int n = ballc_plane_count(params);
+    return n < 0 ? -1 : BALLC_PARAMETER_PLANES + BALLC_N_PLANE_FIELDS * n;
 }
 
 /* Exact Coulomb mode of ``plane`` under ``flags``. */
 enum { MODE_NONE = 0, MODE_SLIP = 1, MODE_SLIP_FIXED = 2, MODE_STICK = 3 };
-static int exact_mode(int flags, int plane)
+static int exact_mode(ballc_flags flags, int plane)
 {
-    int friction = plane == 0 ? BALLC_FLOOR_FRICTION : BALLC_CEILING_FRICTION;
-    int slip = plane == 0 ? BALLC_FLOOR_SLIP : BALLC_CEILING_SLIP;
-    int fixed = plane == 0 ? BALLC_FLOOR_SLIP_FIXED : BALLC_CEILING_SLIP_FIXED;
-    int stick = plane == 0 ? BALLC_FLOOR_STICK : BALLC_CEILING_STICK;
-    if (!(flags & friction)) return MODE_NONE;
-    if (flags & stick) return MODE_STICK;
-    if (flags & fixed) return MODE_SLIP_FIXED;
-    if (flags & slip) return MODE_SLIP;
+    if (!(flags & ballc_flag(BALLC_KIND_FRICTION, plane))) return MODE_NONE;
+    if (flags & ballc_flag(BALLC_KIND_STICK, plane)) return MODE_STICK;
+    if (flags & ballc_flag(BALLC_KIND_SLIP_FIXED, plane)) return MODE_SLIP_FIXED;
+    if (flags & ballc_flag(BALLC_KIND_SLIP, plane)) return MODE_SLIP;
     return MODE_NONE;
 }
 
@@ -144,7 +155,7 @@ static int is_sliding(int mode)
     return mode == MODE_SLIP || mode == MODE_SLIP_FIXED;
 }
 
-/* A plane's slip: the velocity u (along t1, t2), its map du/dx (2 x NS, row-major) and the
+/* A plane's slip: the velocity u (along t1, t2), its map du/dx (2 x n_states, row-major) and the
  * generalized-force map G_t (6 x 2) of a unit tangential force along t1, t2. */
 typedef struct {
     double u[2];
@@ -167,23 +178,24 @@ void ballc_slip_state(const double *state, const ballc_parameters_t *params, int
     slip_t slip;
     ballc_plane_contact_state(&params->planes[plane], state, local);
     slip_of(params, plane, local, &slip);
+    int ns = params->n_states;
     out[0] = slip.u[0];
     out[1] = slip.u[1];
-    memcpy(out + 2, slip.du, 2 * NS * sizeof(double));
-    memcpy(out + 2 + 2 * NS, slip.G, 12 * sizeof(double));
+    memcpy(out + 2, slip.du, 2 * ns * sizeof(double));
+    memcpy(out + 2 + 2 * ns, slip.G, 12 * sizeof(double));
 }
 
 /* What one evaluation of the equations yields besides the state derivative. */
 typedef struct {
     double mass[BALLC_MASS_SIZE];
-    double contact_force[3 * BALLC_N_PLANES];   /* on the ball, per plane: its frame */
-    int mode[BALLC_N_PLANES];                   /* exact Coulomb mode per plane */
-    double load[BALLC_N_PLANES];                /* N: the friction share's normal force */
-    slip_t slip[BALLC_N_PLANES];
-    double e[BALLC_N_PLANES][2];                /* sliding: the force direction is -e */
-    double lambda[BALLC_N_PLANES][2];           /* sticking: the constraint force */
+    double contact_force[3 * MAXP];   /* on the ball, per plane: its frame */
+    int mode[MAXP];                   /* exact Coulomb mode per plane */
+    double load[MAXP];                /* N: the friction share's normal force */
+    slip_t slip[MAXP];
+    double e[MAXP][2];                /* sliding: the force direction is -e */
+    double lambda[MAXP][2];           /* sticking: the constraint force */
     /* the coefficients of rho'' in the auxiliary rates, per plane (0 without) */
-    double acceleration[BALLC_N_PLANES][4];
+    double acceleration[MAXP][4];
 } evaluation_t;
 
 /* The exact penetration acceleration rho'' of ``plane`` from the solved udot: rho = r -
@@ -201,10 +213,11 @@ static double penetration_acceleration(const ballc_parameters_t *params, int pla
  * the Coulomb force -mu N e; a sticking plane's constraint force is added later
  * (it needs M). */
 static void assemble(const double *state, const ballc_parameters_t *params, const double *latch,
-                     int flags, evaluation_t *ev, double *force, double *xdot)
+                     ballc_flags flags, evaluation_t *ev, double *force, double *xdot)
 {
     double buf[BALLC_BALL_NOUT];
     double out[LAW_NOUT];
+    const int np = params->n_planes;
     ballc_ball(state, PARAMS(params), NULL, buf);
     memcpy(ev->mass, buf, BALLC_MASS_SIZE * sizeof(double));
     memcpy(force, buf + BALLC_MASS_SIZE, NU * sizeof(double));
@@ -214,22 +227,22 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
         for (int i = 0; i < NU; i++) force[i] += buf[BALLC_MASS_SIZE + i];
     }
     if (xdot)
-        for (int i = BALLC_N_MECHANICAL_STATES; i < NS; i++) xdot[i] = 0.0;
-    for (int i = 0; i < 3 * BALLC_N_PLANES; i++) ev->contact_force[i] = 0.0;
-    for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+        for (int i = BALLC_N_MECHANICAL_STATES; i < params->n_states; i++) xdot[i] = 0.0;
+    for (int i = 0; i < 3 * np; i++) ev->contact_force[i] = 0.0;
+    for (int plane = 0; plane < np; plane++) {
         ev->mode[plane] = exact_mode(flags, plane);
         ev->load[plane] = 0.0;
         for (int i = 0; i < 4; i++) ev->acceleration[plane][i] = 0.0;
     }
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
-    for (int plane = 0; plane < NP; plane++) {
+    for (int plane = 0; plane < np; plane++) {
         if (!in_contact(flags, plane)) continue;   /* a plane far away costs nothing */
         const ballc_plane_t *pl = &params->planes[plane];
         plane_contact_t contact;
         double sum[LAW_NOUT] = {0};
         plane_contact(params, plane, state, latch, &contact);
         for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
-            if (!(flags & CONTACT_LAWS[k].flag[plane])) continue;
+            if (!law_acts(flags, k, plane)) continue;
             int exact = ev->mode[plane] != MODE_NONE && CONTACT_LAWS[k].normal;
             (exact ? CONTACT_LAWS[k].normal : CONTACT_LAWS[k].value)(
                 contact.state, PARAMS(params), contact.inputs, out);
@@ -331,10 +344,11 @@ static void schur_solve(const schur_t *f, double *b)
 }
 
 /* Responses of a sticking plane: z_k = M^-1 G_t e_k (6 x 2, column k at z[k]) and the
- * Delassus matrix W = (du/d speeds) z (2 x 2), inverted into Winv.  Returns
- * BALLC_SINGULAR when W is not invertible. */
-static int stick_response(const schur_t *factor, const slip_t *slip, double z[2][NU],
-                          double Winv[2][2])
+ * Delassus block W = (du/d speeds) z (2 x 2) of the plane itself, inverted into Winv
+ * (Winv may be NULL: then W is not inverted).  Returns BALLC_SINGULAR when W is not
+ * invertible. */
+static int stick_response(const schur_t *factor, const slip_t *slip, int ns,
+                          double z[2][NU], double Winv[2][2])
 {
     const double *G = slip->G, *du = slip->du;
     double W[2][2];
@@ -343,10 +357,11 @@ static int stick_response(const schur_t *factor, const slip_t *slip, double z[2]
         schur_solve(factor, z[k]);
         for (int r = 0; r < 2; r++) {
             double s = 0;
-            for (int i = 0; i < NU; i++) s += du[r * NS + NQ + i] * z[k][i];
+            for (int i = 0; i < NU; i++) s += du[r * ns + NQ + i] * z[k][i];
             W[r][k] = s;
         }
     }
+    if (!Winv) return BALLC_OK;
     double det = W[0][0] * W[1][1] - W[0][1] * W[1][0];
     if (!(fabs(det) > 0) || !isfinite(det)) return BALLC_SINGULAR;
     Winv[0][0] = W[1][1] / det; Winv[0][1] = -W[0][1] / det;
@@ -354,41 +369,121 @@ static int stick_response(const schur_t *factor, const slip_t *slip, double z[2]
     return BALLC_OK;
 }
 
+/* Solve the dense m x m system A x = b (A row-major, m <= 2 MAXP) in place by Gaussian
+ * elimination with partial pivoting: b becomes x.  BALLC_SINGULAR when a pivot is 0. */
+static int dense_solve(int m, double *A, double *b)
+{
+    for (int c = 0; c < m; c++) {
+        int pivot = c;
+        for (int r = c + 1; r < m; r++)
+            if (fabs(A[r * m + c]) > fabs(A[pivot * m + c])) pivot = r;
+        if (!(fabs(A[pivot * m + c]) > 0) || !isfinite(A[pivot * m + c])) return BALLC_SINGULAR;
+        if (pivot != c) {
+            for (int j = 0; j < m; j++) {
+                double t = A[c * m + j]; A[c * m + j] = A[pivot * m + j]; A[pivot * m + j] = t;
+            }
+            double t = b[c]; b[c] = b[pivot]; b[pivot] = t;
+        }
+        for (int r = c + 1; r < m; r++) {
+            double f = A[r * m + c] / A[c * m + c];
+            for (int j = c; j < m; j++) A[r * m + j] -= f * A[c * m + j];
+            b[r] -= f * b[c];
+        }
+    }
+    for (int c = m - 1; c >= 0; c--) {
+        double s = b[c];
+        for (int j = c + 1; j < m; j++) s -= A[c * m + j] * b[j];
+        b[c] = s / A[c * m + c];
+    }
+    return BALLC_OK;
+}
+
+/* The impulses (or forces) of several planes' tangential constraints at once: the planes
+ * ``which`` (k of them), their slips, and the right-hand side ``target`` (2 k: the change
+ * of each plane's slip velocity wanted, along its t1, t2) give lambda (2 k) with
+ * sum_b W_ab lambda_b = target_a, W_ab = (du_a/d speeds) M^-1 G_b, and the change of the
+ * speeds M^-1 sum_b G_b lambda_b added to ``speeds`` (6). */
+static int joint_constraint(const schur_t *factor, const slip_t *const *slips, int k, int ns,
+                            const double *target, double *lambda, double *speeds)
+{
+    double z[2 * MAXP][NU], W[4 * MAXP * MAXP];
+    int m = 2 * k;
+    for (int b = 0; b < k; b++) stick_response(factor, slips[b], ns, &z[2 * b], NULL);
+    for (int a = 0; a < k; a++)
+        for (int r = 0; r < 2; r++)
+            for (int c = 0; c < m; c++) {
+                double s = 0;
+                for (int i = 0; i < NU; i++) s += slips[a]->du[r * ns + NQ + i] * z[c][i];
+                W[(2 * a + r) * m + c] = s;
+            }
+    for (int c = 0; c < m; c++) lambda[c] = target[c];
+    int status = dense_solve(m, W, lambda);
+    if (status != BALLC_OK) return status;
+    for (int c = 0; c < m; c++)
+        for (int i = 0; i < NU; i++) speeds[i] += z[c][i] * lambda[c];
+    return BALLC_OK;
+}
+
 /* udot (6) and the auxiliary rates.  A sticking plane's constraint force lambda makes
- * du/dt = 0: lambda = -W^-1 (du/d speeds) udot_0, udot = udot_0 + z lambda.  (The
- * planes are handled one after the other: both can only touch the ball at once when
- * H < 2 r, which Scene rejects.) */
+ * du/dt = 0: lambda = -W^-1 (du/d speeds) udot_0, udot = udot_0 + z lambda; several
+ * sticking planes at once (a ball resting in a wedge's corner) are solved jointly, with
+ * the Delassus matrix of all of them (one plane: the 2 x 2 solve of its own). */
 static int accelerations(const double *state, const ballc_parameters_t *params, const double *latch,
-                         int flags, schur_t *factor, evaluation_t *ev, double *udot,
+                         ballc_flags flags, schur_t *factor, evaluation_t *ev, double *udot,
                          double *xdot)
 {
+    const int np = params->n_planes, ns = params->n_states;
     assemble(state, params, latch, flags, ev, udot, xdot);
     int status = schur_factor(ev->mass, factor);
     if (status != BALLC_OK) return status;
     schur_solve(factor, udot);
-    for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
-        if (ev->mode[plane] != MODE_STICK) continue;
+    int sticking[MAXP], k = 0;
+    for (int plane = 0; plane < np; plane++)
+        if (ev->mode[plane] == MODE_STICK) sticking[k++] = plane;
+    if (k == 1) {
+        int plane = sticking[0];
         const slip_t *slip = &ev->slip[plane];
         const double *du = slip->du;
         double z[2][NU], Winv[2][2], a0[2];
-        status = stick_response(factor, slip, z, Winv);
+        status = stick_response(factor, slip, ns, z, Winv);
         if (status != BALLC_OK) return status;
         for (int r = 0; r < 2; r++) {
             a0[r] = 0;
-            for (int i = 0; i < NU; i++) a0[r] += du[r * NS + NQ + i] * udot[i];
+            for (int i = 0; i < NU; i++) a0[r] += du[r * ns + NQ + i] * udot[i];
         }
         double *lambda = ev->lambda[plane];
         lambda[0] = -(Winv[0][0] * a0[0] + Winv[0][1] * a0[1]);
         lambda[1] = -(Winv[1][0] * a0[0] + Winv[1][1] * a0[1]);
         for (int i = 0; i < NU; i++) udot[i] += z[0][i] * lambda[0] + z[1][i] * lambda[1];
+    } else if (k > 1) {
+        const slip_t *slips[MAXP];
+        double target[2 * MAXP], lambda[2 * MAXP];
+        for (int a = 0; a < k; a++) {
+            slips[a] = &ev->slip[sticking[a]];
+            for (int r = 0; r < 2; r++) {
+                double s = 0;
+                for (int i = 0; i < NU; i++) s += slips[a]->du[r * ns + NQ + i] * udot[i];
+                target[2 * a + r] = -s;
+            }
+        }
+        status = joint_constraint(factor, slips, k, ns, target, lambda, udot);
+        if (status != BALLC_OK) return status;
+        for (int a = 0; a < k; a++) {
+            ev->lambda[sticking[a]][0] = lambda[2 * a];
+            ev->lambda[sticking[a]][1] = lambda[2 * a + 1];
+        }
+    }
+    for (int a = 0; a < k; a++) {
+        int plane = sticking[a];
+        const double *lambda = ev->lambda[plane];
         ev->contact_force[3 * plane] += lambda[0];       /* along t1, t2 */
         ev->contact_force[3 * plane + 1] += lambda[1];
         if (xdot)
             xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -=
-                lambda[0] * slip->u[0] + lambda[1] * slip->u[1];
+                lambda[0] * ev->slip[plane].u[0] + lambda[1] * ev->slip[plane].u[1];
     }
     if (xdot)
-        for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+        for (int plane = 0; plane < np; plane++) {
             const double *coefficients = ev->acceleration[plane];
             if (!coefficients[0] && !coefficients[1] && !coefficients[2] && !coefficients[3])
                 continue;
@@ -400,86 +495,100 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
     return all_finite(udot, NU) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
-static int any_stick(int flags)
+static int any_stick(ballc_flags flags, int n_planes)
 {
-    return exact_mode(flags, 0) == MODE_STICK || exact_mode(flags, 1) == MODE_STICK;
+    for (int plane = 0; plane < n_planes; plane++)
+        if (exact_mode(flags, plane) == MODE_STICK) return 1;
+    return 0;
 }
 
-/* The public entry points' part of the checks: finite parameters and latch, and the
- * parameter constants computed from them; 0 when they are not finite. */
+/* The public entry points' part of the checks: a valid plane count, finite parameters
+ * and latch (latch may be NULL: not read), and the parameters prepared from them; 0 when
+ * they are not. */
 static int prepare(const double *params, const double *latch, ballc_parameters_t *prepared)
 {
-    if (!all_finite(params, BALLC_N_PARAMETERS) || !all_finite(latch, BALLC_N_LATCH))
-        return 0;
+    int n = parameter_count(params);
+    if (n < 0 || !all_finite(params, n)) return 0;
     ballc_parameters_init(prepared, params);
-    return 1;
+    return !latch || all_finite(latch, prepared->n_latch);
+}
+
+/* The number of states of a parameter vector (0 when its plane count is not valid). */
+static int state_count(const double *params)
+{
+    int n = ballc_plane_count(params);
+    return n < 0 ? 0 : NB + BALLC_N_PLANE_STATES * n;
 }
 
 int ballc_rhs(const double *state, const double *params, const double *latch,
-              int flags, double *xdot)
+              ballc_flags flags, double *xdot)
 {
     ballc_parameters_t prepared;
     if (!prepare(params, latch, &prepared)) {
-        for (int i = 0; i < NS; i++) xdot[i] = NAN;
+        for (int i = 0, n = state_count(params); i < n; i++) xdot[i] = NAN;
         return BALLC_NOT_FINITE;
     }
     return ballc_rhs_checked_inputs(state, &prepared, latch, flags, xdot);
 }
 
 int ballc_rhs_checked_inputs(const double *state, const ballc_parameters_t *params,
-                             const double *latch, int flags, double *xdot)
+                             const double *latch, ballc_flags flags, double *xdot)
 {
     schur_t factor;
     evaluation_t ev;
-    if (!all_finite(state, NS)) {
-        for (int i = 0; i < NS; i++) xdot[i] = NAN;
+    const int ns = params->n_states;
+    if (!all_finite(state, ns)) {
+        for (int i = 0; i < ns; i++) xdot[i] = NAN;
         return BALLC_NOT_FINITE;
     }
     ballc_kinematics(state, PARAMS(params), NULL, xdot);
     int status = accelerations(state, params, latch, flags, &factor, &ev, xdot + NQ, xdot);
-    if (status == BALLC_OK && !all_finite(xdot, NS)) status = BALLC_NOT_FINITE;
+    if (status == BALLC_OK && !all_finite(xdot, ns)) status = BALLC_NOT_FINITE;
     return status;
 }
 
 int ballc_contact_forces(const double *state, const double *params, const double *latch,
-                         int flags, double *forces)
+                         ballc_flags flags, double *forces)
 {
     ballc_parameters_t prepared;
     if (!prepare(params, latch, &prepared)) {
-        for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
+        int n = ballc_plane_count(params);
+        for (int i = 0; i < 3 * n; i++) forces[i] = 0.0;
         return BALLC_NOT_FINITE;
     }
     return ballc_contact_forces_prepared(state, &prepared, latch, flags, forces);
 }
 
 int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t *params,
-                                  const double *latch, int flags, double *forces)
+                                  const double *latch, ballc_flags flags, double *forces)
 {
     schur_t factor;
     evaluation_t ev;
     double udot[NU];
-    for (int i = 0; i < 3 * BALLC_N_PLANES; i++) forces[i] = 0.0;
-    if (!all_finite(state, NS) || !all_finite(latch, BALLC_N_LATCH)) return BALLC_NOT_FINITE;
+    const int np = params->n_planes;
+    for (int i = 0; i < 3 * np; i++) forces[i] = 0.0;
+    if (!all_finite(state, params->n_states) || !all_finite(latch, params->n_latch))
+        return BALLC_NOT_FINITE;
     int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
-    memcpy(forces, ev.contact_force, sizeof ev.contact_force);
-    for (int p = 0; p < NP; p++)   /* from each plane's frame */
+    memcpy(forces, ev.contact_force, 3 * np * sizeof(double));
+    for (int p = 0; p < np; p++)   /* from each plane's frame */
         ballc_plane_to_inertial(&params->planes[p], forces + 3 * p, 1);
-    return all_finite(forces, 3 * BALLC_N_PLANES) ? BALLC_OK : BALLC_NOT_FINITE;
+    return all_finite(forces, 3 * np) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 int ballc_stick_state(const double *state, const double *params, const double *latch,
-                      int flags, int plane, double *out)
+                      ballc_flags flags, int plane, double *out)
 {
     schur_t factor;
     evaluation_t ev;
     double udot[NU];
     for (int i = 0; i < 4; i++) out[i] = NAN;
-    if (plane < 0 || plane >= BALLC_N_PLANES || exact_mode(flags, plane) != MODE_STICK)
-        return BALLC_SINGULAR;
-    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
     ballc_parameters_t prepared;
-    ballc_parameters_init(&prepared, params);
+    if (!prepare(params, latch, &prepared)) return BALLC_NOT_FINITE;
+    if (plane < 0 || plane >= prepared.n_planes || exact_mode(flags, plane) != MODE_STICK)
+        return BALLC_SINGULAR;
+    if (!all_finite(state, prepared.n_states)) return BALLC_NOT_FINITE;
     int status = accelerations(state, &prepared, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
     out[0] = ev.lambda[plane][0];
@@ -495,7 +604,8 @@ int ballc_stick_state(const double *state, const double *params, const double *l
 #define MARGINS_RESTICK_ACCELERATION BALLC_COMPLIANT_MARGINS
 
 int ballc_compliant_margins_prepared(const double *state, const ballc_parameters_t *params,
-                                     const double *latch, int plane, int row, double *out)
+                                     const double *latch, ballc_flags flags, int plane,
+                                     int row, double *out)
 {
     double m[BALLC_PLANE_COMPLIANT_MARGINS_NOUT];
     plane_contact_t contact;
@@ -504,13 +614,16 @@ int ballc_compliant_margins_prepared(const double *state, const ballc_parameters
     for (int i = 0; i < BALLC_COMPLIANT_MARGINS; i++) out[i] = m[i];
     if ((row < 0 || row == 1) && m[MARGINS_RESTICK_ACCELERATION] != 0) {
         /* the exact rho'' of the contact sliding at the cap (the elastic law at the cap
-         * applies the same force, so it is the rho'' of either mode there) */
-        int flags = plane == 0 ? BALLC_FLOOR_COMPLIANT_SLIDING : BALLC_CEILING_COMPLIANT_SLIDING;
-        if (params->values[BALLC_PARAMETER_OBSERVER_MASS] != 0) flags |= BALLC_WITH_OBSERVER;
+         * applies the same force, so it is the rho'' of either mode there), with every
+         * other plane's contribution of the segment */
+        ballc_flags own = ballc_plane_flags(plane);
+        ballc_flags sliding = (flags & ~own & ~BALLC_WITH_OBSERVER)
+                              | ballc_flag(BALLC_KIND_COMPLIANT_SLIDING, plane);
+        if (params->values[BALLC_PARAMETER_OBSERVER_MASS] != 0) sliding |= BALLC_WITH_OBSERVER;
         schur_t factor;
         evaluation_t ev;
         double udot[NU];
-        int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+        int status = accelerations(state, params, latch, sliding, &factor, &ev, udot, NULL);
         if (status != BALLC_OK) return status;
         out[1] += m[MARGINS_RESTICK_ACCELERATION]
                   * penetration_acceleration(params, plane, udot);
@@ -523,26 +636,26 @@ int ballc_compliant_margins(const double *state, const double *params, const dou
                             int plane, double *out)
 {
     for (int i = 0; i < BALLC_COMPLIANT_MARGINS; i++) out[i] = NAN;
-    if (plane < 0 || plane >= BALLC_N_PLANES) return BALLC_SINGULAR;
-    if (!inputs_finite(state, params, latch)) return BALLC_NOT_FINITE;
     ballc_parameters_t prepared;
-    ballc_parameters_init(&prepared, params);
-    return ballc_compliant_margins_prepared(state, &prepared, latch, plane, -1, out);
+    if (!prepare(params, latch, &prepared)) return BALLC_NOT_FINITE;
+    if (plane < 0 || plane >= prepared.n_planes) return BALLC_SINGULAR;
+    if (!all_finite(state, prepared.n_states)) return BALLC_NOT_FINITE;
+    return ballc_compliant_margins_prepared(state, &prepared, latch, 0, plane, -1, out);
 }
 
-int ballc_remove_slip(const double *state, const double *params, int flags, int plane,
+int ballc_remove_slip(const double *state, const double *params, ballc_flags flags, int plane,
                       double *state_out)
 {
     schur_t factor;
     double mass[BALLC_MASS_SIZE], buf[BALLC_BALL_NOUT];
     double local[NC], z[2][NU], Winv[2][2];
     slip_t slip;
-    memcpy(state_out, state, NS * sizeof(double));
-    if (plane < 0 || plane >= BALLC_N_PLANES) return BALLC_SINGULAR;
-    if (!all_finite(state, NS) || !all_finite(params, BALLC_N_PARAMETERS))
-        return BALLC_NOT_FINITE;
     ballc_parameters_t prepared;
-    ballc_parameters_init(&prepared, params);
+    int ns = state_count(params);
+    for (int i = 0; i < ns; i++) state_out[i] = state[i];
+    if (!prepare(params, NULL, &prepared)) return BALLC_NOT_FINITE;
+    if (plane < 0 || plane >= prepared.n_planes) return BALLC_SINGULAR;
+    if (!all_finite(state, ns)) return BALLC_NOT_FINITE;
     ballc_ball(state, PARAMS(&prepared), NULL, buf);
     memcpy(mass, buf, sizeof mass);
     if (flags & BALLC_WITH_OBSERVER) {
@@ -553,46 +666,68 @@ int ballc_remove_slip(const double *state, const double *params, int flags, int 
     if (status != BALLC_OK) return status;
     ballc_plane_contact_state(&prepared.planes[plane], state, local);
     slip_of(&prepared, plane, local, &slip);
-    status = stick_response(&factor, &slip, z, Winv);
-    if (status != BALLC_OK) return status;
+    /* the other planes that stick keep their slip velocity */
+    slip_t others[MAXP];
+    const slip_t *slips[MAXP] = {&slip};
+    int k = 1;
+    for (int p = 0; p < prepared.n_planes; p++) {
+        if (p == plane || exact_mode(flags, p) != MODE_STICK) continue;
+        ballc_plane_contact_state(&prepared.planes[p], state, local);
+        slip_of(&prepared, p, local, &others[k]);
+        slips[k] = &others[k];
+        k++;
+    }
     const double *u = slip.u;
-    double impulse[2] = {-(Winv[0][0] * u[0] + Winv[0][1] * u[1]),
-                         -(Winv[1][0] * u[0] + Winv[1][1] * u[1])};
-    for (int i = 0; i < NU; i++)
-        state_out[NQ + i] += z[0][i] * impulse[0] + z[1][i] * impulse[1];
-    return all_finite(state_out, NS) ? BALLC_OK : BALLC_NOT_FINITE;
+    if (k == 1) {
+        status = stick_response(&factor, &slip, ns, z, Winv);
+        if (status != BALLC_OK) return status;
+        double impulse[2] = {-(Winv[0][0] * u[0] + Winv[0][1] * u[1]),
+                             -(Winv[1][0] * u[0] + Winv[1][1] * u[1])};
+        for (int i = 0; i < NU; i++)
+            state_out[NQ + i] += z[0][i] * impulse[0] + z[1][i] * impulse[1];
+    } else {
+        double target[2 * MAXP] = {-u[0], -u[1]}, impulse[2 * MAXP], speeds[NU] = {0};
+        status = joint_constraint(&factor, slips, k, ns, target, impulse, speeds);
+        if (status != BALLC_OK) return status;
+        for (int i = 0; i < NU; i++) state_out[NQ + i] += speeds[i];
+    }
+    return all_finite(state_out, ns) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
-/* Add dF/dx (6 x 13) and d(M a)/dq (6 x 4) of one dynamics kernel family. */
+/* Add dF/dx (6 x n_states: the ball's columns) and d(M a)/dq (6 x 4) of one dynamics
+ * kernel family (its Jacobian is by the ball's states, NB columns). */
 static void add_dynamics_jac(kernel_fn kernel, const double *state,
                              const ballc_parameters_t *params, const double *udot,
                              double *dF, double *dMa)
 {
     double buf[BALLC_BALL_JAC_NOUT];   /* ball and observer kernels have equal sizes */
+    const int ns = params->n_states;
     kernel(state, PARAMS(params), udot, buf);
-    for (int i = 0; i < NU * NS; i++) dF[i] += buf[i];
-    for (int i = 0; i < NU * 4; i++) dMa[i] += buf[NU * NS + i];
+    for (int i = 0; i < NU; i++)
+        for (int j = 0; j < NB; j++) dF[i * ns + j] += buf[i * NB + j];
+    for (int i = 0; i < NU * 4; i++) dMa[i] += buf[NU * NB + i];
 }
 
 /* Forward-difference Jacobian of the whole right-hand side, for sticking planes
  * (lambda depends on the state through M, the forcing and the Delassus matrix).
  * Jacobians are rare (the integrator reuses them), so this costs little. */
 static int difference_jacobian(const double *state, const ballc_parameters_t *params, const double *latch,
-                               int flags, double *jac)
+                               ballc_flags flags, double *jac)
 {
-    double f0[NS], f1[NS], y[NS];
+    const int ns = params->n_states;
+    double f0[MAXS], f1[MAXS], y[MAXS];
     int status = ballc_rhs_checked_inputs(state, params, latch, flags, f0);
     if (status != BALLC_OK) return status;
-    memcpy(y, state, sizeof y);
-    for (int j = 0; j < NS; j++) {
+    memcpy(y, state, ns * sizeof(double));
+    for (int j = 0; j < ns; j++) {
         y[j] = state[j] + 1.4901161193847656e-08 * fmax(1.0, fabs(state[j]));
         double h = y[j] - state[j];
         status = ballc_rhs_checked_inputs(y, params, latch, flags, f1);
         y[j] = state[j];
         if (status != BALLC_OK) return status;
-        for (int i = 0; i < NS; i++) jac[i * NS + j] = (f1[i] - f0[i]) / h;
+        for (int i = 0; i < ns; i++) jac[i * ns + j] = (f1[i] - f0[i]) / h;
     }
-    return all_finite(jac, NS * NS) ? BALLC_OK : BALLC_NOT_FINITE;
+    return all_finite(jac, ns * ns) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 /* Add the sliding Coulomb force's derivatives: F_t = -mu N e(u), with
@@ -601,7 +736,7 @@ static int difference_jacobian(const double *state, const ballc_parameters_t *pa
  * ``law_jac``: the normal share's Jacobian by the state, its rows in the plane's frame
  * (the row of the force along n: dN/dx). */
 static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const double *latch,
-                         const double *law_jac, double *dF, double *jac)
+                         const double *law_jac, int ns, double *dF, double *jac)
 {
     const slip_t *slip = &ev->slip[plane];
     const double *du = slip->du, *G = slip->G;
@@ -616,20 +751,20 @@ static void add_slip_jac(const evaluation_t *ev, int plane, double mu, const dou
                 de[a][b] = sign * ((a == b) - e[a] * e[b]) / speed;
     }
     double eu = e[0] * ux + e[1] * uy;
-    for (int j = 0; j < NS; j++) {
-        double dN = law_jac[(BALLC_LAW_FORCE + 2) * NS + j];
-        double du0 = du[j], du1 = du[NS + j];
+    for (int j = 0; j < ns; j++) {
+        double dN = law_jac[(BALLC_LAW_FORCE + 2) * ns + j];
+        double du0 = du[j], du1 = du[ns + j];
         double df[2];
         for (int a = 0; a < 2; a++)
             df[a] = -mu * (e[a] * dN + N * (de[a][0] * du0 + de[a][1] * du1));
-        for (int i = 0; i < NU; i++) dF[i * NS + j] += G[2 * i] * df[0] + G[2 * i + 1] * df[1];
-        jac[BALLC_STATE_DISSIPATED_TANGENTIAL * NS + j] +=
+        for (int i = 0; i < NU; i++) dF[i * ns + j] += G[2 * i] * df[0] + G[2 * i + 1] * df[1];
+        jac[BALLC_STATE_DISSIPATED_TANGENTIAL * ns + j] +=
             mu * (eu * dN + N * (e[0] * du0 + e[1] * du1));
     }
 }
 
 int ballc_jacobian(const double *state, const double *params, const double *latch,
-                   int flags, double *jac)
+                   ballc_flags flags, double *jac)
 {
     ballc_parameters_t prepared;
     if (!prepare(params, latch, &prepared)) return BALLC_NOT_FINITE;
@@ -637,25 +772,31 @@ int ballc_jacobian(const double *state, const double *params, const double *latc
 }
 
 int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t *params,
-                                  const double *latch, int flags, double *jac)
+                                  const double *latch, ballc_flags flags, double *jac)
 {
     schur_t factor;
     evaluation_t ev;
     double udot[NU];
-    if (!all_finite(state, NS)) return BALLC_NOT_FINITE;
-    if (any_stick(flags)) return difference_jacobian(state, params, latch, flags, jac);
+    const int ns = params->n_states, np = params->n_planes;
+    if (!all_finite(state, ns)) return BALLC_NOT_FINITE;
+    if (any_stick(flags, np)) return difference_jacobian(state, params, latch, flags, jac);
     int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
 
-    for (int i = 0; i < NS * NS; i++) jac[i] = 0.0;
-    ballc_kinematics_jac(state, PARAMS(params), NULL, jac);   /* rows 0..6 */
+    for (int i = 0; i < ns * ns; i++) jac[i] = 0.0;
+    {   /* rows 0..6: the kinematics, by the ball's states */
+        double kin[BALLC_KINEMATICS_JAC_NOUT];
+        ballc_kinematics_jac(state, PARAMS(params), NULL, kin);
+        for (int i = 0; i < NQ; i++)
+            for (int j = 0; j < NB; j++) jac[i * ns + j] = kin[i * NB + j];
+    }
 
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
-    double dF[NU * NS] = {0}, dMa[NU * 4] = {0}, buf[LAW_NOUT * NS], local[LAW_NOUT * NC];
+    double dF[NU * MAXS] = {0}, dMa[NU * 4] = {0}, buf[LAW_NOUT * MAXS], local[LAW_NOUT * NC];
     add_dynamics_jac(ballc_ball_jac, state, params, udot, dF, dMa);
     if (flags & BALLC_WITH_OBSERVER)
         add_dynamics_jac(ballc_observer_jac, state, params, udot, dF, dMa);
-    for (int plane = 0; plane < NP; plane++) {
+    for (int plane = 0; plane < np; plane++) {
         if (!in_contact(flags, plane)) continue;
         const ballc_plane_t *pl = &params->planes[plane];
         plane_contact_t contact;
@@ -663,40 +804,41 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
         auxiliary_targets(pl, target);
         plane_contact(params, plane, state, latch, &contact);
         for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
-            if (!(flags & CONTACT_LAWS[k].flag[plane])) continue;
+            if (!law_acts(flags, k, plane)) continue;
             int exact = is_sliding(ev.mode[plane]) && CONTACT_LAWS[k].normal_jac;
             (exact ? CONTACT_LAWS[k].normal_jac : CONTACT_LAWS[k].jac)(
                 contact.state, PARAMS(params), contact.inputs, local);
-            ballc_plane_state_columns(pl, local, LAW_NOUT, buf);
-            if (exact) add_slip_jac(&ev, plane, mu, latch, buf, dF, jac);
+            ballc_plane_state_columns(pl, local, LAW_NOUT, ns, buf);
+            if (exact) add_slip_jac(&ev, plane, mu, latch, buf, ns, dF, jac);
             /* the torque's and the force's rows back from the plane's frame */
-            ballc_plane_rows_to_inertial(pl, buf, NS, BALLC_LAW_GENERALIZED_FORCE, 2);
-            for (int i = 0; i < NU * NS; i++) dF[i] += buf[BALLC_LAW_GENERALIZED_FORCE * NS + i];
+            ballc_plane_rows_to_inertial(pl, buf, ns, BALLC_LAW_GENERALIZED_FORCE, 2);
+            for (int i = 0; i < NU * ns; i++) dF[i] += buf[BALLC_LAW_GENERALIZED_FORCE * ns + i];
             for (int i = 0; i < 4; i++)
-                for (int j = 0; j < NS; j++)
-                    jac[target[i] * NS + j] += buf[(BALLC_LAW_DISSIPATION + i) * NS + j];
+                for (int j = 0; j < ns; j++)
+                    jac[target[i] * ns + j] += buf[(BALLC_LAW_DISSIPATION + i) * ns + j];
         }
     }
     /* d udot / dx_j = M^-1 (dF/dx_j - d(M udot)/dx_j); M depends on q only. */
-    for (int j = 0; j < NS; j++) {
+    for (int j = 0; j < ns; j++) {
         double col[NU];
         for (int i = 0; i < NU; i++)
-            col[i] = dF[i * NS + j] - (j < 4 ? dMa[i * 4 + j] : 0.0);
+            col[i] = dF[i * ns + j] - (j < 4 ? dMa[i * 4 + j] : 0.0);
         schur_solve(&factor, col);
-        for (int i = 0; i < NU; i++) jac[(NQ + i) * NS + j] = col[i];
+        for (int i = 0; i < NU; i++) jac[(NQ + i) * ns + j] = col[i];
     }
-    return all_finite(jac, NS * NS) ? BALLC_OK : BALLC_NOT_FINITE;
+    return all_finite(jac, ns * ns) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 void ballc_energy(const double *state, const ballc_parameters_t *params, double *out)
 {
     double local[NC], e[BALLC_PLANE_ENERGY_NOUT];
+    const int np = params->n_planes;
     ballc_mechanical_energy(state, PARAMS(params), NULL, out);
-    for (int p = 0; p < NP; p++) {
+    for (int p = 0; p < np; p++) {
         ballc_plane_contact_state(&params->planes[p], state, local);
         ballc_plane_energy(local, PARAMS(params), NULL, e);
         out[2 + p] = e[0];
-        out[2 + NP + p] = e[1];
+        out[2 + np + p] = e[1];
     }
 }
 
@@ -704,7 +846,7 @@ void ballc_contact_kinematics(const double *state, const ballc_parameters_t *par
                               double *out)
 {
     double local[NC];
-    for (int p = 0; p < NP; p++, out += BALLC_CONTACT_KINEMATICS_PER_PLANE) {
+    for (int p = 0; p < params->n_planes; p++, out += BALLC_CONTACT_KINEMATICS_PER_PLANE) {
         ballc_plane_contact_state(&params->planes[p], state, local);
         ballc_plane_kinematics(local, PARAMS(params), NULL, out);
         ballc_plane_to_inertial(&params->planes[p], out + 2, 1);   /* the velocity */

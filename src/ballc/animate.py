@@ -75,7 +75,8 @@ def animate(result, path=None, *, frames: int = DEFAULT_FRAMES, fps: int = 20, d
     from matplotlib.animation import FuncAnimation
     from matplotlib.ticker import MaxNLocator
 
-    from .plot import contact_points, scene_title
+    from .planes import clipped, drawing_box
+    from .plot import contact_points, plane_style, scene_title
 
     frames = check_frames(frames)
     scene = result.scene
@@ -86,24 +87,28 @@ def animate(result, path=None, *, frames: int = DEFAULT_FRAMES, fps: int = 20, d
     points = contact_points(result)
     starts = np.array([c.t_start for c in result.contacts])
 
-    low = min(centre[:, 0].min(), centre[:, 1].min()) - 1.5 * scene.radius
-    high = max(centre[:, 0].max(), centre[:, 1].max()) + 1.5 * scene.radius
-    low, high = min(low, -0.5), max(high, 0.5)
-    z_low, z_high = -0.5, scene.ceiling_height + 0.5
-
+    # the box shown: the path and 1.5 radii around it (with the seed's planes, the floor
+    # to the ceiling); each plane drawn where it cuts that box
+    box_low, box_high = drawing_box(scene, centre.T)
+    if scene.ceiling_height is None:   # a cube around the middle of the path
+        middle, half = (box_low + box_high) / 2, np.max(box_high - box_low) / 2
+        box_low, box_high = middle - half, middle + half
     fig = plt.figure(figsize=figsize, dpi=dpi)
     ax = fig.add_subplot(111, projection="3d")
     ax.view_init(elev=elevation, azim=azimuth)
-    ax.set(xlim=(low, high), ylim=(low, high), zlim=(z_low, z_high),
-           xlabel="x (m)", ylabel="y (m)", zlabel="z (m)")
-    ax.set_box_aspect((1, 1, (z_high - z_low) / (high - low)))
+    ax.set(xlim=(box_low[0], box_high[0]), ylim=(box_low[1], box_high[1]),
+           zlim=(box_low[2], box_high[2]), xlabel="x (m)", ylabel="y (m)", zlabel="z (m)")
+    span = box_high - box_low
+    ax.set_box_aspect(tuple(span / span[0]))
     for axis in (ax.xaxis, ax.yaxis, ax.zaxis):     # few tick labels: text is most of a frame
         axis.set_major_locator(MaxNLocator(4))
-    grid = np.array([[low, high], [low, high]])
-    plane_x, plane_y = np.meshgrid(grid[0], grid[1])
-    ax.plot_surface(plane_x, plane_y, np.zeros_like(plane_x), color="c", alpha=0.2)
-    ax.plot_surface(plane_x, plane_y, np.full_like(plane_x, scene.ceiling_height),
-                    color="c", alpha=0.1)
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    for plane, name in zip(scene.planes, scene.plane_names):
+        polygon = clipped(plane, box_low, box_high)
+        if len(polygon):
+            colour = "c" if scene.ceiling_height is not None else plane_style(scene, name)[0]
+            alpha = 0.1 if name == "ceiling" and scene.ceiling_height is not None else 0.2
+            ax.add_collection3d(Poly3DCollection([polygon], color=colour, alpha=alpha))
 
     cmap = plt.get_cmap("plasma")
     colours = cmap(starts / max(result.t[-1], 1e-12)) if len(starts) else []

@@ -90,7 +90,8 @@ def _workers(text: str) -> int:
 
 def write_outputs(result, out: Path, *, animate: bool, frames: int,
                   html: bool = False, t_window=None) -> list[Path]:
-    """Figures (PNG), contact table (CSV) and optionally the animation (GIF, + MP4 with
+    """Figures (PNG; a scene given its planes, not the ceiling_height shorthand, also
+    side_view.png), contact table (CSV) and optionally the animation (GIF, + MP4 with
     ffmpeg) and the interactive 3-D view (view.html) of ``result`` into ``out``; returns
     the paths written.  ``t_window``: the figures' time window (ballc.plot)."""
     import matplotlib
@@ -113,6 +114,8 @@ def write_outputs(result, out: Path, *, animate: bool, frames: int,
     figures = (("coordinates.png", result.plot), ("energy.png", result.plot_energy),
                ("contacts_top_view.png", result.plot_contacts),
                ("observer.png", result.plot_observer))
+    if result.scene.ceiling_height is None:   # planes at any orientation: where they are
+        figures += (("side_view.png", result.plot_side_view),)
     for name, make in figures:
         fig, _ = make(t_window=t_window)
         fig.savefig(out / name, dpi=100)

@@ -68,7 +68,7 @@ _TANGENTIAL_DAMPING = _core.PARAMETER_NAMES.index("tangential_damping_ratio")
 #: self-similar start, whose mode does not change; the elastic kernels' smooth yield
 #: caps it meanwhile.  (4e-13 m for a 2.5-mm ball, 4e-12 m for the seed's: 1e-7 of
 #: their peak penetrations.)
-ARM_ULPS = 2.0 ** 20
+ARM_ULPS = _core.ARM_ULPS   # 2^20, _driver.h's
 #: ... and once Hertz's force k0 rho^(3/2) reaches ARM_FORCE (N): the kernels treat a
 #: normal force below 1e-12 N as a fraction of a load (F_n / max(F_n, 1e-12 N), which
 #: keeps their derivatives finite), so the law is exact only well above it (1e-6 N:
@@ -138,6 +138,13 @@ def contact_time(scene, rate: float) -> float:
 def plane_position(scene, plane: str) -> float:
     """The centre's height z (m) at which the ball touches ``plane`` (rho = 0)."""
     return scene.radius if plane == "floor" else scene.ceiling_height - scene.radius
+
+
+def arm_force_depth(scene) -> float:
+    """(ARM_FORCE / k0)^(2/3) (m): the penetration at which Hertz's force is ARM_FORCE,
+    arm_penetration's floor (the C loop takes the ulps of each plane's position
+    itself)."""
+    return (ARM_FORCE / scene.hertz_stiffness) ** (2.0 / 3.0)
 
 
 def arm_penetration(scene, plane: str) -> float:

@@ -44,9 +44,10 @@ class LinearEvent:
 
     def __init__(self, coefficients, offset=0.0, terminal=False, direction=0):
         self.coefficients = np.array(coefficients, dtype=float)
-        if self.coefficients.shape != (_core.N_STATES,):
-            raise ValueError(f"coefficients must have shape ({_core.N_STATES},), "
-                             f"got {self.coefficients.shape}")
+        if self.coefficients.ndim != 1 or self.coefficients.size < len(_core.BALL_STATE_NAMES):
+            raise ValueError(f"coefficients must have one value per state (the seed's "
+                             f"{_core.N_STATES}, or its scene's state_names), got shape "
+                             f"{self.coefficients.shape}")
         self.offset = float(offset)
         # solve_ivp's: a bool, or k > 0: stop at the k-th occurrence
         self.terminal = terminal if isinstance(terminal, bool) else _core.terminal_count(
@@ -59,10 +60,12 @@ class LinearEvent:
         self._scale = float(self.coefficients[nonzero[0]]) if nonzero.size == 1 else 0.0
 
     @classmethod
-    def of_state(cls, name, scale=1.0, offset=0.0, terminal=False, direction=0):
-        """g(y) = scale * y[name] + offset."""
-        coefficients = np.zeros(_core.N_STATES)
-        coefficients[_STATE[name]] = scale
+    def of_state(cls, name, scale=1.0, offset=0.0, terminal=False, direction=0, scene=None):
+        """g(y) = scale * y[name] + offset; the states of ``scene`` (its ``state_names``;
+        default: the seed's planes)."""
+        names = _core.STATE_NAMES if scene is None else scene.state_names
+        coefficients = np.zeros(len(names))
+        coefficients[names.index(name)] = scale
         return cls(coefficients, offset, terminal, direction)
 
     def __call__(self, t, y):
@@ -71,7 +74,7 @@ class LinearEvent:
         return float(self.coefficients @ y) + self.offset
 
     def __repr__(self):
-        terms = " + ".join(f"{c:g}*{_core.STATE_NAMES[i]}"
+        terms = " + ".join(f"{c:g}*{_core.STATE_NAMES[i] if i < _core.N_STATES else f'y[{i}]'}"
                            for i, c in enumerate(self.coefficients) if c)
         return (f"LinearEvent({terms} + {self.offset:g}, terminal={self.terminal}, "
                 f"direction={self.direction})")

@@ -9,7 +9,7 @@ parabola under gravity.  With ballc's quaternion kinematics qdot = 1/2 [0, omega
 (Hamilton, scalar first, omega inertial; codegen/model.py),
 
     q(s)  = exp(omega s / 2) (x) q0 = cos(|omega| s / 2) q0 + sin(|omega| s / 2) [0, n] (x) q0
-    r(s)  = r0 + v0 s + a s^2 / 2,    v(s) = v0 + a s,    a = (0, 0, -gravity)
+    r(s)  = r0 + v0 s + a s^2 / 2,    v(s) = v0 + a s,    a = the gravity vector
 
 with s = t - t0 and n = omega / |omega|; omega, the dissipated work and the tangential
 deflections stay constant.
@@ -19,7 +19,8 @@ segment instead of integrating it, whatever the method.
 
 Events.  Every event of the segment must be a :class:`ballc.events.LinearEvent` whose
 coefficients leave the quaternion out (the driver's contact-start events are
-``rho - threshold``, linear in z).  On the exact solution such an event is a quadratic
+``rho - threshold``, linear in the centre: in one coordinate for a plane along an
+axis, in x, y, z for a tilted one).  On the exact solution such an event is a quadratic
 g(s) = c0 + c1 s + c2 s^2 whose roots are computed in closed form with the
 cancellation-free formula (q = -(c1 + sign(c1) sqrt(c1^2 - 4 c2 c0)) / 2, roots q / c2
 and c0 / q).  A root counts as the integrators count it: a sign change in the event's
@@ -49,7 +50,6 @@ _PARAMETER = {name: i for i, name in enumerate(_core.PARAMETER_NAMES)}
 _QUATERNION = layout.QUATERNION
 _OBSERVER_MASS, _IXX, _IYY, _IZZ = (_PARAMETER[name] for name in (
     "observer_mass", "inertia_xx", "inertia_yy", "inertia_zz"))
-_GRAVITY = [_PARAMETER[f"gravity_{axis}"] for axis in "xyz"]
 
 #: Fewest sample intervals of an exact flight segment without t_eval.
 MIN_INTERVALS = _core.FLIGHT_MIN_INTERVALS
@@ -58,11 +58,10 @@ MAX_TURN = _core.FLIGHT_MAX_TURN
 
 
 def scene_allows(params) -> bool:
-    """Whether the parameters admit exact flight: massless observer, isotropic inertia,
-    gravity along -z (or none)."""
+    """Whether the parameters admit exact flight: massless observer, isotropic inertia
+    (gravity, any constant vector, makes the centre's path a parabola)."""
     p = params
-    return bool(p[_OBSERVER_MASS] == 0 and p[_IXX] == p[_IYY] == p[_IZZ]
-                and p[_GRAVITY[0]] == p[_GRAVITY[1]] == 0)
+    return bool(p[_OBSERVER_MASS] == 0 and p[_IXX] == p[_IYY] == p[_IZZ])
 
 
 def polynomial_in_flight(event) -> bool:
@@ -73,16 +72,18 @@ def polynomial_in_flight(event) -> bool:
 
 
 class FreeFlight:
-    """The exact free-flight solution from (t0, y0) under ``gravity`` (m/s^2; 0: uniform
-    motion): ``sol(t)`` gives the state (N_STATES,) at a scalar t, (N_STATES, len(t)) at
-    an array of times, like the integrators' interpolants; evaluated in C
-    (``_core.flight_states``, the C loop's own).  ``t_min``/``t_max``: the segment it
-    was built for."""
+    """The exact free-flight solution from (t0, y0) under ``gravity`` (m/s^2: a number g,
+    along -z, (0, 0, -g), or the acceleration vector; 0: uniform motion): ``sol(t)``
+    gives the state (states,) at a scalar t, (states, len(t)) at an array of times, like
+    the integrators' interpolants; evaluated in C (``_core.flight_states``, the C loop's
+    own).  ``t_min``/``t_max``: the segment it was built for."""
 
     def __init__(self, t0, y0, gravity, t_max=None):
         self.t0 = float(t0)
         self.y0 = np.array(y0, dtype=float)
-        self.gravity = float(gravity)
+        g = np.asarray(gravity, dtype=float)
+        #: the gravity vector (m/s^2)
+        self.gravity = np.array([0.0, 0.0, -float(g)]) if g.ndim == 0 else g.reshape(3).copy()
         self.t_min = self.t0
         self.t_max = self.t0 if t_max is None else float(t_max)
 

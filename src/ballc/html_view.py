@@ -99,7 +99,10 @@ def scene_html(result, *, fps: int = 30, speed: float = 1.0, loop: bool = True,
     if not (math.isfinite(speed) and speed > 0):
         raise ValueError(f"speed = {speed!r} is not allowed: must be a finite number > 0")
     scene = result.scene
-    r, h = float(scene.radius), float(scene.ceiling_height)
+    seed = scene.ceiling_height is not None   # the seed's floor and ceiling
+    position = np.asarray(result.position)
+    r = float(scene.radius)
+    h = float(scene.ceiling_height) if seed else float(np.ptp(position[2]) + 4 * r)
     t0, t1 = float(result.t[0]), float(result.t[-1])
 
     recorder = _Recorder(umsgpack.packb)
@@ -108,8 +111,8 @@ def scene_html(result, *, fps: int = 30, speed: float = 1.0, loop: bool = True,
     root["/Axes"].set_property("visible", False)
     vis = root["ballc"]     # the scene, shifted so that the viewer's orbit centre is its middle
 
-    # The planes: slabs whose faces are z = 0 and z = H, covering the motion.
-    position = np.asarray(result.position)
+    # The planes: slabs whose faces are the planes, covering the motion (the seed's: z = 0
+    # and z = H; any other plane: a square slab along it around the path's middle).
     low = position[:2].min(axis=1) - 2 * r
     high = position[:2].max(axis=1) + 2 * r
     centre = (low + high) / 2
@@ -117,9 +120,20 @@ def scene_html(result, *, fps: int = 30, speed: float = 1.0, loop: bool = True,
     size = np.maximum(size, 0.5 * max(size.max(), h))     # no thin strip for a 1-D throw
     thickness = 0.02 * max(h, 4 * r)
     plane = g.MeshLambertMaterial(color=0x7fa7b5, opacity=0.35)
-    for name, z in (("floor", -thickness / 2), ("ceiling", h + thickness / 2)):
-        vis["planes"][name].set_object(g.Box([size[0], size[1], thickness]), plane)
-        vis["planes"][name].set_transform(tf.translation_matrix([centre[0], centre[1], z]))
+    middle = np.r_[centre, (position[2].min() + position[2].max()) / 2]
+    if seed:
+        for name, z in (("floor", -thickness / 2), ("ceiling", h + thickness / 2)):
+            vis["planes"][name].set_object(g.Box([size[0], size[1], thickness]), plane)
+            vis["planes"][name].set_transform(tf.translation_matrix([centre[0], centre[1], z]))
+    else:
+        from .planes import foot, tangents
+        side = 1.2 * max(size.max(), h)
+        for each, name in zip(scene.planes, scene.plane_names):
+            frame = np.eye(4)   # the slab's axes: the plane's t1, t2 and n
+            frame[:3, :3] = np.column_stack([*tangents(each), each.unit_normal])
+            frame[:3, 3] = foot(each, middle) - 0.5 * thickness * each.unit_normal
+            vis["planes"][name].set_object(g.Box([side, side, thickness]), plane)
+            vis["planes"][name].set_transform(frame)
 
     # The ball (wireframe, so that its turning shows) and the observer fixed in it.
     vis["ball"].set_object(g.Sphere(r), g.MeshBasicMaterial(color=0x2040c0, wireframe=True))
@@ -131,15 +145,16 @@ def scene_html(result, *, fps: int = 30, speed: float = 1.0, loop: bool = True,
     step = max(1, position.shape[1] // 4000)
     vis["path"].set_object(g.Line(g.PointsGeometry(position[:, ::step].astype(np.float32)),
                                   g.LineBasicMaterial(color=0x229922)))
-    for i, contact in enumerate(result.contacts):
+    from .plot import contact_points
+    for i, (contact, point) in enumerate(zip(result.contacts, contact_points(result))):
         x, y = contact.contact_point
-        if not (np.isfinite(x) and np.isfinite(y)):
+        if not (np.isfinite(x) and np.isfinite(y) and np.all(np.isfinite(point))):
             continue
-        on_floor = contact.plane == "floor"
+        on_floor = contact.plane == "floor" if seed else (
+            scene.plane_names.index(contact.plane) % 2 == 0)
         marker = g.MeshLambertMaterial(color=0xe07010 if on_floor else 0x1060e0)
         vis["contacts"][str(i + 1)].set_object(g.Sphere(0.12 * r), marker)
-        vis["contacts"][str(i + 1)].set_transform(
-            tf.translation_matrix([x, y, 0.0 if on_floor else h]))
+        vis["contacts"][str(i + 1)].set_transform(tf.translation_matrix(point))
 
     # The motion: keyframes at fps per second of playback.
     count = max(2, int(math.ceil((t1 - t0) / speed * fps)) + 1)
@@ -156,7 +171,8 @@ def scene_html(result, *, fps: int = 30, speed: float = 1.0, loop: bool = True,
     # The camera orbits the origin: put the middle of the box between the planes there,
     # and look from the side of the main horizontal direction of motion (not along it),
     # a little from above.
-    vis.set_transform(tf.translation_matrix([-centre[0], -centre[1], -h / 2]))
+    vis.set_transform(tf.translation_matrix([-centre[0], -centre[1],
+                                             -h / 2 if seed else -middle[2]]))
     reach = 1.25 * max(h, size[0], size[1])
     spread = position[:2] - position[:2].mean(axis=1, keepdims=True)
     main = np.linalg.eigh(spread @ spread.T)[1][:, -1]            # principal direction

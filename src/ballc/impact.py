@@ -159,6 +159,10 @@ def impact(scene: Scene, velocity, angular_velocity=(0.0, 0.0, 0.0), plane: str 
         raise TypeError(f"scene must be a ballc.Scene, got {type(scene).__name__}")
     if plane not in PLANES:
         raise SceneError(f"plane = {plane!r} is not allowed: must be 'floor' or 'ceiling'")
+    if scene.ceiling_height is None or isinstance(scene.gravity, tuple):
+        raise SceneError("scene is not allowed: ballc.impact simulates one impact on the "
+                         "seed's floor or ceiling, so its scene gives ceiling_height (not "
+                         "planes) and gravity as a number (along -z)")
     v = _vector("velocity", velocity)
     w = _vector("angular_velocity", angular_velocity)
     try:

@@ -51,14 +51,44 @@ def _header(result) -> dict:
                                       len(result.t_events))}
 
 
-def _check_provenance(path, stored: dict, state_names) -> None:
-    if tuple(state_names) != tuple(_core.STATE_NAMES):
+def _expected_states(scene: dict) -> tuple:
+    """The state names this ballc gives the scene stored in a file (its planes' names)."""
+    planes = scene.get("planes")
+    if not planes:
+        return _core.STATE_NAMES
+    return _core.state_names(tuple(p.get("name") or f"plane{i}" for i, p in enumerate(planes)))
+
+
+def _check_provenance(path, stored: dict, state_names, scene: dict) -> None:
+    expected = _expected_states(scene)
+    if tuple(state_names) != tuple(expected):
         warnings.warn(f"{path}: its states {tuple(state_names)} differ from this ballc's "
-                      f"{_core.STATE_NAMES}; outputs that evaluate the model will fail",
+                      f"{expected}; outputs that evaluate the model will fail",
                       stacklevel=3)
     elif stored.get("generator_version") != _core.GENERATOR_VERSION:
         warnings.warn(f"{path}: made with kernels {stored.get('generator_version')!r}, "
                       f"this ballc has {_core.GENERATOR_VERSION!r}", stacklevel=3)
+
+
+#: The right-hand side's flags of kernels "1" (two planes, before planes of any
+#: orientation): (bit, kind, plane); files written then are read with today's flags.
+_FLAGS_1 = ((1, "observer", 0), (2, "friction", 0), (4, "digin", 0), (8, "friction", 1),
+            (16, "digin", 1), (32, "compliant", 0), (64, "compliant", 1), (128, "slip", 0),
+            (256, "slip", 1), (512, "stick", 0), (1024, "stick", 1), (2048, "slip_fixed", 0),
+            (4096, "slip_fixed", 1), (8192, "compliant_sliding", 0),
+            (16384, "compliant_sliding", 1), (32768, "compliant_elastic", 0),
+            (65536, "compliant_elastic", 1))
+
+
+def _flags_of(flags, stored: dict) -> np.ndarray:
+    """A file's per-sample flags in this ballc's layout (int64; kernels "1" converted)."""
+    flags = np.asarray(flags, dtype=np.int64)
+    if stored.get("generator_version") != "1" or not flags.size:
+        return flags
+    converted = np.zeros_like(flags)
+    for bit, kind, plane in _FLAGS_1:
+        converted |= np.where(flags & bit, _core.flag(kind, plane), 0)
+    return converted
 
 
 #: File name suffixes save and load understand.
@@ -88,8 +118,8 @@ def save(result, path) -> None:
     events = {f"event_{k}": v for k, v in result.event_arrays().items()}
     np.savez_compressed(
         path, t=result.t, y=result.y, state_names=np.array(result.state_names, dtype=str),
-        flags=_or_empty(result.flags, np.int32), latch=_or_empty(result.latch, float),
-        latch_names=np.array(_core.LATCH_NAMES, dtype=str),
+        flags=_or_empty(result.flags, np.int64), latch=_or_empty(result.latch, float),
+        latch_names=np.array(result.scene.latch_names, dtype=str),
         header=np.array(json.dumps(header)), **contacts, **events)
 
 
@@ -118,7 +148,9 @@ def read(path) -> tuple[dict, dict, dict]:
         header, arrays, contacts = _read_dataset(path)
     else:
         header, arrays, contacts = _read_npz(path)
-    _check_provenance(path, json.loads(header["provenance"]), arrays["state_names"])
+    stored = json.loads(header["provenance"])
+    _check_provenance(path, stored, arrays["state_names"], json.loads(header["scene"]))
+    arrays["flags"] = _flags_of(arrays["flags"], stored)
     return header, arrays, contacts
 
 
@@ -186,7 +218,10 @@ def _to_dataset(result):
                                   "pip install 'ballc[netcdf]' (or save as .npz)") from None
     variables = {"y": (("state", "time"), result.y, {"long_name": "state (SI units)"})}
     if result.flags is not None:
-        variables["flags"] = (("time",), np.asarray(result.flags, dtype=np.int32))
+        # netCDF3 has no 64-bit integers: the flags' low and high 32 bits, as int32
+        flags = np.asarray(result.flags, dtype=np.int64)
+        variables["flags"] = (("time",), (flags & 0xFFFFFFFF).astype(np.uint32).view(np.int32))
+        variables["flags_high"] = (("time",), (flags >> 32).astype(np.int32))
         variables["latch"] = (("latch_name", "time"), result.latch)
     for name, values in result.contact_arrays().items():
         dims = ("contact", f"{name}_component") if values.ndim == 2 else ("contact",)
@@ -196,8 +231,18 @@ def _to_dataset(result):
     variables["event_times"] = (("event",), events["times"], {"units": "s"})
     variables["event_states"] = (("event", "state"), events["states"])
     coords = {"time": ("time", result.t, {"units": "s"}),
-              "state": list(result.state_names), "latch_name": list(_core.LATCH_NAMES)}
+              "state": list(result.state_names), "latch_name": list(result.scene.latch_names)}
     return xr.Dataset(variables, coords=coords, attrs=_header(result))
+
+
+def _flags_read(ds) -> np.ndarray:
+    """A netCDF file's flags (int64): its low 32 bits and, if written, its high ones."""
+    if "flags" not in ds:
+        return np.zeros(0)
+    low = ds["flags"].values.astype(np.int32).view(np.uint32).astype(np.int64)
+    if "flags_high" not in ds:
+        return ds["flags"].values.astype(np.int64)   # a file from before 64-bit flags
+    return low | (ds["flags_high"].values.astype(np.int64) << 32)
 
 
 def _read_dataset(path):
@@ -210,7 +255,7 @@ def _read_dataset(path):
             raise _not_a_result(path, f"it has no {', '.join(missing)}")
         arrays = {"t": ds["time"].values.astype(float), "y": ds["y"].values.astype(float),
                   "state_names": ds["state"].values.astype(str),
-                  "flags": ds["flags"].values.astype(np.int32) if "flags" in ds else np.zeros(0),
+                  "flags": _flags_read(ds),
                   "latch": ds["latch"].values.astype(float) if "latch" in ds else np.zeros(0)}
         arrays.update({name: ds[name].values for name in EVENT_ARRAYS if name in ds})
         contacts = {k[len("contact_"):]: ds[k].values for k in ds.data_vars

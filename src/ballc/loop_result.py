@@ -13,33 +13,32 @@ import weakref
 
 import numpy as np
 
-from . import _core, layout, messages, orbit, outcome
+from . import _core, messages, orbit, outcome
 from .dense import CompiledInterpolant, PiecewiseSolution
 from .flight import FreeFlight
-from .resting import Constant
+from .resting import AcceleratedRolling, Constant
 from .result import Contact, Result
 
-PLANES = layout.PLANES
 
-
-def result_of(scene, options, run) -> Result:
-    """The Result of ``run`` (a ``_core.Drive``) of ``scene`` with ``options``."""
+def result_of(scene, options, run, checks_rest=False) -> Result:
+    """The Result of ``run`` (a ``_core.Drive``) of ``scene`` with ``options``
+    (``checks_rest``: the run checked for end states, run_constants' checks_rest)."""
     result = Result.__new__(Result)
     y = run.rows.T
     blocks = _Blocks(run)
     result.__dict__.update(
         t=run.t, y=y, scene=scene, status=run.status, nfev=run.nfev,
-        njev=run.njev, nlu=run.nlu, state_names=_core.STATE_NAMES, _energy=None,
+        njev=run.njev, nlu=run.nlu, state_names=scene.state_names, _energy=None,
         method_switches=run.switches() if options.method == "auto" else None,
         _pending={
-            "contacts": lambda r: _contacts(run, _ForceSummary(run.t, y, blocks, scene)),
+            "contacts": lambda r: _contacts(scene, run, _ForceSummary(run.t, y, blocks, scene)),
             "flags": lambda r: blocks.flags(),
             "latch": lambda r: blocks.latch(),
             "t_events": lambda r: _user_events(r, run, options)[0],
             "y_events": lambda r: _user_events(r, run, options)[1],
             "sol": lambda r: _dense(scene, run, options) if options.dense_output else None,
             "_segment_log": lambda r: run.segment_log(),
-            "message": lambda r: _message(r, scene, options, run),
+            "message": lambda r: _message(r, scene, options, run, checks_rest),
             "_orbit_trials": lambda r: run.trials(),   # ballc.orbit's: (from, to, accepted)
             "_driver_counts": lambda r: {               # the C loop's counters
                 "segments": run.segments, "profiled": run.profiled,
@@ -48,9 +47,13 @@ def result_of(scene, options, run) -> Result:
     return result
 
 
-def _message(result, scene, options, run) -> str:
-    """How the run ended (ballc.messages) and the warnings of ballc.outcome."""
+def _message(result, scene, options, run, checks_rest) -> str:
+    """How the run ended (ballc.messages), why no end state finished a long contact, and
+    the warnings of ballc.outcome."""
     message = messages.run_message(scene, options, run)
+    if (checks_rest and run.stop_code == _core.DRIVE_OK and not run.end_kind
+            and any(k >= 0 for k in run.open_contacts())):
+        message += messages.why_no_end_state(scene, result.contacts, options.t_end)
     message += outcome.tolerance_warning(options.rtol, options.atol)
     message += outcome.balance_warning(result, options.rtol)
     if options.method == "dop853":   # auto switched to radau5 where the test fired
@@ -60,7 +63,8 @@ def _message(result, scene, options, run) -> str:
 
 
 class _Blocks:
-    """Each sample's segment's flags (n,) int32 and latch (N_LATCH, n), built once from
+    """Each sample's segment's flags (n,) int64 and latch (the latch's values, n), built
+    once from
     the run's blocks (for the Result and for the contacts' force summaries)."""
 
     __slots__ = ("run", "found")
@@ -113,7 +117,7 @@ def _user_events(result, run, options):
     return found
 
 
-def _contacts(run, summary) -> list:
+def _contacts(scene, run, summary) -> list:
     """The run's contacts, their phases and end states; their force summaries are
     computed on first access to one (``summary``, ballc.outcome.summarize_contacts).
     Their vectors are rows of one array per field (a contact that did not end: NaN
@@ -122,18 +126,20 @@ def _contacts(run, summary) -> list:
     t_end, lost, rates = found["t_end"].tolist(), found["lost"].tolist(), found["rate"]
     v_before, w_before, v_after, w_after, digin, point = (found[name] for name in (
         "v_before", "w_before", "v_after", "w_after", "digin", "contact_point"))
+    names, planes = scene.plane_names, scene.planes
     contacts = []
     for k, (plane, kernel_rate, t_start, depth) in enumerate(zip(
             found["plane"].tolist(), found["kernel_rate"].tolist(), found["t_start"].tolist(),
             found["max_penetration"].tolist())):
         contact = Contact.__new__(Contact)
         contact.__dict__.update(
-            plane=PLANES[plane], t_start=t_start, t_end=t_end[k],
+            plane=names[plane], t_start=t_start, t_end=t_end[k],
             velocity_before=v_before[k], angular_velocity_before=w_before[k],
             penetration_rate_at_impact=rates[k] if kernel_rate else float(rates[k]),
             digin_direction=digin[k], velocity_after=v_after[k],
             angular_velocity_after=w_after[k], max_penetration=depth,
-            contact_point=point[k], energy_lost_normal=lost[k][0],
+            contact_point=point[k][:2], contact_point_z=float(point[k][2]),
+            normal=planes[plane].unit_normal, energy_lost_normal=lost[k][0],
             energy_lost_tangential=lost[k][1], transitions=[], t_rest=math.nan,
             t_rolling=math.nan, t_sliding=math.nan, _summary=summary)
         contacts.append(contact)
@@ -149,7 +155,7 @@ def _contacts(run, summary) -> list:
 
 def _dense(scene, run, options):
     """sol(t) over the run: the segments' interpolants, and the closed-form end's."""
-    gravity = float(scene.gravity)
+    gravity = scene.gravity_vector
     pieces = []
     for piece in run.pieces():
         if len(piece) > 3:
@@ -170,6 +176,10 @@ def _dense(scene, run, options):
                                                  orbit.Motion.from_array(motion), base)
         elif end == "rest":
             closed = Constant(y)
+        elif end == "accelerating":
+            closed = AcceleratedRolling(when, y, run.end_acceleration, scene.radius,
+                                        scene.planes[run.end_plane].unit_normal,
+                                        t_max=options.t_end)
         else:
             closed = FreeFlight(when, y, 0.0, t_max=options.t_end)
         pieces.append((when, options.t_end, closed))

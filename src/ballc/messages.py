@@ -13,7 +13,6 @@ import numpy as np
 
 from . import _core, layout, resting
 
-PLANES = layout.PLANES
 SUCCESS = "The solver successfully reached the end of the integration interval."
 TERMINATED = "A termination event occurred."
 #: What the transitions are called in the message of a run whose modes did not settle.
@@ -23,38 +22,41 @@ COMPLIANT_TRANSITIONS = "the compliant law's elastic/sliding"
 #: rounding of its depth r - z allows (see failure_hint).
 TIGHT_ATOL = 1e-10
 #: The C loop's end states (_driver.h: BALLC_END_*; 0 none) by name.
-END_KINDS = (None, "rest", "rolling", "free_sliding")
+END_KINDS = (None, "rest", "rolling", "free_sliding", "accelerating")
 
 
 def run_message(scene, options, run) -> str:
     """The message of the finished ``run`` (a ``_core.Drive``) of ``scene`` with
     ``options``, before the warnings."""
     code = run.stop_code
+    names = scene.plane_names
     if code == _core.DRIVE_FAILED:
         return failure_message(scene, options, run.message, run.nfev, run.fail_end,
-                               dict(zip(PLANES, run.in_contact)))
+                               dict(zip(names, run.in_contact)))
     if code == _core.DRIVE_ABORTED:
         return (f"the run stopped at t = {run.t_run:.6g} s where it cannot go on: "
                 f"{run.message}")
     if code == _core.DRIVE_UNSETTLED:
         what = COMPLIANT_TRANSITIONS if run.unsettled_compliant else COULOMB_TRANSITIONS
         plane = run.stop_plane
-        return unsettled_message(what, PLANES[plane], run.transitions[plane], run.stalled,
+        return unsettled_message(what, names[plane], run.transitions[plane], run.stalled,
                                  run.t_run)
     if code == _core.DRIVE_TERMINATED:
         return TERMINATED
     if code == _core.DRIVE_THROUGH:
-        return through_message(PLANES[run.stop_plane], run.t_run)
+        return through_message(names[run.stop_plane], run.t_run)
     end = END_KINDS[run.end_kind]
     if not end:
         return SUCCESS
-    plane, when = PLANES[run.end_plane], run.end_t
+    plane, when = names[run.end_plane], run.end_t
     orbit = run.orbit()
     if orbit is not None:
         return orbit_message(scene.parameter_vector(), plane, when, run.end_y, end,
                              orbit[1], orbit[2][0], orbit[3], options.t_end)
     if end == "rest":
         return rest_message(scene, plane, when)
+    if end == "accelerating":
+        return accelerating_message(plane, when, run.end_y, run.end_acceleration)
     return motion_message(scene, plane, when, run.end_y, end)
 
 
@@ -68,8 +70,13 @@ def rest_message(scene, plane, t):
 
 def motion_message(scene, plane, t, y, kind):
     """The message of a run that goes on uniformly (``kind`` "rolling" or
-    "free_sliding") on ``plane`` from ``t`` in state ``y``."""
-    v = math.hypot(*y[layout.VELOCITY][:2])
+    "free_sliding") on ``plane`` from ``t`` in state ``y``: its speed along the plane."""
+    n = scene.planes[scene.plane_names.index(plane)].unit_normal
+    velocity = y[layout.VELOCITY]
+    if n[0] == 0 and n[1] == 0:   # horizontal: the horizontal speed
+        v = math.hypot(*velocity[:2])
+    else:
+        v = float(np.linalg.norm(velocity - (velocity @ n) * n))
     what = "rolls uniformly" if kind == "rolling" else (
         "slides uniformly (no force opposes its slip)")
     return (f"{SUCCESS} The ball {what} on the {plane} from t = "
@@ -78,6 +85,49 @@ def motion_message(scene, plane, t, y, kind):
             f"{resting.equilibrium_penetration(scene):.6g} m); from there "
             f"to t_end the state is that {kind.replace('free_', '')}, in "
             "closed form.")
+
+
+def accelerating_message(plane, t, y, acceleration) -> str:
+    """The message of a run that rolls down ``plane`` uniformly accelerated from ``t``
+    (state ``y``, the centre's ``acceleration``)."""
+    v = float(np.linalg.norm(y[layout.VELOCITY]))
+    return (f"{SUCCESS} The ball rolls down the {plane} without slip from t = {t:.9g} s at "
+            f"{v:.6g} m/s, uniformly accelerated at {float(np.linalg.norm(acceleration)):.6g} "
+            "m/s^2 (g_t / (1 + I / (m r^2)), g_t gravity along the plane; nothing else is "
+            "reached by t_end); from there to t_end the state is that rolling, in closed "
+            "form.")
+
+
+def why_no_end_state(scene, contacts, t_end) -> str:
+    """What a run that went on to ``t_end`` in a long contact (more than REST_PERIODS
+    small-oscillation periods) says about why no end state finished it in closed form:
+    rest and uniform rolling are exact only on a plane whose normal is opposite gravity,
+    alone (resting.resting_plane_index); on any other plane -- an incline, where rolling
+    is uniformly accelerated -- or against two planes at once the integration goes on.
+    "" when no such contact was open at the end."""
+    open_ = [c for c in contacts if c.t_end != c.t_end and c.t_rest != c.t_rest
+             and c.t_rolling != c.t_rolling and c.t_sliding != c.t_sliding]
+    if not open_ or not scene.gravity_magnitude > 0:
+        return ""
+    long_ago = t_end - resting.REST_PERIODS * resting.oscillation_period(scene)
+    open_ = [c for c in open_ if c.t_start <= long_ago]
+    if not open_:
+        return ""
+    names = " and the ".join(c.plane for c in open_)
+    index = resting.resting_plane_index(scene)
+    if len(open_) > 1:
+        why = (f"the ball is in contact with the {names} at once (rest and uniform rolling "
+               "are checked on a plane whose normal is opposite gravity, alone)")
+    elif index is None or open_[0].plane != scene.plane_names[index]:
+        why = (f"the ball is in contact with the {names}, whose normal is not opposite "
+               "gravity: rest and uniform rolling are exact end states only on such a "
+               "plane; rolling down an incline, uniformly accelerated, ends in closed form "
+               "only once it rolls without slip straight down the slope without spin "
+               "about the normal, reaching no other plane by t_end (a massless observer, "
+               "isotropic inertia)")
+    else:
+        return ""
+    return f" No closed-form end state: {why}; the integration went on to t_end."
 
 
 def orbit_message(params, plane, t, y, kind, period, phi, rate, t_end):
@@ -144,7 +194,7 @@ def _tight_atol_hint(atol):
             "tolerance on the centre's height and vertical velocity can be below the "
             "rounding noise of the contact depth r - z, most of all for a hard ball "
             f"at rest; try atol >= {TIGHT_ATOL:g} (one number, or per state: "
-            "ballc.STATE_NAMES))")
+            "scene.state_names))")
 
 
 def _regularised_friction_hint(scene):

@@ -49,3 +49,14 @@ def flags(scene, in_contact):
         if mixture > 0:
             flags |= _core.FLAGS[f"{plane}_digin"]
     return flags
+
+
+def contact_flags(scene, plane: int) -> int:
+    """The flags of a contact with the plane with index ``plane`` (its laws: compliant;
+    or friction and/or dig-in by the mixture), without its modes: what the C loop adds
+    its modes to."""
+    if scene.tangential_model == "compliant":
+        return _core.flag("compliant", plane)
+    mixture = scene.effective_mixture
+    return ((_core.flag("friction", plane) if mixture < 1 else 0)
+            | (_core.flag("digin", plane) if mixture > 0 else 0))

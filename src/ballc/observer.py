@@ -32,7 +32,7 @@ def state_derivatives(result) -> np.ndarray:
     return _core.rhs_per_sample(np.ascontiguousarray(result.y.T),
                                 result.scene.parameter_vector(),
                                 np.ascontiguousarray(result.latch.T),
-                                np.ascontiguousarray(result.flags, dtype=np.intc)).T
+                                np.ascontiguousarray(result.flags, dtype=np.int64)).T
 
 
 def observer_acceleration(result) -> np.ndarray:
@@ -55,7 +55,7 @@ def specific_force(result, frame: str = "inertial") -> np.ndarray:
     if frame not in ("inertial", "ball"):
         raise ValueError(f"frame = {frame!r} is not allowed: must be 'inertial' or 'ball'")
     force = observer_acceleration(result)
-    force[2] += result.scene.gravity
+    force -= result.scene.gravity_vector[:, None]
     force /= STANDARD_GRAVITY
     return to_ball_frame(result, force) if frame == "ball" else force
 

@@ -82,8 +82,9 @@ def check_method(method) -> str:
     raise SceneError(f"method = {plain(method)} is not allowed: must be one of {METHODS}{hint}")
 
 
-def check_tolerances(rtol, atol):
-    """(rtol, atol) as float and float-or-array, or SceneError naming the bad one."""
+def check_tolerances(rtol, atol, names=_core.STATE_NAMES):
+    """(rtol, atol) as float and float-or-array, or SceneError naming the bad one
+    (``names``: the run's states, one atol each when it is not one number)."""
     if (type(rtol) is float and type(atol) is float and MIN_RTOL <= rtol < math.inf
             and 0 < atol < math.inf):   # the common case, without numpy
         return rtol, atol
@@ -99,10 +100,10 @@ def check_tolerances(rtol, atol):
     if float(rtol) < MIN_RTOL:
         raise SceneError(f"rtol = {plain(rtol)} is not allowed: must be >= 100 machine "
                          f"epsilons = {MIN_RTOL:.3g}")
-    n = _core.N_STATES
+    n = len(names)
     if np.ndim(atol) > 1 or np.ndim(atol) == 1 and np.size(atol) != n:
         raise SceneError(f"atol = {plain(atol)} is not allowed: must be a number or one per "
-                         f"state ({n}: {', '.join(_core.STATE_NAMES)})")
+                         f"state ({n}: {', '.join(names)})")
     atol = float(atol) if np.ndim(atol) == 0 else np.array(atol, dtype=float)
     return float(rtol), atol
 
@@ -124,9 +125,10 @@ def check_t_eval(t_eval, t_end):
     return t_eval
 
 
-def check_events(events) -> tuple:
+def check_events(events, names=_core.STATE_NAMES) -> tuple:
     """User event functions g(t, y) with solve_ivp's optional ``terminal`` (a bool, or
-    an integer k: stop at the k-th occurrence) and ``direction`` (number) attributes."""
+    an integer k: stop at the k-th occurrence) and ``direction`` (number) attributes
+    (``names``: the run's states, a LinearEvent's coefficients one each)."""
     if events is None:
         return ()
     if callable(events):
@@ -152,17 +154,17 @@ def check_events(events) -> tuple:
             raise SceneError(f"events[{k}].direction = {plain(direction)} is not allowed: must "
                              "be a number (its sign: +1 rising, -1 falling, 0 both)")
         if isinstance(event, LinearEvent):
-            _check_linear_event(k, event)
+            _check_linear_event(k, event, names)
     return events
 
 
-def _check_linear_event(k, event):
-    """A LinearEvent's coefficients (N_STATES finite numbers) and offset (finite)."""
+def _check_linear_event(k, event, names):
+    """A LinearEvent's coefficients (one finite number per state) and offset (finite)."""
     row = getattr(event, "coefficients", None)
-    n = _core.N_STATES
+    n = len(names)
     if not (_is_number_like(row) and np.shape(row) == (n,) and np.all(np.isfinite(row))):
         raise SceneError(f"events[{k}].coefficients = {plain(row)} is not allowed: must be "
-                         f"{n} finite numbers, one per state ({', '.join(_core.STATE_NAMES)})")
+                         f"{n} finite numbers, one per state ({', '.join(names)})")
     offset = getattr(event, "offset", None)
     if not (_is_number_like(offset) and np.ndim(offset) == 0 and np.isfinite(offset)):
         raise SceneError(f"events[{k}].offset = {plain(offset)} is not allowed: must be a "
@@ -181,7 +183,7 @@ def check_options(scene, t_end, method="radau5", rtol=1e-10, atol=1e-10, max_ste
         raise TypeError(f"scene must be a ballc.Scene, got {type(scene).__name__}")
     t_end = _positive_number("t_end", t_end, hint="a finite number > 0")
     method = check_method(method)
-    rtol, atol = check_tolerances(rtol, atol)
+    rtol, atol = check_tolerances(rtol, atol, scene.state_names)
     max_step = _positive_number("max_step", max_step, allow_inf=True,
                                 hint="a number > 0 (inf for no limit)")
     if first_step is not None:
@@ -203,5 +205,6 @@ def check_options(scene, t_end, method="radau5", rtol=1e-10, atol=1e-10, max_ste
     return Options(t_end=t_end, method=method, rtol=rtol, atol=atol, max_step=max_step,
                    first_step=first_step, t_eval=check_t_eval(t_eval, t_end),
                    max_nfev=None if max_nfev is None else int(max_nfev),
-                   events=check_events(events), dense_output=bool(dense_output),
+                   events=check_events(events, scene.state_names),
+                   dense_output=bool(dense_output),
                    exact_flight=bool(exact_flight))

@@ -76,9 +76,14 @@ TILT_SAMPLES = _core.ORBIT_TILT_SAMPLES
 
 
 def applies(scene) -> bool:
-    """Routh's sphere on the floor: g > 0, isotropic inertia, a massive observer."""
+    """Routh's sphere on the floor: g > 0 along -z, every plane horizontal (the scene
+    symmetric about the vertical: the motion G turns it into itself), isotropic inertia,
+    a massive observer."""
     p = scene._parameters   # (read only)
-    return bool(scene.gravity > 0 and scene.observer_mass > 0
+    g = scene.gravity_vector
+    return bool(g[2] < 0 and g[0] == 0 and g[1] == 0 and scene.observer_mass > 0
+                and all(plane.normal[0] == 0 and plane.normal[1] == 0
+                        for plane in scene.planes)
                 and p[_PARAMETER["inertia_xx"]] == p[_PARAMETER["inertia_yy"]]
                 == p[_PARAMETER["inertia_zz"]])
 
@@ -91,25 +96,34 @@ def body_axis(scene) -> np.ndarray:
     return p / norm if norm > 0 else np.array([0.0, 0.0, 1.0])
 
 
+#: The seed's planes as a motion sees them (_core.motion_planes): two, the floor's
+#: deflection turning with the scene, the ceiling's against it.
+SEED_PLANES = (2.0, 1.0, -1.0) + (0.0,) * (_core.MAX_PLANES - 2)
+
+
 class Motion:
     """G = (phi, d, psi, dissipated): turn the scene by phi about the vertical, shift it
     by d = (dx, dy), turn the ball by psi about its axis a, add ``dissipated`` (J,
-    normal and tangential) to the dissipated work."""
+    normal and tangential) to the dissipated work.  ``planes``: the scene's planes as G
+    turns their deflections (_core.motion_planes: their number, then +1 or -1 each;
+    default the seed's floor and ceiling)."""
 
-    def __init__(self, phi, d, psi, axis, dissipated=(0.0, 0.0)):
+    def __init__(self, phi, d, psi, axis, dissipated=(0.0, 0.0), planes=SEED_PLANES):
         self.phi, self.psi = float(phi), float(psi)
         self.d = (float(d[0]), float(d[1]))
         self.axis = np.array(axis, dtype=float).reshape(3)
         self.dissipated = np.array(dissipated, dtype=float).reshape(2)
+        self.planes = tuple(float(v) for v in planes)
 
     @classmethod
     def from_array(cls, values):
-        """G from its _core.MOTION_SIZE numbers (phi, dx, dy, psi, axis, work)."""
+        """G from its _core.MOTION_SIZE numbers (phi, dx, dy, psi, axis, work, planes)."""
         v = [float(x) for x in values]
-        return cls(v[0], v[1:3], v[3], v[4:7], v[7:9])
+        return cls(v[0], v[1:3], v[3], v[4:7], v[7:9], v[9:])
 
     def as_array(self):
-        return np.array([self.phi, *self.d, self.psi, *self.axis, *self.dissipated])
+        return np.array([self.phi, *self.d, self.psi, *self.axis, *self.dissipated,
+                         *self.planes])
 
     def apply(self, y, k=1, rate=False):
         """G^k y for states y (N_STATES,) or (N_STATES, n), k an integer or one per
@@ -157,7 +171,7 @@ def measure(interpolant, t0, t1, axis, guess, rtol, atol, energy_threshold, para
     found = _core.orbit_measure(
         interpolant, float(t0), float(t1), np.ascontiguousarray(axis, dtype=float),
         float(guess), float(rtol),
-        np.ascontiguousarray(np.broadcast_to(atol, (_core.N_STATES,)), dtype=float),
+        np.ascontiguousarray(np.broadcast_to(atol, (_core.layout_of(params)[1],)), dtype=float),
         resting.REST_FACTOR, float(energy_threshold), np.ascontiguousarray(params, dtype=float))
     if found is None:
         return None

@@ -17,8 +17,6 @@ import numpy as np
 
 from . import _core
 
-PLANES = ("floor", "ceiling")
-
 #: Contacts of the classic experiment: floor, table underside, floor.
 CAME_BACK_AFTER_CONTACTS = 3
 
@@ -166,6 +164,7 @@ def summarize_contacts(contacts, t, y, latch, flags, scene):
         contact.peak_normal_force = contact.time_sticking = contact.time_slipping = math.nan
     if not contacts:
         return
+    names = scene.plane_names
     mu = scene.friction_coefficient
     ends = [c.t_end if np.isfinite(c.t_end) else t[-1] for c in contacts]
     # each contact's samples, t_start <= t <= end: one run of them (t is increasing)
@@ -179,21 +178,25 @@ def summarize_contacts(contacts, t, y, latch, flags, scene):
     rows = np.concatenate([np.arange(first, stop) for first, stop in runs])
     forces = _core.contact_forces_per_sample(
         np.ascontiguousarray(y.T[rows]), scene.parameter_vector(),
-        np.ascontiguousarray(latch.T[rows]), np.ascontiguousarray(flags[rows], dtype=np.int32))
+        np.ascontiguousarray(latch.T[rows]), np.ascontiguousarray(flags[rows], dtype=np.int64))
     offset = 0
     for contact, end, first, stop in zip(contacts, ends, firsts, stops):
         if stop <= first:
             continue
-        k = PLANES.index(contact.plane)
-        normal = 1.0 if contact.plane == "floor" else -1.0
+        k = names.index(contact.plane)
         block = forces[offset:offset + stop - first, 3 * k:3 * k + 3]
         offset += stop - first
-        f_n = block[:, 2] * normal
+        n = contact.unit_normal
+        if n[0] == 0 and n[1] == 0:   # horizontal: the z component, as it is
+            f_n = block[:, 2] * n[2]
+            f_t = np.hypot(block[:, 0], block[:, 1])
+        else:   # along the normal, and the rest
+            f_n = block @ n
+            f_t = np.linalg.norm(block - f_n[:, None] * n, axis=1)
         contact.peak_normal_force = float(f_n.max())
         if contact.transitions:   # exact Coulomb friction: the phases are events
             contact.time_sticking, contact.time_slipping = _phase_times(contact, end)
             continue
-        f_t = np.hypot(block[:, 0], block[:, 1])
         slipping = (f_t >= STICK_SLIP_THRESHOLD * mu * f_n) & (f_n > 0)
         times = t[first:stop]
         dt = np.diff(times)

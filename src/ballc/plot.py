@@ -20,6 +20,24 @@ import numpy as np
 
 PLANE_COLOURS = {"floor": "tab:brown", "ceiling": "tab:cyan"}
 PLANE_MARKERS = {"floor": "o", "ceiling": "^"}
+#: The colours and markers of the other planes, by their index in the scene.
+OTHER_COLOURS = ("tab:green", "tab:purple", "tab:olive", "tab:pink", "tab:gray", "tab:blue")
+OTHER_MARKERS = ("s", "D", "v", "P", "X", "*")
+
+
+def plane_style(scene, name) -> tuple:
+    """(colour, marker) of the plane ``name`` of ``scene`` in every figure: the seed's
+    floor brown o and ceiling cyan ^; any other by its index."""
+    if name in PLANE_COLOURS and scene.ceiling_height is not None:
+        return PLANE_COLOURS[name], PLANE_MARKERS[name]
+    index = scene.plane_names.index(name)
+    return OTHER_COLOURS[index % len(OTHER_COLOURS)], OTHER_MARKERS[index % len(OTHER_MARKERS)]
+
+
+def planes_key(scene) -> str:
+    """"brown floor, cyan ceiling": what each plane's colour is, for a title."""
+    return ", ".join(f"{plane_style(scene, name)[0].removeprefix('tab:')} {name}"
+                     for name in scene.plane_names)
 #: Energy keys drawn first, in this order; any other key (e.g. dissipated_*) follows,
 #: and "total" comes last, thick.
 ENERGY_ORDER = ("kinetic", "potential", "spring")
@@ -217,16 +235,19 @@ def scene_title(scene) -> str:
 
 
 def shade_contacts(ax, result) -> None:
-    """Shade the time spans of the contacts (floor brown, ceiling cyan)."""
+    """Shade the time spans of the contacts, each in its plane's colour (floor brown,
+    ceiling cyan: plane_style)."""
     for contact in result.contacts:
         end = contact.t_end if np.isfinite(contact.t_end) else result.t[-1]
-        ax.axvspan(contact.t_start, end, color=PLANE_COLOURS[contact.plane], alpha=0.2, lw=0)
+        ax.axvspan(contact.t_start, end, color=plane_style(result.scene, contact.plane)[0],
+                   alpha=0.2, lw=0)
 
 
 def plot_coordinates(result, axes=None, figsize=(10, 8), t_window=None):
     """Centre position, centre velocity and angular velocity against time.
 
-    Returns (figure, array of 3 axes).  Contacts are shaded (floor brown, ceiling cyan);
+    Returns (figure, array of 3 axes).  Contacts are shaded in their plane's colour
+    (floor brown, ceiling cyan);
     the x, y, z components are solid, dashed and dotted (``COMPONENT_STYLES``).
     ``t_window=(t0, t1)``: draw that time window (s); default the whole run, or up to
     the closed-form end state plus a margin (see the module's notes).
@@ -253,7 +274,7 @@ def plot_coordinates(result, axes=None, figsize=(10, 8), t_window=None):
         ax.legend(loc="upper right", fontsize="small", ncol=3)
     _mark_tail(axes, tail, result.t[-1])
     axes[-1].set_xlabel("time (s)")
-    axes[0].set_title("Ball centre (shaded: contacts, brown floor, cyan ceiling)\n"
+    axes[0].set_title(f"Ball centre (shaded: contacts, {planes_key(result.scene)})\n"
                       + scene_title(result.scene))
     return fig, axes
 
@@ -291,18 +312,21 @@ CONTACT_POINT = "the centre's (x, y) at maximum penetration"
 
 
 def contact_points(result) -> np.ndarray:
-    """(k, 3) the contact points (m): each contact's ``contact_point`` -- the centre's
-    (x, y) at maximum penetration, as contacts.csv's contact_point_x/y -- on its plane."""
+    """(k, 3) the contact points (m): each contact's centre at maximum penetration
+    (``contact_point``, as contacts.csv's contact_point_x/y, and ``contact_point_z``)
+    taken to its foot on the plane (a horizontal plane's: (x, y) at the plane's z)."""
+    from .planes import foot
+    scene = result.scene
     points = np.empty((len(result.contacts), 3))
     for i, contact in enumerate(result.contacts):
-        z = 0.0 if contact.plane == "floor" else result.scene.ceiling_height
-        points[i] = (*contact.contact_point, z)
+        plane = scene.planes[scene.plane_names.index(contact.plane)]
+        points[i] = foot(plane, (*contact.contact_point, contact.contact_point_z))
     return points
 
 
 def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5), t_window=None):
     """Top view (x, y): the centre's path and the contact points coloured by time,
-    numbered, with arrows from each to the next (floor o, ceiling ^).
+    numbered, with arrows from each to the next (floor o, ceiling ^; plane_style).
     ``t_window``: as :func:`plot_coordinates`'s (the path in it, and the contacts that
     start in it)."""
     plt = _pyplot()
@@ -322,12 +346,12 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5), t_window=None):
     if len(points):
         norm = plt.Normalize(t0, max(t1, t0 + 1e-12))
         cmap = plt.get_cmap("plasma")
-        for plane in ("floor", "ceiling"):
+        for plane in result.scene.plane_names:
             chosen = [k for k, i in enumerate(shown) if result.contacts[i].plane == plane]
             if chosen:
                 ax.scatter(points[chosen, 0], points[chosen, 1], c=times[chosen], cmap=cmap,
-                           norm=norm, marker=PLANE_MARKERS[plane], s=80, edgecolors="k",
-                           zorder=3, label=f"{plane} contact")
+                           norm=norm, marker=plane_style(result.scene, plane)[1], s=80,
+                           edgecolors="k", zorder=3, label=f"{plane} contact")
         view = np.concatenate([np.c_[x, y], points[:, :2]])
         for i in _labelled(points[:, :2], float(np.ptp(view, axis=0).max())):
             ax.annotate(str(shown[i] + 1), points[i, :2], textcoords="offset points",
@@ -340,6 +364,8 @@ def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5), t_window=None):
                     label="to the next contact\n(coloured by its time)")
         fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
                      label="contact start time (s)")
+    if result.scene.ceiling_height is None:   # planes at any orientation: where they are
+        draw_planes(ax, result, (0, 1))
     if tail is not None:
         ax.text(0.02, 0.02, f"path to t = {t1:.4g} s; {tail[1]} from t = {tail[0]:.4g} s: "
                 f"closed form to t_end = {result.t[-1]:g} s", transform=ax.transAxes,
@@ -428,6 +454,60 @@ def _observer_samples(result):
     return dataclasses.replace(result, t=result.t[index], y=result.y[:, index],
                                flags=result.flags[index], latch=result.latch[:, index],
                                _energy=None, sol=None)
+
+
+def draw_planes(ax, result, components=(0, 2)) -> None:
+    """Each plane of the scene where it is, seen along the remaining axis: the polygon
+    where it cuts the picture's box (planes.drawing_box) projected on the axes
+    ``components`` (0 x, 1 y, 2 z), filled in its colour (a plane seen edge-on: its
+    line), labelled with its name."""
+    from .planes import clipped, drawing_box
+    scene = result.scene
+    low, high = drawing_box(scene, result.position)
+    for plane, name in zip(scene.planes, scene.plane_names):
+        polygon = clipped(plane, low, high)
+        if not len(polygon):
+            continue
+        colour = plane_style(scene, name)[0]
+        shape = polygon[:, components]
+        ax.fill(*shape.T, color=colour, alpha=0.25, lw=0)
+        ax.plot(*np.vstack([shape, shape[:1]]).T, color=colour, lw=2, label=f"plane {name}")
+
+
+def plot_side_view(result, ax=None, figsize=(8, 6.5), t_window=None):
+    """Side view (x, z): the centre's path, every plane where it is (each in its
+    colour, seen along y: a plane containing the y axis as its line) and the contact
+    points numbered -- the picture of a tilted pair of plates, a wedge or a channel.
+    ``t_window``: as :func:`plot_coordinates`'s."""
+    plt = _pyplot()
+    t0, t1, tail = _window(result, t_window)
+    fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
+               else (ax.figure, ax))
+    drawn = _in_window(result, t0, t1, tail)
+    inside = (drawn.t >= t0) & (drawn.t <= t1)
+    _, x, z = _for_drawing(drawn.t[inside], drawn.position[0, inside],
+                           drawn.position[2, inside])
+    draw_planes(ax, result, (0, 2))
+    ax.plot(x, z, color="0.35", lw=0.8, label="centre path")
+    if t0 <= result.t[0]:
+        ax.plot(result.position[0, 0], result.position[2, 0], "kx", ms=8, label="start")
+    shown = [i for i, c in enumerate(result.contacts) if t0 <= c.t_start <= t1]
+    points = contact_points(result)[shown]
+    for k, i in enumerate(shown):
+        colour, marker = plane_style(result.scene, result.contacts[i].plane)
+        ax.plot(points[k, 0], points[k, 2], marker=marker, color=colour, mec="k", ms=8,
+                ls="")
+    for i in _labelled(points[:, [0, 2]], max(float(np.ptp(np.r_[x, z])), 1e-12)):
+        ax.annotate(str(shown[i] + 1), points[i, [0, 2]], textcoords="offset points",
+                    xytext=(6, 6), fontsize=9)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("z (m)")
+    ax.set_title("Side view: the planes where they are, the centre's path and the "
+                 "contact points\n" + scene_title(result.scene), fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    return fig, ax
 
 
 def plot_observer(result, axes=None, figsize=(10, 7), t_window=None):

@@ -81,9 +81,31 @@ MAX_ROLL_SAMPLES = _core.MAX_ROLL_SAMPLES
 _EPS = float(np.finfo(float).eps)
 
 
+#: How far (the length of n + g/|g|) a plane's unit normal may be from opposite gravity
+#: for rest and uniform rolling on it to count as exact (a scene turned as a whole keeps
+#: its floor within rounding of it).
+OPPOSITE_GRAVITY = 1e-12
+
+
+def resting_plane_index(scene) -> int | None:
+    """The index of the plane gravity presses the ball against -- the first whose normal
+    is opposite gravity (within OPPOSITE_GRAVITY), where rest and uniform rolling are
+    exact end states -- or None (g = 0, or no such plane: then the integration goes on)."""
+    g = scene.gravity_magnitude
+    if not g > 0:
+        return None
+    down = scene.gravity_vector / g
+    for i, plane in enumerate(scene.planes):
+        if float(np.linalg.norm(plane.unit_normal + down)) <= OPPOSITE_GRAVITY:
+            return i
+    return None
+
+
 def resting_plane(scene) -> str | None:
-    """The plane gravity presses the ball against ("floor"), or None (g = 0)."""
-    return "floor" if scene.gravity > 0 else None
+    """The name of the plane gravity presses the ball against (resting_plane_index), or
+    None."""
+    index = resting_plane_index(scene)
+    return None if index is None else scene.plane_names[index]
 
 
 def total_mass(scene) -> float:
@@ -92,7 +114,7 @@ def total_mass(scene) -> float:
 
 def equilibrium_penetration(scene) -> float:
     """rho_eq = (m_total g / k0)^(2/3) (m): the Hertz force k0 rho^(3/2) carries the weight."""
-    return (total_mass(scene) * scene.gravity / scene.hertz_stiffness) ** (2.0 / 3.0)
+    return (total_mass(scene) * scene.gravity_magnitude / scene.hertz_stiffness) ** (2.0 / 3.0)
 
 
 def linear_stiffness(scene) -> float:
@@ -113,13 +135,14 @@ def _largest(atol) -> float:
 def speed_tolerance(scene, rtol, atol) -> float:
     """dv = REST_FACTOR (atol + rtol sqrt(g r)) (m/s): REST_FACTOR integration
     tolerances of a speed."""
-    return REST_FACTOR * (_largest(atol) + rtol * math.sqrt(scene.gravity * scene.radius))
+    return REST_FACTOR * (_largest(atol) + rtol * math.sqrt(scene.gravity_magnitude
+                                                            * scene.radius))
 
 
 def steady_level(scene) -> float:
     """The rounding level (1e3 eps g, m/s^2) below which a state's accelerations count as
     zero (uniform motion's steady state)."""
-    return 1e3 * _EPS * scene.gravity
+    return 1e3 * _EPS * scene.gravity_magnitude
 
 
 def energy_threshold(scene, rtol, atol) -> float:
@@ -127,6 +150,30 @@ def energy_threshold(scene, rtol, atol) -> float:
     dx = REST_FACTOR * (_largest(atol) + rtol * scene.radius)
     dv = speed_tolerance(scene, rtol, atol)
     return min(0.5 * linear_stiffness(scene) * dx * dx, 0.5 * total_mass(scene) * dv * dv)
+
+
+class AcceleratedRolling:
+    """The dense output of rolling down an unbounded incline, uniformly accelerated (the
+    C loop's end state on an incline, _driver.c: incline_state): from (t0, y0), a state
+    rolling without slip (omega = n x v / r), no spin about the unit normal ``normal``,
+    the centre's acceleration ``acceleration`` = g_t / (1 + I / (m r^2)): the centre
+    c0 + v0 s + a s^2 / 2, the velocity v0 + a s, the angular velocity
+    omega(s) = (w0 + A s / r) e about the fixed axis e = n x a / A (A the length of a,
+    w0 = omega0 . e), the quaternion turned about e by theta(s) = w0 s + A s^2 / (2 r), the
+    rest constant (s = t - t0; isotropic inertia and a massless observer: the rotation is
+    exact).  Evaluated in C (``_core.rolling_states``, the C loop's own ballc_rolling,
+    which samples the end state too)."""
+
+    def __init__(self, t0, y0, acceleration, radius, normal, t_max=None):
+        self.t0, self.y0 = float(t0), np.array(y0, dtype=float)
+        self.t_min, self.t_max = self.t0, self.t0 if t_max is None else float(t_max)
+        self.acceleration = np.array(acceleration, dtype=float).reshape(3)
+        self.radius = float(radius)
+        self.normal = np.array(normal, dtype=float).reshape(3)
+
+    def __call__(self, t):
+        return _core.rolling_states(self.t0, self.y0, self.acceleration, self.radius,
+                                    self.normal, t)
 
 
 class Constant:
@@ -140,3 +187,4 @@ class Constant:
         if t.ndim == 0:
             return self.y.copy()
         return np.repeat(self.y[:, None], t.size, axis=1)
+

@@ -31,7 +31,8 @@ class Contact:
     Attributes
     ----------
     plane : str
-        "floor" or "ceiling".
+        The plane's name (the scene's ``plane_names``: "floor" or "ceiling" for the
+        seed's).
     t_start, t_end : float
         Start and end of the contact (s).
     velocity_before, velocity_after : ndarray, shape (3,)
@@ -46,6 +47,9 @@ class Contact:
         Largest penetration depth (m).
     contact_point : ndarray, shape (2,)
         Centre (x, y) when the penetration was largest: the contact point (m).
+    contact_point_z : float
+        Centre z then (m): with (x, y), the centre, whose foot on the plane is the
+        contact point (``ballc.plot.contact_points``).
     peak_normal_force : float
         Largest normal force over the stored samples (N).
     energy_lost_normal, energy_lost_tangential : float
@@ -54,12 +58,14 @@ class Contact:
         Time with the tangential force below, and at, the Coulomb cap mu F_n (s).
     transitions : list of (float, str)
         Exact Coulomb friction: the start (s) of each "slip" or "stick" phase.
+    normal : ndarray, shape (3,)
+        The plane's unit normal, towards the ball (1).
 
     The properties ``duration`` (s) and ``rebound_ratio`` (-v_n after / v_n before, 1:
     the scene's restitution e only without gravity) are derived from these.
     """
 
-    plane: str                       # "floor" or "ceiling"
+    plane: str                       # the plane's name ("floor", "ceiling", ...)
     t_start: float                   # s
     velocity_before: np.ndarray      # m/s, at t_start
     angular_velocity_before: np.ndarray  # rad/s, at t_start
@@ -71,6 +77,8 @@ class Contact:
     max_penetration: float = 0.0     # m
     #: centre (x, y) when the penetration was largest: the contact point (m)
     contact_point: np.ndarray = field(default_factory=_NAN_2.copy)
+    #: centre z then (m; NaN in a file from before planes of any orientation)
+    contact_point_z: float = np.nan
     peak_normal_force: float = np.nan      # N, largest F . n over the stored samples
     energy_lost_normal: float = np.nan     # J, dissipated by the normal force
     energy_lost_tangential: float = np.nan  # J, dissipated by the tangential force
@@ -86,6 +94,9 @@ class Contact:
     t_rolling: float = np.nan
     #: likewise for a contact sliding with no force opposing the slip (mu = 0) (s)
     t_sliding: float = np.nan
+    #: the plane's unit normal, towards the ball (a file from before planes of any
+    #: orientation: NaN, the seed's by its name)
+    normal: np.ndarray = field(default_factory=_NAN_3.copy)
     #: a run's contacts: computes peak_normal_force, time_sticking and time_slipping of
     #: every contact of the run on first access (ballc.outcome.summarize_contact_forces)
     _summary: object = field(default=None, init=False, repr=False, compare=False)
@@ -104,6 +115,14 @@ class Contact:
         return dict(self.__dict__)
 
     @property
+    def unit_normal(self) -> np.ndarray:
+        """The plane's unit normal towards the ball: ``normal``, or the seed's floor's
+        (+z) or ceiling's (-z) by the plane's name when a file did not store it."""
+        if self.normal[0] == self.normal[0]:   # stored (not NaN)
+            return self.normal
+        return np.array([0.0, 0.0, -1.0 if self.plane == "ceiling" else 1.0])
+
+    @property
     def duration(self) -> float:
         """t_end - t_start (s)."""
         return self.t_end - self.t_start
@@ -116,10 +135,17 @@ class Contact:
         not start approaching the plane.  Without gravity it is the normal law's
         restitution e (``Scene.restitution``); under gravity it is not
         (``Result.gravity_affected_contacts``, docs/limits.md)."""
-        normal = 1.0 if self.plane == "floor" else -1.0
-        before = float(self.velocity_before[2]) * normal
-        after = float(self.velocity_after[2]) * normal
+        before = self.normal_velocity(self.velocity_before)
+        after = self.normal_velocity(self.velocity_after)
         return -after / before if before < 0 else math.nan
+
+    def normal_velocity(self, velocity) -> float:
+        """v . n (m/s): ``velocity``'s component along the plane's normal (towards the
+        ball)."""
+        n = self.unit_normal
+        if n[0] == 0 and n[1] == 0:   # horizontal: the z component, as it is
+            return float(velocity[2]) * float(n[2])
+        return float(np.asarray(velocity, dtype=float) @ n)
 
     def as_dict(self) -> dict:
         """The contact as one flat row (the contact table's columns, units in
@@ -129,6 +155,7 @@ class Contact:
                "max_penetration": self.max_penetration,
                "contact_point_x": float(self.contact_point[0]),
                "contact_point_y": float(self.contact_point[1]),
+               "contact_point_z": float(self.contact_point_z),
                "peak_normal_force": self.peak_normal_force,
                "energy_lost_normal": self.energy_lost_normal,
                "energy_lost_tangential": self.energy_lost_tangential,
@@ -153,7 +180,8 @@ for _name in _SUMMARY_FIELDS:
 CONTACT_UNITS = {
     "plane": "", "t_start": "s", "t_end": "s", "duration": "s", "rebound_ratio": "1",
     "max_penetration": "m",
-    "contact_point_x": "m", "contact_point_y": "m", "peak_normal_force": "N",
+    "contact_point_x": "m", "contact_point_y": "m", "contact_point_z": "m",
+    "peak_normal_force": "N",
     "energy_lost_normal": "J", "energy_lost_tangential": "J", "time_sticking": "s",
     "time_slipping": "s", "penetration_rate_at_impact": "m/s", "t_rest": "s",
     "t_rolling": "s", "t_sliding": "s",
@@ -264,7 +292,8 @@ class Result:
         file.  Built on first access."""
         found = self.__dict__.get("_segments")
         if found is None and self._segment_log is not None:
-            found = self.__dict__["_segments"] = segment_table(self._segment_log)
+            found = self.__dict__["_segments"] = segment_table(self._segment_log,
+                                                               self.scene.plane_names)
         return found
 
     @property
@@ -323,7 +352,8 @@ class Result:
     def energy(self) -> dict:
         """name -> (n,) array (J).
 
-        ``kinetic``, ``potential`` (gravity), ``spring`` (Hertz, 2/5 k0 rho^(5/2)),
+        ``kinetic``, ``potential`` (gravity), ``spring`` (Hertz, 2/5 k0 rho^(5/2), every
+        plane's),
         ``tangential_spring`` (the compliant law's, ``1/2 k_t |s|^2``; 0 for the others) and
         their sum ``total`` (the seed's total energy, plus the tangential spring's); ``dissipated_normal`` and
         ``dissipated_tangential``: work dissipated by the contact forces since t = 0
@@ -333,8 +363,11 @@ class Result:
         """
         if self._energy is None:
             e = _core.energies(np.ascontiguousarray(self.y.T), self.scene.parameter_vector())
-            spring = e[:, 2] + e[:, 3]
-            tangential_spring = e[:, 4] + e[:, 5]
+            planes = (e.shape[1] - 2) // 2
+            spring, tangential_spring = e[:, 2], e[:, 2 + planes]
+            for k in range(1, planes):
+                spring = spring + e[:, 2 + k]
+                tangential_spring = tangential_spring + e[:, 2 + planes + k]
             total = e[:, 0] + e[:, 1] + spring + tangential_spring
             normal = self.y[_STATE["dissipated_normal"]]
             tangential = self.y[_STATE["dissipated_tangential"]]
@@ -403,6 +436,12 @@ class Result:
         from .plot import plot_observer
         return plot_observer(self, **options)
 
+    def plot_side_view(self, **options):
+        """Side view (x, z): the planes where they are, the path, the contact points;
+        returns (figure, axes).  See ballc.plot."""
+        from .plot import plot_side_view
+        return plot_side_view(self, **options)
+
     def plot_contacts(self, **options):
         """Top view of the contact points coloured by time; returns (figure, axes)."""
         from .plot import plot_contacts_top_view
@@ -430,21 +469,24 @@ class Result:
         normal speed; or the ball did not leave -- it came to rest on the plane, or the
         run ended in a contact over which gravity's impulse already exceeds the impact
         speed (its weight holds it there).  Their ``rebound_ratio`` is not the scene's
-        restitution e, which is the law's e of an isolated impact without gravity."""
-        g = float(self.scene.gravity)
-        if g <= 0:
+        restitution e, which is the law's e of an isolated impact without gravity.  (g:
+        gravity's component along the plane's normal.)"""
+        gravity = self.scene.gravity_vector
+        if not np.any(gravity):
             return []
         found = []
         for i, contact in enumerate(self.contacts):
-            normal = 1.0 if contact.plane == "floor" else -1.0
+            g = abs(contact.normal_velocity(gravity))
+            if not g > 0:
+                continue
             if contact.t_rest == contact.t_rest:
                 found.append(i)
             elif contact.t_end == contact.t_end:
-                exit_speed = abs(float(contact.velocity_after[2]) * normal)
+                exit_speed = abs(contact.normal_velocity(contact.velocity_after))
                 if g * contact.duration > GRAVITY_IMPULSE_SHARE * exit_speed:
                     found.append(i)
             elif g * (float(self.t[-1]) - contact.t_start) > abs(
-                    float(contact.velocity_before[2]) * normal):
+                    contact.normal_velocity(contact.velocity_before)):
                 found.append(i)
         return found
 
@@ -484,16 +526,17 @@ class Result:
         1).  Lines under it name the contacts where gravity changed the rebound
         (``gravity_affected_contacts``), that came to rest, or were continued in closed
         form."""
-        head = (f"{'#':>2} {'plane':7} {'t_start':>8} {'t_end':>8} {'max pen.':>9} "
+        width = max([7] + [len(c.plane) for c in self.contacts])
+        head = (f"{'#':>2} {'plane':{width}} {'t_start':>8} {'t_end':>8} {'max pen.':>9} "
                 f"{'vx before':>10} {'vx after':>9} {'vy before':>10} {'vy after':>9} "
                 f"{'vz before':>10} {'vz after':>9} {'rebound':>8}")
-        units = (f"{'':>2} {'':7} {'[s]':>8} {'[s]':>8} {'[m]':>9} " +
+        units = (f"{'':>2} {'':{width}} {'[s]':>8} {'[s]':>8} {'[m]':>9} " +
                  " ".join(f"{'[m/s]':>{width}}" for width in (10, 9, 10, 9, 10, 9)) +
                  f" {'[1]':>8}")
         lines = [head, units, "-" * len(head)]
         for i, c in enumerate(self.contacts, 1):
             vb, va = c.velocity_before, c.velocity_after
-            lines.append(f"{i:2d} {c.plane:7} {c.t_start:8.4f} {c.t_end:8.4f} "
+            lines.append(f"{i:2d} {c.plane:{width}} {c.t_start:8.4f} {c.t_end:8.4f} "
                          f"{c.max_penetration:9.4f} {vb[0]:10.3f} {va[0]:9.3f} "
                          f"{vb[1]:10.3f} {va[1]:9.3f} {vb[2]:10.3f} {va[2]:9.3f} "
                          f"{c.rebound_ratio:8.4f}")
@@ -537,8 +580,8 @@ CONTACT_FIELDS = [f.name for f in fields(Contact) if f.init]
 
 
 #: The columns of ``Result.segments``: name -> (unit, meaning).  The modes are
-#: ballc.automaton.MODES, the event kinds its TRANSITIONS' events; a plane's column pair
-#: (shape (2,)) is (floor, ceiling).
+#: ballc.automaton.MODES, the event kinds its TRANSITIONS' events; a plane's columns
+#: (shape (planes,)) are the scene's planes in order (the seed's: floor, ceiling).
 SEGMENT_FIELDS = {
     "t_start": ("s", "when the segment started"),
     "t_end": ("s", "when it ended (a failed one: the last time it reached)"),
@@ -557,9 +600,9 @@ SEGMENT_FIELDS = {
             "steps end), failed (the integrator), or a scheduled rest check named by the "
             "last of its checks that ran, each running when the one before found "
             "nothing: rest check, uniform check, orbit check"),
-    "plane": ("", "the plane of that event or check (floor, ceiling), else ''"),
-    "before": ("", "each plane's mode during the segment (floor, ceiling)"),
-    "after": ("", "each plane's mode once its end was handled (floor, ceiling)"),
+    "plane": ("", "the plane of that event or check (its name), else ''"),
+    "before": ("", "each plane's mode during the segment (the scene's planes in order)"),
+    "after": ("", "each plane's mode once its end was handled (the scene's planes)"),
     "rearms": ("", "events re-armed inside the segment without ending it (a free slip's "
                "approach re-latched, the compliant capacity guard turned)"),
     "rearm_kind": ("", "the last of those: its event kind (approach, capacity), or ''"),
@@ -569,13 +612,16 @@ SEGMENT_FIELDS = {
 }
 
 
-def segment_table(raw: bytes) -> np.ndarray:
+def segment_table(raw: bytes, plane_names=layout.PLANES) -> np.ndarray:
     """The readable segment table (``Result.segments``) of the C loop's log ``raw``
     (records ballc._core.SEGMENT_RECORD, of codes), with names for its codes
-    (_core.PLANE_MODES, SEGMENT_ENDS, SEGMENT_METHODS; layout.PLANES); read-only."""
+    (_core.PLANE_MODES, SEGMENT_ENDS, SEGMENT_METHODS; the scene's ``plane_names``);
+    read-only."""
     log = np.frombuffer(raw, dtype=_core.SEGMENT_RECORD)
     modes = np.array(_core.PLANE_MODES + ("",))        # code -1: ''
-    planes = np.array(layout.PLANES + ("",))
+    planes = np.array(tuple(plane_names) + ("",))
+    count = len(plane_names)
+    width = max([7] + [len(name) for name in plane_names])
     methods = _core.SEGMENT_METHODS
     low = min(methods)
     method_names = np.array([methods.get(k, str(k)) for k in range(low, max(methods) + 1)])
@@ -584,8 +630,9 @@ def segment_table(raw: bytes) -> np.ndarray:
         ("t_start", "f8"), ("t_end", "f8"), ("method", "U6"), ("method_end", "U6"),
         ("switches", "i4"), ("nfev", "i8"), ("njev", "i8"), ("nlu", "i8"), ("nstep", "i8"),
         ("nreject", "i8"), ("end", "U13"),
-        ("plane", "U7"), ("before", "U14", (2,)), ("after", "U14", (2,)), ("rearms", "i4"),
-        ("rearm_kind", "U8"), ("rearm_plane", "U7"), ("rearm_before", "U14"),
+        ("plane", f"U{width}"), ("before", "U14", (count,)), ("after", "U14", (count,)),
+        ("rearms", "i4"), ("rearm_kind", "U8"), ("rearm_plane", f"U{width}"),
+        ("rearm_before", "U14"),
         ("rearm_after", "U14")])
     for name in ("t_start", "t_end", "switches", "nfev", "njev", "nlu", "nstep", "nreject",
                  "rearms"):
@@ -595,8 +642,8 @@ def segment_table(raw: bytes) -> np.ndarray:
     table["end"] = ends[log["end"]]
     user = log["end"] == _core.SEGMENT_ENDS.index("user")   # its plane is the event's index
     table["plane"] = planes[np.where(user, -1, log["plane"])]
-    table["before"] = modes[log["before"]]
-    table["after"] = modes[log["after"]]
+    table["before"] = modes[log["before"][:, :count]]
+    table["after"] = modes[log["after"][:, :count]]
     table["rearm_kind"] = ends[log["rearm_kind"]]
     table["rearm_plane"] = planes[log["rearm_plane"]]
     table["rearm_before"] = modes[log["rearm_before"]]

@@ -59,7 +59,8 @@ def _vector(name, value):
 def rigid_impact(velocity, angular_velocity, *, mass=1.0, radius=1.0, inertia=None,
                  restitution=1.0, friction_coefficient=0.0, tangential_restitution=0.0,
                  plane="floor") -> RigidImpact:
-    """Post-impact velocity and spin of a sphere hitting ``plane`` ("floor"/"ceiling").
+    """Post-impact velocity and spin of a sphere hitting ``plane`` ("floor"/"ceiling", or
+    any plane: a ballc.Plane or its normal towards the ball, 3 numbers).
 
     Parameters
     ----------
@@ -76,8 +77,9 @@ def rigid_impact(velocity, angular_velocity, *, mass=1.0, radius=1.0, inertia=No
     tangential_restitution : float
         e_t (1), in [-1, 1]: 0 = the contact point ends rolling when it sticks (pure
         Coulomb), 1 = its tangential velocity is reversed (a perfect superball).
-    plane : str
-        "floor" (normal +z) or "ceiling" (normal -z).
+    plane : str, ballc.Plane or 3 floats
+        "floor" (normal +z), "ceiling" (normal -z), a ballc.Plane, or the plane's normal
+        towards the ball (any length > 0).
 
     Returns
     -------
@@ -86,8 +88,7 @@ def rigid_impact(velocity, angular_velocity, *, mass=1.0, radius=1.0, inertia=No
     """
     v = _vector("velocity", velocity)
     w = _vector("angular_velocity", angular_velocity)
-    if plane not in ("floor", "ceiling"):
-        raise ValueError(f"plane = {plane!r} is not allowed: must be 'floor' or 'ceiling'")
+    n = _normal(plane)
     for name, value, low, high in (("mass", mass, 0, np.inf), ("radius", radius, 0, np.inf)):
         if not (np.isfinite(value) and value > low):
             raise ValueError(f"{name} = {value!r} is not allowed: must be finite and > 0")
@@ -103,7 +104,6 @@ def rigid_impact(velocity, angular_velocity, *, mass=1.0, radius=1.0, inertia=No
         raise ValueError(f"tangential_restitution = {tangential_restitution!r} is not "
                          "allowed: must be in [-1, 1]")
 
-    n = np.array([0.0, 0.0, 1.0 if plane == "floor" else -1.0])
     approach = -v @ n
     if approach <= 0:
         raise ValueError(f"velocity = {velocity!r}: the ball is not moving towards the {plane}")
@@ -122,6 +122,22 @@ def rigid_impact(velocity, angular_velocity, *, mass=1.0, radius=1.0, inertia=No
                        angular_velocity=w + np.cross(arm, p_t) / inertia,
                        normal_impulse=float(p_n), tangential_impulse=p_t,
                        sticking=bool(sticking))
+
+
+def _normal(plane) -> np.ndarray:
+    """The unit normal (towards the ball) of ``plane``: "floor", "ceiling", a Plane or a
+    normal vector."""
+    if isinstance(plane, str):
+        if plane not in ("floor", "ceiling"):
+            raise ValueError(f"plane = {plane!r} is not allowed: must be 'floor', 'ceiling', "
+                             "a ballc.Plane or a normal (3 numbers)")
+        return np.array([0.0, 0.0, 1.0 if plane == "floor" else -1.0])
+    normal = getattr(plane, "normal", plane)
+    n = _vector("plane's normal", normal)
+    size = float(np.linalg.norm(n))
+    if not size > 0:
+        raise ValueError(f"plane = {plane!r} is not allowed: its normal must not be zero")
+    return n / size
 
 
 def hunt_crossley_restitution(c_tau: float) -> float:

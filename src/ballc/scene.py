@@ -15,8 +15,10 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from . import _core
+from ._errors import SceneError
 from ._format import plain
 from .orientation import quaternion_from_angles_123
+from .planes import MAX_PLANES, Plane, PlaneError, check_room, names_of, seed_planes
 
 #: The values of ``Scene.tangential_model``.
 TANGENTIAL_MODELS = ("mixture", "friction", "dig-in", "compliant")
@@ -51,13 +53,10 @@ SEED_SYMBOLS = {
 }
 
 
-class SceneError(ValueError):
-    """A scene parameter has a value ballc cannot simulate."""
-
-
 @dataclass(frozen=True)
 class Scene:
-    """One ball between a floor (z = 0) and a ceiling (z = ceiling_height).
+    """One ball between planes: a floor (z = 0) and a ceiling (z = ceiling_height), or
+    one to six planes at any orientation (``planes``).
 
     All quantities in SI units.  ``Scene(**fields)`` validates; invalid values raise
     :class:`SceneError` naming the field, the value and what is allowed (an unknown
@@ -72,10 +71,22 @@ class Scene:
         Mass of the observer particle inside the ball (kg), >= 0.  Default 1e-4.
     radius : float
         Radius of the ball (m), > 0.  Default 1.0.
-    gravity : float
-        Gravitational acceleration, pointing along -z (m/s^2), >= 0.  Default 9.81.
-    ceiling_height : float
-        Height H of the ceiling above the floor (m), > 2 radius.  Default 10.0.
+    gravity : float or tuple of 3 float
+        Gravitational acceleration (m/s^2): a number g >= 0 points along -z, (0, 0, -g);
+        or the acceleration as a vector (3 finite numbers).  Default 9.81.
+    ceiling_height : float or None
+        Height H of the ceiling above the floor (m), > 2 radius: the shorthand for the
+        seed's two planes, the floor (0, 0, 0), normal (0, 0, 1), and the ceiling
+        (0, 0, H), normal (0, 0, -1), named "floor" and "ceiling".  Default 10.0; None
+        (and it must not be given) with ``planes``.
+    planes : tuple of ballc.Plane, optional
+        One to six planes, each a point and a normal pointing into the space where the
+        ball lives (:class:`ballc.Plane`; a mapping of point, normal and name is taken
+        too, as a TOML ``[[planes]]`` table gives it); none may face another closer than
+        2 radius, and together they must leave room for the ball.  The state vector has
+        15 states and two per plane, each plane's tangential deflection
+        ``<name>_deflection_x``, ``_y`` (:attr:`state_names`).  Default (None): the
+        ``ceiling_height`` shorthand.
     inertia : tuple of 3 float, optional
         Principal moments of inertia about the ball's x, y, z axes (kg m^2).
         Default (None): 2/5 mass radius^2 each, a solid sphere.
@@ -144,7 +155,9 @@ class Scene:
         Tangential / normal contact stiffness ratio kappa of the compliant model (1).
         Default (None): Mindlin's 4 G* / E*, from the Poisson ratios and the moduli.
     position : tuple of 3 float
-        Initial position of the centre (m), 0 < z < ceiling_height.  Default (0, 0, 5).
+        Initial position of the centre (m), on the ball's side of every plane, less than
+        one radius deep in it (0 < z < ceiling_height with the shorthand).  Default
+        (0, 0, 5).
     velocity : tuple of 3 float
         Initial velocity of the centre (m/s).  Default (-5, 5, -25).
     angles : tuple of 3 float
@@ -185,6 +198,9 @@ class Scene:
     friction_regularization            (none)          (none)       "exact" (or "max",
                                                                     "smooth")
     tangential_stiffness_ratio         (none)          1            Mindlin (compliant)
+    planes                             (none)          (none)       None: the floor and
+                                                                    ceiling_height's
+                                                                    ceiling
     position (centre)                  m1, m2, m3      m            (0, 0, 5)
     velocity (centre)                  um1, um2, um3   m/s          (-5, 5, -25)
     angles (body-fixed 123)            q1, q2, q3      rad          (0, 0, 0)
@@ -199,8 +215,8 @@ class Scene:
     mass: float = 1.0
     observer_mass: float = 1e-4
     radius: float = 1.0
-    gravity: float = 9.81
-    ceiling_height: float = 10.0
+    gravity: float | tuple = 9.81
+    ceiling_height: float | None = 10.0
     inertia: tuple | None = None
     observer_position: tuple = (0.7, 0.0, 0.7)
     ball_youngs_modulus: float = 3e3
@@ -222,18 +238,23 @@ class Scene:
     velocity: tuple = (-5.0, 5.0, -25.0)
     angles: tuple = (0.0, 0.0, 0.0)
     angular_velocity: tuple = (0.0, 0.0, 0.0)
+    planes: tuple | None = None
 
     def __new__(cls, *args, **kwargs):
         # Unknown keyword -> SceneError with a "did you mean" (the dataclass __init__
         # would raise a bare TypeError without a suggestion).
         _reject_unknown_fields(kwargs)
-        return super().__new__(cls)
+        scene = super().__new__(cls)
+        # ceiling_height given with planes is a contradiction; its default is not
+        object.__setattr__(scene, "_ceiling_given", kwargs.get("ceiling_height") is not None)
+        return scene
 
     #: The fields that are 3-vectors (a tuple of 3 floats each).
     VECTOR_FIELDS = ("inertia", "observer_position", "position", "velocity", "angles",
                      "angular_velocity")
 
     def __post_init__(self):
+        _resolve_planes(self)
         for name in self.VECTOR_FIELDS:
             value = getattr(self, name)
             if value is None or (type(value) is tuple and len(value) == 3 and all(
@@ -278,6 +299,9 @@ class Scene:
         values = {name: getattr(self, name) for name in _FIELD_NAMES}
         for name in getattr(self, "_derived", ()):
             values[name] = None     # computed from another field: not an input
+        # the seed's planes are the shorthand's (ceiling_height); given planes as tables
+        values["planes"] = None if self.ceiling_height is not None else [
+            plane.to_dict() for plane in self.planes]
         return values
 
     @classmethod
@@ -297,8 +321,13 @@ class Scene:
     def to_toml(self, path) -> None:
         """Write every field to a TOML file that ``Scene.from_toml`` reads back equal."""
         lines = ["# ballc scene: SI units, fields as in README.md 'Scene fields'"]
-        lines += [f"{name} = {_toml_value(value)}" for name, value in self.to_dict().items()
+        values = self.to_dict()
+        planes = values.pop("planes")
+        lines += [f"{name} = {_toml_value(value)}" for name, value in values.items()
                   if value is not None]
+        for plane in planes or ():   # [[planes]] tables: after every plain key
+            lines += ["", "[[planes]]"] + [f"{key} = {_toml_value(value)}"
+                                           for key, value in plane.items()]
         with open(path, "w", encoding="utf-8") as stream:
             stream.write("\n".join(lines) + "\n")
 
@@ -313,6 +342,10 @@ class Scene:
         """A copy with some fields changed (validated).  Giving one of c_tau,
         restitution and damping_ratio drops the others (a scene gives one)."""
         values = self.to_dict()
+        if changes.get("planes") is not None:   # planes replace the shorthand
+            values["ceiling_height"] = None
+        elif "ceiling_height" in changes:
+            values["planes"] = None
         if any(name in changes for name in _DAMPING_INPUTS) or "normal_damping" in changes:
             keep = "restitution" if "normal_damping" in changes else None
             for name in _DAMPING_INPUTS:
@@ -358,12 +391,48 @@ class Scene:
         return self._parameters.copy()
 
     @functools.cached_property
+    def plane_names(self) -> tuple:
+        """Each plane's name (its own, or ``plane<i>``), in the plane table's order."""
+        return names_of(self.planes)
+
+    @functools.cached_property
+    def state_names(self) -> tuple:
+        """The names of the state vector's rows: the ball's 15, then each plane's
+        ``<name>_deflection_x``, ``_y`` (the seed's: ``ballc.STATE_NAMES``)."""
+        return _core.state_names(self.plane_names)
+
+    @functools.cached_property
+    def parameter_names(self) -> tuple:
+        """The names of :meth:`parameter_vector`'s entries."""
+        return _core.parameter_names(self.plane_names)
+
+    @functools.cached_property
+    def latch_names(self) -> tuple:
+        """The names of the latched values (per plane, LATCH fields)."""
+        return _core.latch_names(self.plane_names)
+
+    @property
+    def gravity_vector(self) -> np.ndarray:
+        """The gravitational acceleration as a vector (m/s^2): (0, 0, -g) for a number."""
+        if isinstance(self.gravity, tuple):
+            return np.array(self.gravity)
+        return np.array([0.0, 0.0, -float(self.gravity)])
+
+    @property
+    def gravity_magnitude(self) -> float:
+        """The length of the gravity vector (m/s^2)."""
+        if isinstance(self.gravity, tuple):
+            return math.sqrt(sum(g * g for g in self.gravity))
+        return float(self.gravity)
+
+    @functools.cached_property
     def _parameters(self) -> np.ndarray:
         ix, iy, iz = self.inertia
         a, b, c = self.observer_position
+        gx, gy, gz = self.gravity_vector
         values = {
             "mass": self.mass, "observer_mass": self.observer_mass,
-            "gravity_x": 0.0, "gravity_y": 0.0, "gravity_z": -self.gravity,
+            "gravity_x": gx, "gravity_y": gy, "gravity_z": gz,
             "radius": self.radius,
             "observer_alpha": a, "observer_beta": b, "observer_gamma": c,
             "inertia_xx": ix, "inertia_yy": iy, "inertia_zz": iz,
@@ -380,22 +449,24 @@ class Scene:
             "normal_damping_model": float(self.normal_damping == "viscoelastic"),
             "damping_ratio": self.damping_ratio or 0.0,
             "tangential_damping_ratio": self.tangential_damping_ratio or 0.0,
-            # the plane table: a point and a normal (towards the ball) per plane
-            **_plane_entries("floor", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
-            **_plane_entries("ceiling", (0.0, 0.0, self.ceiling_height), (0.0, 0.0, -1.0)),
+            # the plane table: its count, then a point and a normal (towards the ball) per
+            # plane
+            "plane_count": len(self.planes),
+            **{name: value for plane, label in zip(self.planes, self.plane_names)
+               for name, value in _plane_entries(label, plane.point, plane.normal).items()},
         }
-        return np.array([float(values[name]) for name in _core.PARAMETER_NAMES])
+        return np.array([float(values[name]) for name in self.parameter_names])
 
     def initial_state(self) -> np.ndarray:
-        """State vector in the generated layout order (``ballc._core.STATE_NAMES``); a
-        fresh copy each call."""
+        """State vector in the generated layout order (:attr:`state_names`); a fresh copy
+        each call."""
         return self._initial.copy()
 
     @functools.cached_property
     def _initial(self) -> np.ndarray:
         """The initial state, built once (read-only: every run starts from it)."""
         at = _core.STATE_INDEX
-        state = np.zeros(_core.N_STATES)   # the dissipated work and deflections: zero
+        state = np.zeros(len(self.state_names))   # the dissipated work and deflections: zero
         state[at["qw"]:at["qw"] + 4] = _quaternion_of(*self.angles)
         for name, first in (("position", "x"), ("angular_velocity", "omega_x"),
                             ("velocity", "vx")):
@@ -411,8 +482,60 @@ _FIELD_SET = frozenset(_FIELD_NAMES)
 
 def _plane_entries(plane: str, point, normal) -> dict:
     """A plane's entries of the parameter vector (its point and normal)."""
-    names = ("point_x", "point_y", "point_z", "normal_x", "normal_y", "normal_z")
+    names = _core.PLANE_FIELD_NAMES
     return {f"{plane}_{name}": value for name, value in zip(names, (*point, *normal))}
+
+
+def _seed_form(planes) -> bool:
+    """Whether ``planes`` are the ceiling_height shorthand's, for some height (what
+    ``dataclasses.replace`` passes back with the ceiling_height it is given)."""
+    if not isinstance(planes, tuple) or len(planes) != 2 or not all(
+            isinstance(p, Plane) for p in planes):
+        return False
+    floor, ceiling = planes
+    return (floor == Plane((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), "floor")
+            and ceiling.name == "ceiling" and ceiling.normal == (0.0, 0.0, -1.0)
+            and ceiling.point[:2] == (0.0, 0.0))
+
+
+def _resolve_planes(s: Scene) -> None:
+    """The scene's planes: the ceiling_height shorthand's two, or the given ones (1 to
+    MAX_PLANES, each a Plane, names unique); SceneError naming the field otherwise.  The
+    shorthand's planes given back with a ceiling_height (``dataclasses.replace``) are the
+    shorthand of that height."""
+    if getattr(s, "_ceiling_given", False) and _seed_form(s.planes):
+        object.__setattr__(s, "planes", None)
+    if s.planes is None:
+        if s.ceiling_height is None:
+            raise SceneError("ceiling_height = None is not allowed without planes: give "
+                             "ceiling_height (the seed's floor and ceiling) or planes")
+        try:
+            object.__setattr__(s, "planes", seed_planes(float(s.ceiling_height)))
+        except (TypeError, ValueError, PlaneError):
+            _fail("ceiling_height", s.ceiling_height, "must be a real number")
+        return
+    if getattr(s, "_ceiling_given", False):
+        raise SceneError(f"ceiling_height = {plain(s.ceiling_height)} is given with planes: "
+                         "ceiling_height is the shorthand for the seed's floor and ceiling, "
+                         "give one or the other")
+    object.__setattr__(s, "ceiling_height", None)
+    given = s.planes
+    if isinstance(given, (Plane, dict, str, bytes)) or not hasattr(given, "__len__"):
+        raise SceneError(f"planes = {plain(given)} is not allowed: must be a sequence of "
+                         f"1 to {MAX_PLANES} ballc.Plane")
+    if not 1 <= len(given) <= MAX_PLANES:
+        raise SceneError(f"planes: {len(given)} given is not allowed: a scene has 1 to "
+                         f"{MAX_PLANES} planes")
+    try:
+        planes = tuple(Plane.of(plane, i) for i, plane in enumerate(given))
+    except PlaneError as error:
+        raise SceneError(str(error)) from None
+    names = names_of(planes)
+    for i, name in enumerate(names):
+        if name in names[:i]:
+            raise SceneError(f"planes[{i}]: name = {name!r} is not allowed: another plane has "
+                             "it (each plane's name names its states and contacts)")
+    object.__setattr__(s, "planes", planes)
 
 
 @functools.lru_cache(maxsize=256)
@@ -590,13 +713,16 @@ def check_speeds(scene, velocity, angular_velocity, names=("velocity", "angular_
 def _validate(s: Scene) -> None:
     fail, finite = _fail, _finite
 
-    for name in ("mass", "radius", "ceiling_height", "ball_youngs_modulus",
-                 "plane_youngs_modulus", "friction_regularization_speed"):
+    for name in ("mass", "radius", "ball_youngs_modulus", "plane_youngs_modulus",
+                 "friction_regularization_speed"):
         if not finite(name, getattr(s, name)) > 0:
             fail(name, getattr(s, name), "must be > 0")
-    for name in ("observer_mass", "gravity", "friction_coefficient"):
+    if s.ceiling_height is not None and not finite("ceiling_height", s.ceiling_height) > 0:
+        fail("ceiling_height", s.ceiling_height, "must be > 0")
+    for name in ("observer_mass", "friction_coefficient"):
         if not finite(name, getattr(s, name)) >= 0:
             fail(name, getattr(s, name), "must be >= 0")
+    _validate_gravity(s)
     for name in ("ball_poisson_ratio", "plane_poisson_ratio"):
         if not -1 < finite(name, getattr(s, name)) <= 0.5:
             fail(name, getattr(s, name), "must be in (-1, 0.5]")
@@ -616,7 +742,7 @@ def _validate(s: Scene) -> None:
         close = difflib.get_close_matches(str(s.tangential_model), TANGENTIAL_MODELS, n=1)
         hint = f"; did you mean {close[0]!r}?" if close else ""
         fail("tangential_model", s.tangential_model, f"must be one of {TANGENTIAL_MODELS}{hint}")
-    if not s.ceiling_height > 2 * s.radius:
+    if s.ceiling_height is not None and not s.ceiling_height > 2 * s.radius:
         fail("ceiling_height", s.ceiling_height, f"must be > 2 * radius = {2 * s.radius}")
     for name in Scene.VECTOR_FIELDS:
         vector = getattr(s, name)
@@ -632,9 +758,49 @@ def _validate(s: Scene) -> None:
     if sum(v * v for v in s.observer_position) >= 1:
         fail("observer_position", s.observer_position,
              "the observer must lie strictly inside the ball (alpha^2 + beta^2 + gamma^2 < 1)")
-    z = s.position[2]
-    if not 0 < z < s.ceiling_height:
-        fail("position", s.position, f"the centre must start between the planes, less than "
-             f"one radius deep in either: 0 < z < {s.ceiling_height}")
+    if s.ceiling_height is not None:
+        z = s.position[2]
+        if not 0 < z < s.ceiling_height:
+            fail("position", s.position, f"the centre must start between the planes, less "
+                 f"than one radius deep in either: 0 < z < {s.ceiling_height}")
+    else:
+        try:
+            check_room(s.planes, float(s.radius))
+        except PlaneError as error:
+            raise SceneError(f"planes: {error}") from None
+        check_inside(s, s.position)
     check_speeds(s, s.velocity, s.angular_velocity)
+
+
+def check_inside(s: Scene, position, name="position") -> None:
+    """SceneError unless the centre ``position`` is on the ball's side of every plane of
+    ``s``, less than one radius deep in it (n . (c - p) > 0)."""
+    for plane, label in zip(s.planes, s.plane_names):
+        height = plane.height(position)
+        if not height > 0:
+            _fail(name, tuple(float(v) for v in position),
+                  f"the centre must start on the ball's side of every plane, less than one "
+                  f"radius deep in it: its height above plane {label!r} is n . (c - p) = "
+                  f"{height:.6g} m, must be > 0 (a penetration below radius = {s.radius})")
+
+
+def _validate_gravity(s: Scene) -> None:
+    """gravity: a number >= 0 (along -z), or a vector of 3 finite numbers (stored as a
+    tuple of floats)."""
+    g = s.gravity
+    if isinstance(g, (list, tuple, np.ndarray)):
+        try:
+            if any(isinstance(v, (str, bytes, bool, np.bool_)) for v in g):
+                raise TypeError
+            vector = tuple(float(v) for v in g)
+        except (TypeError, ValueError):
+            _fail("gravity", g, "must be a number >= 0 (along -z) or 3 numbers (a vector)")
+        if len(vector) != 3 or not all(math.isfinite(v) for v in vector):
+            _fail("gravity", g, "must be a number >= 0 (along -z) or 3 finite numbers (a "
+                  "vector)")
+        object.__setattr__(s, "gravity", vector)
+        return
+    if not _finite("gravity", g) >= 0:
+        _fail("gravity", g, "must be >= 0 (a number points along -z; give a vector of 3 "
+              "numbers for any other direction)")
 

@@ -20,32 +20,37 @@ from .loop_result import result_of
 from .options import DEFAULT_MAX_NFEV, METHODS, check_options  # noqa: F401 (re-exported)
 from .progress import progress_bar
 from .result import Result
-from .scene import Scene, SceneError, check_speeds
+from .scene import Scene, SceneError, check_inside, check_speeds
 
 _STATE = layout.INDEX
 _QUATERNION = layout.QUATERNION
 
 
 def check_initial_state(scene, y0):
-    """The full initial state: the scene's, or ``y0`` (N_STATES values, the quaternion
-    normalised) checked to be finite with the centre between the planes."""
+    """The full initial state: the scene's, or ``y0`` (one value per state of the scene,
+    ``scene.state_names``; the quaternion normalised) checked to be finite with the centre
+    on the ball's side of every plane."""
     if y0 is None:
         return scene.initial_state()
+    names = scene.state_names
     try:
         y = np.array(y0, dtype=float)
     except (TypeError, ValueError):
-        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {_core.N_STATES} numbers "
-                         f"({', '.join(_core.STATE_NAMES)})") from None
-    if y.shape != (_core.N_STATES,) or not np.all(np.isfinite(y)):
-        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {_core.N_STATES} finite "
-                         f"numbers ({', '.join(_core.STATE_NAMES)})")
+        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {len(names)} numbers "
+                         f"({', '.join(names)})") from None
+    if y.shape != (len(names),) or not np.all(np.isfinite(y)):
+        raise SceneError(f"y0 = {plain(y0)} is not allowed: must be {len(names)} finite "
+                         f"numbers ({', '.join(names)})")
     size = np.linalg.norm(y[_QUATERNION])
     if not size > 0:
         raise SceneError("y0 is not allowed: its quaternion (qw, qx, qy, qz) is zero")
     y[_QUATERNION] /= size
-    if not 0 < y[_STATE["z"]] < scene.ceiling_height:
-        raise SceneError(f"y0 is not allowed: z = {plain(y[_STATE['z']])} must be between the "
-                         f"planes, 0 < z < {scene.ceiling_height}")
+    if scene.ceiling_height is not None:
+        if not 0 < y[_STATE["z"]] < scene.ceiling_height:
+            raise SceneError(f"y0 is not allowed: z = {plain(y[_STATE['z']])} must be between "
+                             f"the planes, 0 < z < {scene.ceiling_height}")
+    else:
+        check_inside(scene, y[layout.POSITION], "y0's position (x, y, z)")
     check_speeds(scene, y[_STATE["vx"]:_STATE["vz"] + 1],
                  y[_STATE["omega_x"]:_STATE["omega_z"] + 1],
                  ("y0's velocity (vx, vy, vz)",
@@ -104,14 +109,14 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         As solve_ivp's: g(t, y) with optional ``terminal`` (bool) and ``direction``
         attributes; their zeros are located on the dense output and returned in
         ``result.t_events`` / ``result.y_events`` (one array per event).  A terminal
-        event ends the run with status 1.  ``y`` is the full state (``STATE_NAMES``).
+        event ends the run with status 1.  ``y`` is the full state (``scene.state_names``).
     dense_output : bool
         Build ``result.sol``: the continuous solution sol(t) over the run, piecewise
         across contact and stick/slip events, from each integrator's own interpolant.
     y0 : array_like, optional
-        The full initial state (``STATE_NAMES``: quaternion, centre, angular velocity,
-        velocity, then the auxiliary states) instead of the scene's; the quaternion is
-        normalised.  A state in contact with a plane starts that contact (see
+        The full initial state (``scene.state_names``: quaternion, centre, angular
+        velocity, velocity, then the auxiliary states, two per plane) instead of the
+        scene's; the quaternion is normalised.  A state in contact with a plane starts that contact (see
         ballc.modes for what it latches).
     max_nfev : int or None
         Give up (status -1, message, results so far) after this many right-hand-side
@@ -132,7 +137,8 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         ``ballc.events.LinearEvent`` is integrated as before.  False: every segment is
         integrated by ``method``.
     rest : bool
-        True (default): a ball that has come to rest on the floor (the criterion of
+        True (default): a ball that has come to rest on the floor -- the plane whose
+        normal is opposite gravity (the criterion of
         ballc.resting: a contact lasting 20 small-oscillation periods, energy above
         the static Hertz equilibrium below that of an oscillation of 10 tolerances)
         is put in the rest state and the run finishes analytically: ``message`` says
@@ -143,7 +149,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
         observer (isotropic inertia) that rolls on with its wobble goes on as a
         relative periodic orbit, measured over a trial of 3.5 periods (ballc.orbit;
         ``t_rolling``, or ``t_sliding`` when it slides; the message says what it
-        neglects).  Checked only without
+        neglects); on an incline, a ball rolling straight down it without slip and
+        reaching no other plane by t_end goes on uniformly accelerated in closed form
+        (``t_rolling``).  Checked only without
         ``t_eval`` and user ``events``.  False: integrate to t_end whatever happens.
 
     Returns
@@ -161,12 +169,13 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                             max_nfev, events, dense_output, exact_flight)
     y = scene._initial if y0 is None else check_initial_state(scene, y0)
     constants = scene_constants(scene)
+    run_given = run_constants(scene, options, rest)
     bar = progress_bar(progress, options.t_end)   # advanced from C, throttled in wall time
     try:
-        run = _core.drive(constants, y, run_constants(scene, options, rest), bar)
+        run = _core.drive(constants, y, run_given, bar)
         if bar is not None:   # to where the run ended
             bar.update((options.t_end if run.status == 0 else run.t_run) - bar.n)
     finally:
         if bar is not None:
             bar.close()
-    return result_of(scene, options, run)
+    return result_of(scene, options, run, bool(run_given["checks_rest"]))

@@ -28,8 +28,10 @@ import sys
 import threading
 from pathlib import Path
 
+from . import planes as plane_sweep
 from ._format import plain
 from .outcome import CAME_BACK_AFTER_CONTACTS, summary
+from .planes import PlaneError
 from .scene import Scene, SceneError, read_toml, reject_unknown_keys
 
 #: Columns every row has besides the swept parameters (see ballc.outcome.summary).
@@ -88,12 +90,15 @@ def _values(value) -> list:
 
 def combinations(base_scene: Scene, parameters: dict) -> list:
     """[(changes, scene)] for every combination, validated before anything runs.  A
-    parameter given one value instead of a list (``{"mixture": 0.3}``) is that value."""
+    parameter given one value instead of a list (``{"mixture": 0.3}``) is that value.
+    Besides the scene's fields, ``planes.tilt`` and ``planes.<i>.tilt`` turn the base
+    scene's planes about the y axis (rad; ballc.planes)."""
     if not isinstance(base_scene, Scene):
         raise TypeError(f"base_scene must be a ballc.Scene, got {type(base_scene).__name__}")
     if not isinstance(parameters, dict):
         raise SceneError(f"parameters = {parameters!r} is not allowed: must be a dict of "
                          "scene field -> list of values")
+    parameters = _flat(parameters)
     names = list(parameters)
     grids = [_values(parameters[name]) for name in names]
     for name, grid in zip(names, grids):
@@ -103,8 +108,40 @@ def combinations(base_scene: Scene, parameters: dict) -> list:
     cases = []
     for values in itertools.product(*grids):
         changes = dict(zip(names, values))
-        cases.append((changes, base_scene.replace(**changes)))   # validates ("did you mean")
+        cases.append((changes, _scene_of(base_scene, changes)))   # validates
     return cases
+
+
+def _flat(parameters: dict) -> dict:
+    """The parameters with a nested ``planes`` table (a TOML sweep file's unquoted
+    ``planes.tilt`` and ``planes.0.tilt`` keys) as the dotted names."""
+    nested = parameters.get("planes")
+    if not isinstance(nested, dict):
+        return parameters
+    flat = {}
+    for name, value in parameters.items():
+        if name != "planes":
+            flat[name] = value
+            continue
+        for key, inner in nested.items():
+            if isinstance(inner, dict):
+                flat.update({f"planes.{key}.{k}": v for k, v in inner.items()})
+            else:
+                flat[f"planes.{key}"] = inner
+    return flat
+
+
+def _scene_of(base_scene: Scene, changes: dict) -> Scene:
+    """The base scene with ``changes``: its fields replaced ("did you mean" for an
+    unknown one), then its planes turned by the planes' sweep parameters."""
+    turns = {k: v for k, v in changes.items() if plane_sweep.is_sweep_key(k)}
+    scene = base_scene.replace(**{k: v for k, v in changes.items() if k not in turns})
+    if not turns:
+        return scene
+    try:
+        return scene.replace(planes=plane_sweep.swept(scene.planes, turns))
+    except PlaneError as error:
+        raise SceneError(str(error)) from None
 
 
 def _is_number(value) -> bool:
