@@ -15,7 +15,10 @@ status, the contact times (start, end) and the final mechanical state (centre, v
 angular velocity; the quaternion as the rotation it stands for), and
 
 * ``error``: the BEFORE run's own error, its distance to the reference;
-* ``moved``: the distance between the BEFORE and AFTER runs.
+* ``moved``: the distance between the BEFORE and AFTER runs;
+* ``after's error``: the AFTER run's distance to the same reference (printed, not scored:
+  by the triangle inequality moved <= error + after's error, so a case that fails has an
+  AFTER run farther from the reference than the BEFORE run in that quantity).
 
 A case passes when both runs end with the same status and the same number of contacts on the
 same planes, and ``moved <= 3 error + floor`` for every quantity (floor: 1e-12 of the
@@ -234,14 +237,16 @@ def compare(before: dict, after: dict, reference: dict | None) -> tuple[bool, li
     for key in QUANTITIES:
         moved = distance(before[key], after[key])
         if reference is None or "error" in reference or reference["planes"] != before["planes"]:
-            error = np.inf if reference is not None else 0.0
+            error = after_error = np.inf if reference is not None else 0.0
         else:
             error = distance(before[key], reference[key])
+            after_error = distance(after[key], reference[key])
         scale = float(np.nanmax(np.abs(np.asarray(before[key], dtype=float)), initial=1.0))
         floor = 1e-12 * max(scale, 1.0)
         passed = moved <= 3 * error + floor
         ok &= passed or before["planes"] != after["planes"]
-        lines.append(f"    {'ok ' if passed else 'BAD'} {key:17s} moved {moved:9.3g}  error {error:9.3g}")
+        lines.append(f"    {'ok ' if passed else 'BAD'} {key:17s} moved {moved:9.3g}  error {error:9.3g}"
+                     f"  (after's error {after_error:9.3g})")
     return ok, lines
 
 
