@@ -16,7 +16,7 @@ from .contact import TANGENTIAL_LAWS
 from .kernels import MASS_LAYOUT, build_kernels, contact_law_offsets, describe_contact_law_layout
 from .model import (CONTACT_STATE_NAMES, LATCH_FIELDS, LATCH_NAMES, MECHANICAL_STATE_NAMES,
                     PARAMETER_NAMES, PARAMETERS, PLANE_FIELDS, PLANE_INPUT_NAMES, PLANES,
-                    STATE_NAMES)
+                    ROLLING_MODE_CODES, ROLLING_STATE_NAMES, STATE_NAMES)
 
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
@@ -83,6 +83,11 @@ def render(verbose=False) -> dict[str, str]:
          *[f"#define BALLC_PARAMETER_{name.upper()} {i}"
            for i, name in enumerate(PARAMETER_NAMES)],
          *[f"#define BALLC_LATCH_{field[0].upper()} {i}" for i, field in enumerate(LATCH_FIELDS)],
+         "/* a plane's rolling and twisting modes, as its latch holds them */",
+         *[f"#define BALLC_ROLLING_MODE_{name.upper()} {code}"
+           for name, code in ROLLING_MODE_CODES],
+         "/* the rolling resistance's states, last: left out of the error norm without it */",
+         f"#define BALLC_N_ROLLING_STATES {len(ROLLING_STATE_NAMES)}",
          f"#define BALLC_N_MECHANICAL_STATES {len(MECHANICAL_STATE_NAMES)}",
          f"#define BALLC_CONTACT_LAW_NOUT {contact_law_nout}",
          "/* contact-law kernel outputs: " + describe_contact_law_layout() + " */",

@@ -44,7 +44,8 @@ from dataclasses import dataclass
 import sympy as sm
 import sympy.physics.mechanics as me
 
-from .model import LATCH_FIELDS, Model, require_frame_plane, contact_point
+from .model import (LATCH_FIELDS, ROLLING_SPRING_FIELDS, Model, contact_point,
+                    require_frame_plane)
 
 
 def plane_geometry(model: Model, plane: str):
@@ -748,3 +749,63 @@ def spring_energy(model: Model, plane: str):
     """Hertz elastic energy 2/5 k0 rho^(5/2) stored in the contact with ``plane``."""
     _, rho = plane_geometry(model, plane)
     return sm.Rational(2, 5) * hertz_stiffness(model) * _positive(rho)**sm.Rational(5, 2)
+
+
+# --- the rolling part: the law's fourth part (LAMMPS GRANULAR's rolling and twisting
+# sub-models; docs/contact_laws.md, "Rolling resistance") --------------------------------
+
+
+def rolling_velocities(model: Model, plane: str):
+    """The contact's rolling and twisting velocities in the plane's frame (m/s): the
+    rolling velocity v_roll = r (omega x n) (2: along t1, t2; LAMMPS' vrl with
+    R_eff = r, Wang et al. 2015, eq. 31) and the twisting velocity v_twist = r omega . n
+    (LAMMPS' magtwist times r).  A ball rolling without slip along u at speed v has
+    v_roll = v u: the velocity of its centre."""
+    normal, _ = plane_geometry(model, plane)
+    N = model.frame
+    omega = model.ball_frame.ang_vel_in(N)
+    r = model.p["radius"]
+    rolling = r * me.cross(omega, normal)
+    return [me.dot(rolling, N.x), me.dot(rolling, N.y), r * me.dot(omega, normal)]
+
+
+def rolling_torque(model: Model, plane: str, rolling_force, twisting_force):
+    """The torque on the ball (about its centre) of a rolling force F_r (2: along t1,
+    t2) and a twisting force F_w (1): r n x F_r + r F_w n (N m), LAMMPS' torroll =
+    R_eff (n x F_r) and tortwist along n.  Its power on the ball is
+    F_r . v_roll + F_w v_twist (rolling_velocities): a force against the rolling
+    velocity is passive."""
+    normal, _ = plane_geometry(model, plane)
+    N = model.frame
+    r = model.p["radius"]
+    force = rolling_force[0] * N.x + rolling_force[1] * N.y
+    return r * me.cross(normal, force) + r * twisting_force * normal
+
+
+def rolling_load(model: Model, plane: str):
+    """The normal force F_n (N) that caps the rolling and twisting torques: the
+    contact's normal x damping parts (damped_normal: Hertz with the scene's normal
+    damping, clamped at 0), as LAMMPS' rolling sub-model reads Fncrit from its normal
+    sub-model.  For the friction and compliant laws it is their normal force; the seed's
+    dig-in law, whose force is along the direction latched at impact, has no normal
+    force of its own, and its share of the mixture adds none to the cap."""
+    _, _, rho, rhodot = contact_kinematics(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_n, _ = damped_normal(model, rho, rhodot, rate_at_impact)
+    return f_n
+
+
+
+def rolling_spring_symbols(model: Model, plane: str):
+    """The plane's rolling spring's deflection (xi_x, xi_y along t1, t2, xi_w about n;
+    m): model.ROLLING_SPRING_FIELDS."""
+    return [model.state(f"{plane}_{name}") for name in ROLLING_SPRING_FIELDS]
+
+
+def rolling_spring_energy(model: Model, plane: str):
+    """The energy stored in the sds rolling and twisting springs (J):
+    1/2 k_r (xi_x^2 + xi_y^2) + 1/2 k_w xi_w^2 (0 for the exact model, whose spring
+    states stay 0)."""
+    xx, xy, xw = rolling_spring_symbols(model, plane)
+    return (model.p["rolling_stiffness"] * (xx**2 + xy**2)
+            + model.p["twisting_stiffness"] * xw**2) / 2

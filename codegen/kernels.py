@@ -250,6 +250,7 @@ def plane_kernels(model: Model, pieces: dict):
     law_kernels("friction_normal", "A plane's contact in its own frame, friction law with "
                 "mu = 0 (its normal share, weighted):")
     kernels += slip_kernels(model, plane, pieces["force_map"])
+    kernels += rolling_kernels(model, plane, inputs, extra_doc)
     margins = contact.compliant_margins(model, plane)
     accel = contact.penetration_acceleration(plane)
     restick = _affine_coefficient(margins[1], accel, "the re-stick margin")
@@ -271,6 +272,11 @@ def plane_kernels(model: Model, pieces: dict):
         local([contact.spring_energy(model, plane),
                contact.tangential_spring_energy(model, plane)], "plane_energy"),
         [], state=state))
+    kernels.append(Kernel(
+        "plane_rolling_energy", "A plane's contact: the energy of the rolling part's sds "
+        "springs, 1/2 k_r |xi_roll|^2 + 1/2 k_w xi_twist^2 (J).",
+        local([contact.rolling_spring_energy(model, plane)], "plane_rolling_energy"), [],
+        state=state))
     kernels.append(Kernel(
         "plane_kinematics", "A plane's contact: rho, rhodot, the contact point's velocity "
         "in the plane's frame (3).",
@@ -404,6 +410,56 @@ def slip_kernels(model: Model, plane: str, force_map: sm.Matrix):
                f"du/d(contact state) (2x{len(CONTACT_STATE_SYMBOLS)} row-major), "
                "generalized-force map of a tangential force at the contact point "
                "(6x2 row-major).", constant, [], state=CONTACT_STATE_SYMBOLS),
+    ]
+
+
+def rolling_kernels(model: Model, plane: str, inputs, extra_doc):
+    """What the rolling part (contact.rolling_velocities, rolling_torque, rolling_load)
+    needs on a plane, in its own frame: three kernels.
+
+    ``plane_rolling``: the rolling velocity (2, along t1, t2), the twisting velocity and
+    the normal force F_n that caps their torques; ``plane_rolling_jac`` its derivative
+    d/d(contact state) (4 x N_CONTACT_STATES), whose last row is dF_n/d(contact state)
+    (the exact rolling torque's Jacobian).  ``plane_rolling_map``: constants (the
+    velocities are linear in the contact state: checked) -- their derivative (3 x
+    N_CONTACT_STATES row-major) and the generalized-force map of a unit rolling force
+    along t1, t2 and a unit twisting force (6 x 3 row-major: the torque r n x F_r,
+    r F_w n in the plane's frame, no force), which the C core turns into a plane's maps
+    once per parameter vector, as the slip maps.  The exact rolling and twisting
+    torques and their holding constraint are applied through these maps
+    (src/ballc/_rolling.c), so where they act stays derived here.
+    """
+    N = model.frame
+    velocities = contact_state(model, contact.rolling_velocities(model, plane),
+                               "the rolling velocities")
+    load = contact_state(model, [contact.rolling_load(model, plane)], "the rolling load")
+    derivative = [v.diff(x) for v in velocities for x in CONTACT_STATE_SYMBOLS]
+    partials = me.partial_velocity([model.ball_frame.ang_vel_in(N)], model.speeds, N)[0]
+    units = [contact.rolling_torque(model, plane, [1, 0], 0),
+             contact.rolling_torque(model, plane, [0, 1], 0),
+             contact.rolling_torque(model, plane, [0, 0], 1)]
+    torque_map = contact_state(model, [me.dot(unit, partial) for partial in partials
+                                       for unit in units], "the rolling force map")
+    constant = derivative + torque_map
+    if any(sm.sympify(e).has(*CONTACT_STATE_SYMBOLS) for e in constant):
+        raise ValueError("the rolling velocities are not linear in the contact state, or "
+                         "their force map depends on it: plane_rolling_map would not be "
+                         "constant")
+    n = len(CONTACT_STATE_SYMBOLS)
+    outputs = velocities + load
+    return [
+        Kernel("plane_rolling", "A plane's contact in its own frame: the rolling velocity "
+               "r (omega x n) (2), the twisting velocity r omega . n and the normal force "
+               "F_n that caps their torques (contact.rolling_load).", outputs, inputs,
+               extra_doc, state=CONTACT_STATE_SYMBOLS),
+        jacobian_kernel(model, "plane_rolling_jac", "A plane's contact in its own frame: "
+                        f"d(plane_rolling)/d(contact state) ({len(outputs)}x{n} row-major).",
+                        outputs, inputs, extra_doc, state=CONTACT_STATE_SYMBOLS),
+        Kernel("plane_rolling_map", "A plane's contact in its own frame, constants: "
+               f"d(rolling and twisting velocities)/d(contact state) (3x{n} row-major), "
+               "generalized-force map of a unit rolling force along t1, t2 and a unit "
+               "twisting force (6x3 row-major).", constant, [],
+               state=CONTACT_STATE_SYMBOLS),
     ]
 
 

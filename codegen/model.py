@@ -43,14 +43,27 @@ MECHANICAL_STATE_NAMES = (
     "omega_x", "omega_y", "omega_z",
     "vx", "vy", "vz",
 )
+PLANES = ("floor", "ceiling")
+#: A plane's rolling spring (the rolling part's sds model, LAMMPS ``rolling sds`` and
+#: ``twisting sds``): the deflection of the rolling spring along the plane's t1, t2 and
+#: of the twisting spring about its normal, as displacements of the contact (m).
+ROLLING_SPRING_FIELDS = ("rolling_x", "rolling_y", "twisting")
+#: The states of rolling resistance, last in the state: the work dissipated by the
+#: rolling and twisting torques (J), then each plane's rolling spring.  They are
+#: constant (0) in a scene without rolling resistance, whose runs leave them out of
+#: the integrators' error norms (ballc_drive_config.norm_states): its results are
+#: those of the layout without them, bit for bit.
+ROLLING_STATE_NAMES = ("dissipated_rolling",) + tuple(
+    f"{plane}_{name}" for plane in PLANES for name in ROLLING_SPRING_FIELDS)
 #: States that ride along with the mechanics: dissipated work (J), integrated so that
-#: kinetic + potential + spring + dissipated is conserved, and the elastic tangential
-#: deflection (m) of the compliant contact model on each plane.
+#: kinetic + potential + spring + dissipated is conserved, the elastic tangential
+#: deflection (m) of the compliant contact model on each plane, and the rolling
+#: resistance's (ROLLING_STATE_NAMES).
 AUXILIARY_STATE_NAMES = (
     "dissipated_normal", "dissipated_tangential",
     "floor_deflection_x", "floor_deflection_y",
     "ceiling_deflection_x", "ceiling_deflection_y",
-)
+) + ROLLING_STATE_NAMES
 STATE_NAMES = MECHANICAL_STATE_NAMES + AUXILIARY_STATE_NAMES
 
 #: (name, seed symbol, unit, description)
@@ -86,8 +99,16 @@ PARAMETERS = (
      "compliant model, viscoelastic normal damping: c_n = 2 gamma sqrt(m* k_n)"),
     ("tangential_damping_ratio", "-", "1",
      "compliant model's tangential damping: c_t = 2 gamma_t sqrt(m* k_t)"),
+    ("rolling_resistance", "-", "1",
+     "rolling resistance mu_r: the rolling torque is at most mu_r r F_n (0: none)"),
+    ("rolling_stiffness", "-", "N/m",
+     "sds rolling spring k_r: rolling force -k_r xi, torque r n x F"),
+    ("rolling_damping", "-", "N s/m", "sds rolling dashpot gamma_r: force -gamma_r v_roll"),
+    ("twisting_resistance", "-", "1",
+     "twisting resistance mu_t: the torque about the normal is at most mu_t r F_n"),
+    ("twisting_stiffness", "-", "N/m", "sds twisting spring k_t: force -k_t xi_t, torque r F n"),
+    ("twisting_damping", "-", "N s/m", "sds twisting dashpot: force -gamma_t v_twist"),
 )
-PLANES = ("floor", "ceiling")
 #: Each plane's table entry, part of the parameters: a point of the plane and its normal,
 #: towards the ball (any length > 0: the C core normalises it and builds the plane's
 #: frame, src/ballc/_plane.c).  The seed's floor: (0, 0, 0), (0, 0, 1); its ceiling:
@@ -118,7 +139,7 @@ CONTACT_STATE = (
     ("vx", "vx"), ("vy", "vy"), ("vz", "vz"),
     (f"{FRAME_PLANE}_deflection_x", "deflection_x"),
     (f"{FRAME_PLANE}_deflection_y", "deflection_y"),
-)
+) + tuple((f"{FRAME_PLANE}_{name}", name) for name in ROLLING_SPRING_FIELDS)
 CONTACT_STATE_NAMES = tuple(local for _, local in CONTACT_STATE)
 
 #: Values latched at the start of a contact, per plane, in this order.
@@ -133,7 +154,19 @@ LATCH_FIELDS = (
      "the segment start, along the plane's first tangent t1 (its frame, as the slip)"),
     ("slip_direction_y", "-", "1",
      "exact Coulomb friction: unit slip direction latched at the segment start, along t2"),
+    ("rolling_mode", "-", "1", "the rolling part's mode (ROLLING_MODE_CODES; 0: none)"),
+    ("rolling_direction_x", "-", "1", "exact rolling resistance: unit rolling-velocity "
+     "direction latched at the segment start, along t1 (the plane's frame)"),
+    ("rolling_direction_y", "-", "1", "exact rolling resistance: ... along t2"),
+    ("twisting_mode", "-", "1", "the twisting part's mode (ROLLING_MODE_CODES; 0: none)"),
+    ("twisting_direction", "-", "1",
+     "exact twisting resistance: the sign of the twisting velocity latched (+1 or -1)"),
 )
+#: The codes of a plane's rolling and twisting modes in its latch (rolling_mode,
+#: twisting_mode): exact (type A with holding) free, direction held, holding; sds
+#: spring (below the cap), slider (at the cap).
+ROLLING_MODE_CODES = (("none", 0), ("free", 1), ("fixed", 2), ("holding", 3), ("spring", 4),
+                      ("slider", 5))
 LATCH_NAMES = tuple(f"{plane}_{f[0]}" for plane in PLANES for f in LATCH_FIELDS)
 #: A plane kernel's ``extra`` argument: the plane's latched values (LATCH_FIELDS, the
 #: dig-in direction turned into the plane's frame), then gravity's component into the

@@ -22,7 +22,7 @@ cdef extern from "ballc_kernels.h":
     const char *const BALLC_PARAMETER_UNITS[]
     const char *const BALLC_LATCH_NAMES[]
     const char *BALLC_GENERATOR_VERSION
-    int BALLC_OBSERVER_POSITION_NOUT, BALLC_N_PLANES
+    int BALLC_OBSERVER_POSITION_NOUT, BALLC_N_PLANES, BALLC_N_ROLLING_STATES
     void ballc_observer_position(const double *, const double *, const double *, const double *,
         double *) nogil
     void ballc_hertz_stiffness(const double *, const double *, const double *, const double *,
@@ -65,8 +65,15 @@ cdef extern from "_system.h":
                                 double *) nogil
     int ballc_compliant_margins_prepared(const double *, const ballc_parameters_t *,
                                          const double *, int, int, double *) nogil
+    int BALLC_ROLLING_STATE_NOUT
+    int ballc_rolling_state(const double *, const ballc_parameters_t *, const double *, int,
+                            int, double *) nogil
+    int ballc_remove_velocities(const double *, const ballc_parameters_t *, const double *,
+                                int, int, int, double *) nogil
 
 N_STATES = BALLC_N_STATES
+#: the rolling resistance's states, last in the state (codegen model.ROLLING_STATE_NAMES)
+N_ROLLING_STATES = BALLC_N_ROLLING_STATES
 N_PARAMETERS = BALLC_N_PARAMETERS
 N_LATCH = BALLC_N_LATCH
 N_LATCH_PER_PLANE = BALLC_N_LATCH_PER_PLANE
@@ -391,6 +398,45 @@ def remove_slip(const double[::1] y, const double[::1] params, int flags, int pl
     cdef int status = ballc_remove_slip(&y[0], &params[0], flags, plane, &o[0])
     if status != BALLC_OK:
         raise FloatingPointError(f"remove_slip failed with C status {status}")
+    return out
+
+
+def rolling_state(const double[::1] y, const double[::1] params, const double[::1] latch,
+                  int flags, int plane):
+    """Rolling resistance on ``plane`` (src/ballc/_rolling.h) under ``flags`` and the
+    modes in ``latch``: (lambda (3: the rolling force along t1, t2 and the twisting force
+    that hold the held parts, N), F_n (N), the rolling margin mu_r F_n - |lambda_r| (N),
+    the twisting margin mu_t F_n - |lambda_w| (N), the rolling velocity (2, m/s), the
+    twisting velocity (m/s)); raises if it cannot be evaluated (the plane must be in
+    contact under ``flags``)."""
+    _check_plane_call(y, params, latch, plane)
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
+    out = np.empty(BALLC_ROLLING_STATE_NOUT)
+    cdef double[::1] o = out
+    cdef int status = ballc_rolling_state(&y[0], &prepared, &latch[0], flags, plane, &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"rolling state failed with C status {status}")
+    return out
+
+
+#: ballc_remove_velocities' mask bits (_rolling.h BALLC_HOLD_*)
+HOLD_SLIP, HOLD_ROLLING, HOLD_TWISTING = 1, 2, 4
+
+
+def remove_velocities(const double[::1] y, const double[::1] params, const double[::1] latch,
+                      int flags, int plane, int mask):
+    """The state with ``plane``'s velocities in ``mask`` (HOLD_SLIP, HOLD_ROLLING,
+    HOLD_TWISTING) set to zero by one impulse of the constraint forces that hold them."""
+    _check_plane_call(y, params, latch, plane)
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
+    out = np.empty(BALLC_N_STATES)
+    cdef double[::1] o = out
+    cdef int status = ballc_remove_velocities(&y[0], &prepared, &latch[0], flags, plane, mask,
+                                              &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"remove_velocities failed with C status {status}")
     return out
 
 

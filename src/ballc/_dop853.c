@@ -76,7 +76,7 @@ int dop853_attempt(dop853_fun fun, void *ctx, int n, double t, double h, const d
     return fun(ctx, t + h, y_new, K + DOP853_STAGES * n);
 }
 
-double dop853_error_norm(int n, const double *K, double h, const double *scale,
+double dop853_error_norm(int n, int count, const double *K, double h, const double *scale,
                          double *e5, double *e3)
 {
     combine(n, E5, DOP853_STAGES + 1, K, e5);
@@ -88,7 +88,7 @@ double dop853_error_norm(int n, const double *K, double h, const double *scale,
         e3_2 += b * b;
     }
     if (e5_2 == 0 && e3_2 == 0) return 0;
-    return fabs(h) * e5_2 / sqrt((e5_2 + 0.01 * e3_2) * n);
+    return fabs(h) * e5_2 / sqrt((e5_2 + 0.01 * e3_2) * count);
 }
 
 int dop853_dense(dop853_fun fun, void *ctx, int n, double t_old, double h,
@@ -178,7 +178,7 @@ int dop853_step(solver_t *s)
         }
         for (int c = 0; c < n; c++)
             s->scale[c] = s->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * s->rtol;
-        double error_norm = dop853_error_norm(n, K, h, s->scale, s->err, s->ZE);
+        double error_norm = dop853_error_norm(n, s->n_norm, K, h, s->scale, s->err, s->ZE);
         if (error_norm < 1) {
             double factor = error_norm == 0 ? MAX_FACTOR
                             : fmin(MAX_FACTOR, 0.9 * pow(error_norm, exponent));

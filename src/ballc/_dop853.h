@@ -23,10 +23,10 @@ typedef int (*dop853_fun)(void *ctx, double t, const double *y, double *f);
 int dop853_attempt(dop853_fun fun, void *ctx, int n, double t, double h, const double *y,
                    double *K, double *y_new, double *ytmp);
 
-/* scipy's DOP853._estimate_error_norm: |h| |e5|^2 / sqrt((|e5|^2 + 0.01 |e3|^2) n), where
- * e5 = K^T E5 / scale and e3 = K^T E3 / scale over rows 0..12 of K; e5, e3 (n) are
- * scratch (they get K^T E5 and K^T E3). */
-double dop853_error_norm(int n, const double *K, double h, const double *scale,
+/* scipy's DOP853._estimate_error_norm: |h| |e5|^2 / sqrt((|e5|^2 + 0.01 |e3|^2) count),
+ * where e5 = K^T E5 / scale and e3 = K^T E3 / scale over rows 0..12 of K (count = n in
+ * scipy; radau5_problem.norm_states); e5, e3 (n) are scratch (they get K^T E5 and K^T E3). */
+double dop853_error_norm(int n, int count, const double *K, double h, const double *scale,
                          double *e5, double *e3);
 
 /* The accepted step (t_old, y_old) -> (t_old + h, y)'s dense output: the 3 extra stages

@@ -11,11 +11,12 @@
 #include "_driver.h"
 #include "_integrator.h"
 #include "_system.h"
+#include "_rolling.h"
 
 #define N BALLC_N_STATES
 #define NL BALLC_N_LATCH
 #define NLP BALLC_N_LATCH_PER_PLANE
-#define DRIVER_EVENTS 12  /* the driver's own events of a segment, at most */
+#define DRIVER_EVENTS 18  /* the driver's own events of a segment, at most */
 #define SLIP_D 4          /* floor_slip_direction_x within a plane's latch block */
 #define KIN_PER_PLANE (BALLC_CONTACT_KINEMATICS_NOUT / 2)
 
@@ -222,6 +223,7 @@ typedef struct {
     int interrupted;
     long seg_interpolant;
     ballc_segment_rec seg;      /* the segment under way's log record */
+    ballc_rolling_run rolling_run[2];   /* rolling resistance's exact modes, per plane */
 } run_t;
 
 enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
@@ -229,7 +231,9 @@ enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
 #define CAPACITY_SECOND (2 + 2 * 5)
 
 enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE,
-       K_ARM, K_YIELD, K_RESTICK, K_CAPACITY, K_USER };   /* from K_APPROACH on: CARRY_STEP */
+       K_ARM, K_YIELD, K_RESTICK, K_CAPACITY,
+       K_ROLL_FIRST,   /* rolling resistance's events (_rolling.h BALLC_ROLLING_*) */
+       K_USER = K_ROLL_FIRST + BALLC_ROLLING_EVENTS };   /* from K_APPROACH on: CARRY_STEP */
 
 /* ---- the segment log (_driver.h: ballc_segment_rec) ---- */
 
@@ -237,6 +241,7 @@ enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RE
 typedef char k_codes_are_segment_ends[((int)K_ENTER == (int)BALLC_SEG_ENTER
                                        && (int)K_DEEPEST == (int)BALLC_SEG_DEEPEST
                                        && (int)K_CAPACITY == (int)BALLC_SEG_CAPACITY
+                                       && (int)K_ROLL_FIRST == (int)BALLC_SEG_ROLL_APPROACH
                                        && (int)K_USER == (int)BALLC_SEG_USER) ? 1 : -1];
 
 typedef char integrator_prof_fits[RADAU5_PROF_N == 7 ? 1 : -1];
@@ -247,7 +252,9 @@ const char *const ballc_plane_mode_names[BALLC_N_PLANE_MODES] = {
 
 const char *const ballc_segment_end_names[BALLC_N_SEGMENT_ENDS] = {
     "enter", "leave", "through", "deepest", "approach", "stop", "clear", "release", "arm",
-    "yield", "restick", "capacity", "user", "t_end", "rest check", "uniform check",
+    "yield", "restick", "capacity", "roll_approach", "roll_stop", "roll_clear",
+    "roll_release", "twist_stop", "twist_release", "user", "t_end", "rest check",
+    "uniform check",
     "orbit check", "step bound", "failed"};
 
 /* _Run.mode: plane p's mode now (BALLC_PLANE_*) */
@@ -279,7 +286,11 @@ static void log_open(run_t *r)
     g->t_start = r->t;
     g->plane = -1;
     g->rearm_kind = g->rearm_plane = g->rearm_before = g->rearm_after = -1;
-    for (int p = 0; p < 2; p++) g->before[p] = (signed char)plane_mode(r, p);
+    for (int p = 0; p < 2; p++) {
+        g->before[p] = (signed char)plane_mode(r, p);
+        g->rolling_before[p] = (signed char)ballc_rolling_mode(r->latch + p * NLP, 0);
+        g->twisting_before[p] = (signed char)ballc_rolling_mode(r->latch + p * NLP, 1);
+    }
 }
 
 /* An event of plane p re-armed inside the segment, leaving it in mode ``before``. */
@@ -304,7 +315,11 @@ static int log_close(run_t *r, int end, int plane, double t_end)
     g->end = end;
     g->plane = plane;
     g->t_end = t_end;
-    for (int p = 0; p < 2; p++) g->after[p] = (signed char)plane_mode(r, p);
+    for (int p = 0; p < 2; p++) {
+        g->after[p] = (signed char)plane_mode(r, p);
+        g->rolling_after[p] = (signed char)ballc_rolling_mode(r->latch + p * NLP, 0);
+        g->twisting_after[p] = (signed char)ballc_rolling_mode(r->latch + p * NLP, 1);
+    }
     o->log[o->n_log++] = *g;
     return 0;
 }
@@ -427,12 +442,23 @@ static double force_scale(const run_t *r, double load)
     return (64 * DBL_EPSILON) * (r->c->weight + fabs(load));
 }
 
+/* The slip of plane p removed by an impulse (stickslip.remove_slip): with the rolling
+ * part's held velocities held too, when it holds any (_rolling.h). */
+static int remove_slip(run_t *r, int p, int flags, double *y_out)
+{
+    int held = ballc_rolling_held_mask(r->latch, p, 0);
+    if (held)
+        return ballc_remove_velocities(r->y, &r->prepared, r->latch, flags, p,
+                                       held | BALLC_HOLD_SLIP, y_out);
+    return ballc_remove_slip(r->y, r->c->params, flags, p, y_out);
+}
+
 /* _Run.settle -> stickslip.settle */
 static int settle(run_t *r, int p)
 {
     int base = run_flags(r, 0);
     double y0[N], out[4];
-    if (ballc_remove_slip(r->y, r->c->params, base, p, y0) != BALLC_OK) {
+    if (remove_slip(r, p, base, y0) != BALLC_OK) {
         r->failed_kernel = 1;
         return -1;
     }
@@ -597,6 +623,9 @@ static double step_bound_end(const run_t *r)
     return end;
 }
 
+static int start_rolling(run_t *r, int p);
+static int recheck_modes(run_t *r, int p);
+
 /* _Run.begin_contact (with modes.latch_values) */
 static int begin_contact(run_t *r, int p)
 {
@@ -651,14 +680,18 @@ static int begin_contact(run_t *r, int p)
     r->relatches[p] = r->transitions[p] = 0;
     r->rest_check[p] = p == c->resting_plane ? r->t + c->rest_period : INFINITY;
     if (c->exact && start_coulomb(r, p)) return -1;
-    if (c->compliant_modes) return start_compliant(r, p, rate);
-    return 0;
+    if (c->compliant_modes && start_compliant(r, p, rate)) return -1;
+    return start_rolling(r, p);
 }
 
 /* _Run.end_contact */
 static void end_contact(run_t *r, int p)
 {
     ballc_drive_output *o = r->o;
+    double *l = r->latch + p * NLP;   /* the rolling part rests with the contact */
+    l[BALLC_LATCH_ROLLING_MODE] = l[BALLC_LATCH_TWISTING_MODE] = BALLC_ROLLING_MODE_NONE;
+    l[BALLC_LATCH_ROLLING_DIRECTION_X] = l[BALLC_LATCH_ROLLING_DIRECTION_Y] = 0.0;
+    l[BALLC_LATCH_TWISTING_DIRECTION] = 0.0;
     r->rest_check[p] = INFINITY;
     r->in_contact[p] = 0;
     r->coulomb[p] = BALLC_MODE_NONE;
@@ -740,7 +773,7 @@ static int coulomb_event(run_t *r, int kind, int p)
             dir[1] = -out[1] / size;
             d = dir;
         }
-        if (ballc_remove_slip(r->y, r->c->params, run_flags(r, 0), p, y1) != BALLC_OK) {
+        if (remove_slip(r, p, run_flags(r, 0), y1) != BALLC_OK) {
             r->failed_kernel = 1;
             return -1;
         }
@@ -748,6 +781,86 @@ static int coulomb_event(run_t *r, int kind, int p)
         return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
     }
     }
+}
+
+/* ---- rolling resistance's exact modes (_rolling.h) ---- */
+
+/* The scales of the rolling part's guards and resets at y (_rolling.h). */
+static ballc_rolling_scales rolling_scales(const run_t *r, const double *y)
+{
+    double error = error_speed(r, y);
+    ballc_rolling_scales s = {error, CLEAR_FACTOR * error, 4 * ballc_py_ulp(speed_scale(r, y)),
+                              r->c->weight};
+    return s;
+}
+
+/* A contact starts: the exact rolling and twisting parts' first modes. */
+static int start_rolling(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    if (c->rolling != 1 && c->twisting != 1) return 0;
+    ballc_rolling_scales scales = rolling_scales(r, r->y);
+    if (ballc_rolling_start(&r->prepared, p, c->rolling == 1, c->twisting == 1, r->y,
+                            r->latch, run_flags(r, 1), r->coulomb[p] == BALLC_MODE_STICK,
+                            &r->rolling_run[p], &scales)) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    return recheck_modes(r, p);
+}
+
+/* After a reset of plane p that moved the state (an impulse: a settle, a release), the
+ * exact modes that slide must still be on their guards' side (_rolling.h,
+ * ballc_rolling_recheck): a Coulomb slip with u . d above its approach speed (free) or
+ * above -margin (fixed), and so the rolling and twisting parts; one that is not starts
+ * afresh, which may move the state again (a few passes).  Only with rolling
+ * resistance: without it, Coulomb's resets keep their own invariants. */
+static int recheck_modes(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    if (c->rolling != 1 && c->twisting != 1) return 0;
+    for (int pass = 0; pass < 8; pass++) {
+        int restarted = 0;
+        int mode = r->coulomb[p];
+        if (c->exact && (mode == BALLC_MODE_SLIP || mode == BALLC_MODE_SLIP_FIXED)) {
+            double u[2], speed, error, clear;
+            slip(r, p, r->y, u, &speed, &error, &clear);
+            const double *d = r->latch + p * NLP + SLIP_D;
+            double along = u[0] * d[0] + u[1] * d[1];
+            double guard = mode == BALLC_MODE_SLIP
+                           ? (r->has_approach[p] ? r->approach[p] : clear)
+                           : -4 * ballc_py_ulp(speed_scale(r, r->y));
+            if (!(along > guard)) {
+                if (start_coulomb(r, p)) return -1;
+                restarted++;
+            }
+        }
+        ballc_rolling_scales scales = rolling_scales(r, r->y);
+        int n = ballc_rolling_recheck(&r->prepared, p, r->y, r->latch, run_flags(r, 1),
+                                      r->coulomb[p] == BALLC_MODE_STICK,
+                                      &r->rolling_run[p], &scales);
+        if (n < 0) {
+            r->failed_kernel = 1;
+            return -1;
+        }
+        if (!restarted && !n) return 0;
+    }
+    return 0;
+}
+
+/* An event of the rolling part: its reset (_rolling.c), counted as a mode change. */
+static int rolling_event(run_t *r, int kind, int p)
+{
+    if (!settles(r, p)) return 0;
+    ballc_rolling_scales scales = rolling_scales(r, r->y);
+    r->transitions[p] += 1;
+    if (ballc_rolling_transition(&r->prepared, p, kind - K_ROLL_FIRST, r->y, r->latch,
+                                 run_flags(r, 1), r->coulomb[p] == BALLC_MODE_STICK,
+                                 &r->rolling_run[p], &scales)) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    return recheck_modes(r, p);
 }
 
 /* _Run.compliant_event */
@@ -811,6 +924,10 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     double out[6];
     (void)t;
     int code = r->ev_plane_code[e];
+    if (r->ev_kind[e] >= K_ROLL_FIRST && r->ev_kind[e] < K_USER)   /* rolling's release */
+        return ballc_rolling_guard_value(&r->prepared, r->ev_plane[e],
+                                         r->ev_kind[e] - K_ROLL_FIRST, y, r->latch,
+                                         r->seg_flags, g);
     if (code <= -2) {   /* the user's callable (the bridge's _user_event) */
         int st = r->c->user_fun(r->c->user_ctx, -2 - code, t, y, g);
         if (st) r->user_failed = 1;
@@ -976,6 +1093,22 @@ static int segment_events(run_t *r, int flags)
             int k = add_event(r, K_RELEASE, p, NULL, -1, 0, force_scale(r, out[2]), 1, -1);
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = p;
+        }
+        if (r->in_contact[p] && ballc_rolling_on(r->latch + p * NLP)) {   /* _rolling.h */
+            ballc_rolling_guard guards[4];
+            ballc_rolling_scales scales = rolling_scales(r, y0);
+            int n = ballc_rolling_guards(&r->prepared, p, y0, r->latch, flags,
+                                         &r->rolling_run[p], &scales, guards);
+            if (n < 0) {
+                r->failed_kernel = 1;
+                return -1;
+            }
+            for (int i = 0; i < n; i++) {
+                const ballc_rolling_guard *g = &guards[i];
+                int k = add_event(r, K_ROLL_FIRST + g->event, p, g->linear ? g->row : NULL,
+                                  -1, 0, g->offset, 1, g->direction);
+                r->ev_nonlinear[k] = !g->linear;
+            }
         }
         if (r->compliant[p] != COMPLIANT_NONE) {   /* compliantmodes.guard */
             if (!r->armed[p]) {   /* the penetration rising through the arming depth */
@@ -1291,6 +1424,10 @@ static void booked(const run_t *r, const double *y, double *new_y)
     energy_of(r, new_y, b);
     double before = a[0] + a[1] + a[2] + a[3] + a[4] + a[5];
     double after = b[0] + b[1] + b[2] + b[3] + b[4] + b[5];
+    for (int i = 6; i < BALLC_ENERGY_NOUT; i++) {   /* the rolling springs' (0 without) */
+        before += a[i];
+        after += b[i];
+    }
     new_y[BALLC_STATE_DISSIPATED_NORMAL] += before - after;
 }
 
@@ -1306,7 +1443,12 @@ static int at_rest(const run_t *r, const double *y, double t_start, double t)
     const ballc_drive_config *c = r->c;
     if (t - t_start < c->rest_period) return 0;
     double across = 0.0, up = 0.0;
-    if (c->observer_massive) {   /* resting._observer_offset */
+    /* a ball whose rolling is held rests wherever its observer is: it cannot roll the
+     * observer lower (the holding torque is within its cap, or it would have let go) */
+    int held = c->resting_plane >= 0
+               && ballc_rolling_mode(r->latch + c->resting_plane * NLP, 0)
+                  == BALLC_ROLLING_MODE_HOLDING;
+    if (c->observer_massive && !held) {   /* resting._observer_offset */
         double where[BALLC_OBSERVER_POSITION_NOUT], d[3];
         ballc_observer_position(y, c->params, r->prepared.constants, NULL, where);
         for (int i = 0; i < 3; i++) d[i] = where[i] - y[BALLC_STATE_X + i];
@@ -1317,6 +1459,7 @@ static int at_rest(const run_t *r, const double *y, double t_start, double t)
     double e[BALLC_ENERGY_NOUT];
     energy_of(r, y, e);
     double kinetic = e[0], spring = e[4] + e[5];
+    for (int i = 6; i < BALLC_ENERGY_NOUT; i++) spring += e[i];   /* rolling springs */
     double rho = c->radius - y[BALLC_STATE_Z];
     double x = (rho - c->rho_eq) / c->rho_eq;
     double normal = INFINITY;
@@ -1325,7 +1468,7 @@ static int at_rest(const run_t *r, const double *y, double t_start, double t)
         if (!isfinite(normal) && isfinite(x)) return -1;   /* math.expm1 overflow */
     }
     double observer = 0.0;
-    if (c->observer_massive) {
+    if (c->observer_massive && !held) {
         double pair[2] = {across, up};
         double reach = ballc_py_hypot(2, pair);
         observer = reach > 0 ? c->observer_weight * across * across / (reach + fabs(up)) : 0.0;
@@ -1345,20 +1488,72 @@ static double max_abs(const double *v, int n)
     return m;
 }
 
+/* Whether plane p holds its rolling (rolling resistance's exact holding mode) and sticks:
+ * the ball can then only spin about the normal, uniformly (the constraints keep omega
+ * along n and the centre still; no force has a moment about n), whatever its inertia
+ * and observer -- a uniform motion in closed form (exact flight's, g = 0). */
+static int held_still(const run_t *r, int p)
+{
+    return p >= 0 && ballc_rolling_mode(r->latch + p * NLP, 0) == BALLC_ROLLING_MODE_HOLDING
+           && r->coulomb[p] == BALLC_MODE_STICK;
+}
+
+/* rolls() of a ball held and sticking (held_still): roll = y with vz = 0 and z at the
+ * contact's own vertical equilibrium (Newton's method on the vertical acceleration: with
+ * the seed's dig-in law and a direction latched off the normal, the weight is not
+ * carried by the Hertz force alone, and z_eq is not the equilibrium), the rolling
+ * springs and deflections as they are; the end state when the small vertical
+ * oscillation about it holds less than the rest threshold's energy and the state is
+ * steady there (its spin about the normal then goes on uniformly). */
+static int held_spin(const run_t *r, const double *y, double slip_speed, double *roll)
+{
+    const ballc_drive_config *c = r->c;
+    int flags = run_flags(r, 1);
+    double rate[N], moved[N], slope = 0.0;
+    memcpy(roll, y, N * sizeof(double));
+    roll[BALLC_STATE_VZ] = 0.0;
+    roll[BALLC_STATE_Z] = c->z_eq;
+    for (int it = 0; it < 40; it++) {
+        if (ballc_rhs(roll, c->params, r->latch, flags, rate) != BALLC_OK) return -1;
+        double h = 1e-6 * c->rho_eq;
+        memcpy(moved, roll, sizeof moved);
+        moved[BALLC_STATE_Z] += h;
+        double a = rate[BALLC_STATE_VZ];
+        if (ballc_rhs(moved, c->params, r->latch, flags, rate) != BALLC_OK) return -1;
+        slope = (rate[BALLC_STATE_VZ] - a) / (moved[BALLC_STATE_Z] - roll[BALLC_STATE_Z]);
+        if (!(slope < 0)) return 0;   /* no restoring force: not in contact */
+        double dz = -a / slope;
+        roll[BALLC_STATE_Z] += dz;
+        if (fabs(dz) <= 4 * DBL_EPSILON * fabs(roll[BALLC_STATE_Z])) break;
+    }
+    double dz = y[BALLC_STATE_Z] - roll[BALLC_STATE_Z];
+    double above = c->half_mass * (y[BALLC_STATE_VZ] * y[BALLC_STATE_VZ] - slope * dz * dz);
+    if (!(above <= c->rest_threshold)) return 0;
+    booked(r, y, roll);
+    if (ballc_rhs(roll, c->params, r->latch, flags, rate) != BALLC_OK) return -1;
+    double level = c->rolls_level;
+    if (max_abs(rate + BALLC_STATE_VX, 3) > level
+            || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level)
+        return 0;
+    return slip_speed <= c->rolls_dv ? BALLC_END_ROLLING : BALLC_END_SLIDING;
+}
+
 /* resting.rolls: BALLC_END_ROLLING / SLIDING with ``roll`` the uniform state, 0 none,
  * -1 where Python would raise */
 static int rolls(const run_t *r, const double *y, double t_start, double t,
                  double slip_speed, double *roll)
 {
     const ballc_drive_config *c = r->c;
-    if (t - t_start < c->rest_period || !c->rolls_allowed) return 0;
+    int held = held_still(r, c->resting_plane);
+    if (t - t_start < c->rest_period || !(c->rolls_allowed || held)) return 0;
+    if (held) return held_spin(r, y, slip_speed, roll);
     double e[BALLC_ENERGY_NOUT];
     energy_of(r, y, e);
     double x = (c->radius - y[BALLC_STATE_Z] - c->rho_eq) / c->rho_eq;
     if (!(x > -1)) return 0;
     double normal = normal_above(c, x);
     if (!isfinite(normal) && isfinite(x)) return -1;
-    double above = c->half_mass * pow(y[BALLC_STATE_VZ], 2.0) + (e[4] + e[5])
+    double above = c->half_mass * pow(y[BALLC_STATE_VZ], 2.0) + (e[4] + e[5] + e[6] + e[7])
                    + py_max(normal, 0.0);
     if (!(above <= c->rest_threshold)) return 0;
     memcpy(roll, y, N * sizeof(double));   /* resting.rolling_state */
@@ -1500,6 +1695,8 @@ static int end_state(run_t *r, int p)
         new_y[BALLC_STATE_Z] = c->z_eq;
         new_y[BALLC_STATE_FLOOR_DEFLECTION_X] = new_y[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
         new_y[BALLC_STATE_CEILING_DEFLECTION_X] = new_y[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
+        for (int q = 0; q < BALLC_N_PLANES; q++)   /* the rolling springs relax */
+            for (int i = 0; i < 3; i++) new_y[r->prepared.planes[q].rolling + i] = 0.0;
         booked(r, r->y, new_y);
         memcpy(r->y, new_y, sizeof new_y);
         return BALLC_END_REST;
@@ -1808,6 +2005,7 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
         pr.poll = drv_poll;
+        pr.norm_states = c->norm_states;
         ballc_segment seg = {flags, r->latch, c->params, -1};   /* the integrator interface */
         memset(&res, 0, sizeof res);
         solved = (c->integrate ? c->integrate : ballc_compiled_integrator)(
@@ -1990,7 +2188,15 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         case K_ARM: case K_YIELD: case K_RESTICK: case K_CAPACITY:
             handled = compliant_event(r, kind, p);
             break;
-        default: handled = coulomb_event(r, kind, p); break;
+        case K_ROLL_FIRST + BALLC_ROLLING_APPROACH: case K_ROLL_FIRST + BALLC_ROLLING_STOP:
+        case K_ROLL_FIRST + BALLC_ROLLING_CLEAR: case K_ROLL_FIRST + BALLC_ROLLING_RELEASE:
+        case K_ROLL_FIRST + BALLC_TWISTING_STOP: case K_ROLL_FIRST + BALLC_TWISTING_RELEASE:
+            handled = rolling_event(r, kind, p);
+            break;
+        default:
+            handled = coulomb_event(r, kind, p);
+            if (!handled && r->status == 0) handled = recheck_modes(r, p);
+            break;
         }
         if (handled) { rc = -1; break; }
         if (log_close(r, kind, p, r->t)) { rc = -2; break; }

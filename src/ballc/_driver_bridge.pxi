@@ -36,7 +36,7 @@ cdef extern from "_driver.h":
         int n_terms[2][2]
         int term_index[2][2][2]
         double term_coef[2][2][2]
-        double slip_map[2][2][19]
+        double slip_map[2][2][26]
         const double *t_eval
         long n_eval
         int dense_output
@@ -80,6 +80,7 @@ cdef extern from "_driver.h":
         const int *user_rearm
         int (*rearm_fun)(void *, int, double, const double *, double *, double *,
                          double *) noexcept nogil
+        int rolling, twisting, norm_states
     ctypedef struct ballc_contact_rec:
         int plane, ended, passed_through, rate_is_kernel_value
         double t_start, t_end
@@ -101,7 +102,7 @@ cdef extern from "_driver.h":
         long step0, n_steps, coef0
         int terms
         int flight
-        double y0[19]
+        double y0[26]
         int own
         long interpolant
     enum: BALLC_N_PLANE_MODES, BALLC_N_SEGMENT_ENDS
@@ -114,6 +115,10 @@ cdef extern from "_driver.h":
         signed char before[2]
         signed char after[2]
         signed char rearm_kind, rearm_plane, rearm_before, rearm_after
+        signed char rolling_before[2]
+        signed char rolling_after[2]
+        signed char twisting_before[2]
+        signed char twisting_after[2]
     ctypedef struct ballc_drive_output:
         long n
         double *t
@@ -152,7 +157,7 @@ cdef extern from "_driver.h":
         long segments
         int end_kind, end_plane
         double end_t
-        double end_y[19]
+        double end_y[26]
         int profiled
         double integrator_ns, drive_ns
         int end_orbit
@@ -193,12 +198,16 @@ cdef object _segment_record():
                <char *>&g.plane - at, <char *>&g.rearms - at, <char *>&g.before[0] - at,
                <char *>&g.after[0] - at, <char *>&g.rearm_kind - at,
                <char *>&g.rearm_plane - at, <char *>&g.rearm_before - at,
-               <char *>&g.rearm_after - at]
+               <char *>&g.rearm_after - at, <char *>&g.rolling_before[0] - at,
+               <char *>&g.rolling_after[0] - at, <char *>&g.twisting_before[0] - at,
+               <char *>&g.twisting_after[0] - at]
     fields = [("t_start", "f8"), ("t_end", "f8"), ("nfev", "l"), ("njev", "l"), ("nlu", "l"),
               ("nstep", "l"), ("nreject", "l"), ("method", "intc"), ("method_end", "intc"), ("switches", "intc"),
               ("end", "intc"), ("plane", "intc"), ("rearms", "intc"),
               ("before", ("i1", (2,))), ("after", ("i1", (2,))), ("rearm_kind", "i1"),
-              ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1")]
+              ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1"),
+              ("rolling_before", ("i1", (2,))), ("rolling_after", ("i1", (2,))),
+              ("twisting_before", ("i1", (2,))), ("twisting_after", ("i1", (2,)))]
     return np.dtype(dict(names=[f[0] for f in fields], formats=[f[1] for f in fields],
                          offsets=offsets, itemsize=sizeof(ballc_segment_rec)))
 
@@ -427,6 +436,9 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
         c.user_index = &uindex[0]
         c.user_count = &ucount[0]
         c.user_direction = &udirection[0]
+    c.rolling = k.get("rolling", 0)
+    c.twisting = k.get("twisting", 0)
+    c.norm_states = k.get("norm_states", 0)
     c.compliant_modes = k["compliant_modes"]
     c.compliant_any = k["compliant_any"]
     c.compliant_sliding_any = k["compliant_sliding_any"]

@@ -48,8 +48,8 @@ static double initial_step(solver_t *s)
         d0 += (s->y[c] / s->scale[c]) * (s->y[c] / s->scale[c]);
         d1 += (s->f[c] / s->scale[c]) * (s->f[c] / s->scale[c]);
     }
-    d0 = sqrt(d0 / n);
-    d1 = sqrt(d1 / n);
+    d0 = sqrt(d0 / s->n_norm);
+    d1 = sqrt(d1 / s->n_norm);
     double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
     h0 = fmin(h0, interval);
     for (int c = 0; c < n; c++) s->tmp[c] = s->y[c] + h0 * s->direction * s->f[c];
@@ -58,7 +58,7 @@ static double initial_step(solver_t *s)
             double v = (s->f_new[c] - s->f[c]) / s->scale[c];
             d2 += v * v;
         }
-        d2 = sqrt(d2 / n) / h0;
+        d2 = sqrt(d2 / s->n_norm) / h0;
     }
     const int order = s->dop853 ? DOP853_ERROR_ORDER : 3;
     double h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? fmax(1e-6, h0 * 1e-3)
@@ -567,6 +567,7 @@ int radau5_solve(const radau5_problem *p, radau5_result *r)
     s.p = p;
     s.r = r;
     s.n = n;
+    s.n_norm = p->norm_states > 0 ? p->norm_states : n;
     s.auto_mode = p->method == RADAU5_METHOD_AUTO;
     s.dop853 = p->method == RADAU5_METHOD_DOP853 || (s.auto_mode && !p->auto_implicit);
     s.dense_dop853 = s.dop853;

@@ -108,6 +108,12 @@ typedef struct {
                                * follows |s| step by step; a Jacobian kept from an earlier
                                * step overestimates it and Newton settles on a wrong
                                * deflection direction, issue 28) */
+    int norm_states;          /* the error norms' divisor: the RMS norms (error estimates,
+                               * Radau's Newton increments, the initial step's) divide
+                               * their sums by it instead of n (0: n).  ballc's rolling
+                               * resistance states are last and constant without it: a
+                               * run without it gives them no weight, and its results
+                               * are those of the state without them, bit for bit */
 } radau5_problem;
 
 #define RADAU5_POLL_STEPS 16

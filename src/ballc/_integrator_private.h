@@ -41,6 +41,7 @@ typedef struct ballc_solver {
     radau5_result *r;
     constants_t k;
     int n;
+    int n_norm;                         /* the RMS norms' divisor (problem.norm_states) */
     double direction, newton_tol;
     /* step control (radau5_problem.controller): the tolerances in use (transformed with
      * RADAU5_CTRL_TOL), the Newton iteration cap, and Hairer's predictive-controller
@@ -101,8 +102,9 @@ typedef struct ballc_solver {
     size_t cap_out, cap_hits, cap_dense;
 } solver_t;
 
-/* common.norm: RMS norm (two partial sums: half the chain of dependent additions). */
-static inline double rms(const double *x, int n)
+/* common.norm: RMS norm (two partial sums: half the chain of dependent additions) of
+ * x's n values, the sum divided by ``count`` (solver_t.n_norm). */
+static inline double rms(const double *x, int n, int count)
 {
     double s0 = 0, s1 = 0;
     int i = 0;
@@ -111,7 +113,7 @@ static inline double rms(const double *x, int n)
         s1 += x[i + 1] * x[i + 1];
     }
     if (i < n) s0 += x[i] * x[i];
-    return sqrt((s0 + s1) / n);
+    return sqrt((s0 + s1) / count);
 }
 
 static inline int call_fun(solver_t *s, double t, const double *y, double *f)

@@ -201,7 +201,7 @@ static int solve_collocation(solver_t *s, double t, double h, double *restrict Z
             sum1 += v1 * v1;
             sum2 += v2 * v2;
         }
-        double dW_norm = sqrt((sum0 + sum1 + sum2) / (3 * n));
+        double dW_norm = sqrt((sum0 + sum1 + sum2) / (3 * s->n_norm));
         if (!isfinite(dW_norm)) break;
         if (have_old) {
             rate = dW_norm / dW_norm_old;
@@ -348,7 +348,7 @@ int radau_iia_step(solver_t *s)
                 s->scale[c] = s->atol[c] + fmax(fabs(y[c]), fabs(y_new[c])) * s->rtol;
             s->tmp[c] = err[c] / s->scale[c];
         }
-        error_norm = rms(s->tmp, n);
+        error_norm = rms(s->tmp, n, s->n_norm);
         safety = 0.9 * (2 * s->newton_maxiter + 1) / (2 * s->newton_maxiter + n_iter);
 
         if (rejected && error_norm > 1) {
@@ -359,7 +359,7 @@ int radau_iia_step(solver_t *s)
                 for (int c = 0; c < n; c++) err[c] += ZE[c];
                 solve_real(s, err);
                 for (int c = 0; c < n; c++) s->tmp[c] = err[c] / s->scale[c];
-                error_norm = rms(s->tmp, n);
+                error_norm = rms(s->tmp, n, s->n_norm);
             }
         }
         if (!(error_norm <= 1)) {

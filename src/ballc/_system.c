@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "_system.h"
+#include "_rolling.h"
 
 #define NS BALLC_N_STATES
 #define NQ 7  /* coordinates: quaternion (4) and centre (3) */
@@ -17,26 +18,33 @@ typedef void (*kernel_fn)(const double *restrict, const double *restrict,
 /* A kernel's parameter arguments: the parameters and their constants. */
 #define PARAMS(p) (p)->values, (p)->constants
 
-/* Each plane's deflection states (x; y next). */
+/* Each plane's deflection states (x; y next) and rolling spring (rolling_x, _y, twisting). */
 static const int DEFLECTION[NP] = {BALLC_STATE_FLOOR_DEFLECTION_X,
                                    BALLC_STATE_CEILING_DEFLECTION_X};
+static const int ROLLING[NP] = {BALLC_STATE_FLOOR_ROLLING_X, BALLC_STATE_CEILING_ROLLING_X};
 
 void ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
 {
     prepared->values = params;
     ballc_parameter_constants(params, prepared->constants);
     const double anywhere[NC] = {0};   /* the slip maps are constants (codegen checks) */
-    double maps[BALLC_PLANE_SLIP_MAP_NOUT];
+    double maps[BALLC_PLANE_SLIP_MAP_NOUT], rolling[BALLC_PLANE_ROLLING_MAP_NOUT];
     ballc_plane_slip_map(anywhere, PARAMS(prepared), NULL, maps);
+    ballc_plane_rolling_map(anywhere, PARAMS(prepared), NULL, rolling);
     for (int p = 0; p < NP; p++) {
         const double *entry = params + BALLC_PARAMETER_PLANES + p * BALLC_N_PLANE_FIELDS;
         ballc_plane_t *pl = &prepared->planes[p];
         ballc_plane_init(pl, entry + BALLC_PLANE_POINT_X, entry + BALLC_PLANE_NORMAL_X,
-                         params + BALLC_PARAMETER_GRAVITY_X, DEFLECTION[p]);
+                         params + BALLC_PARAMETER_GRAVITY_X, DEFLECTION[p], ROLLING[p]);
         /* the plane's slip map by the ball's state, its force map in inertial components */
         ballc_plane_state_columns(pl, maps, 2, prepared->slip_map[p]);
         memcpy(prepared->slip_force_map[p], maps + 2 * NC, sizeof prepared->slip_force_map[p]);
         ballc_plane_rows_to_inertial(pl, prepared->slip_force_map[p], 2, 0, 2);
+        /* the same for its rolling and twisting velocities (_rolling.h) */
+        ballc_plane_state_columns(pl, rolling, 3, prepared->rolling_map[p]);
+        memcpy(prepared->rolling_force_map[p], rolling + 3 * NC,
+               sizeof prepared->rolling_force_map[p]);
+        ballc_plane_rows_to_inertial(pl, prepared->rolling_force_map[p], 3, 0, 2);
     }
 }
 
@@ -184,6 +192,7 @@ typedef struct {
     double lambda[BALLC_N_PLANES][2];           /* sticking: the constraint force */
     /* the coefficients of rho'' in the auxiliary rates, per plane (0 without) */
     double acceleration[BALLC_N_PLANES][4];
+    ballc_rolling_eval rolling[BALLC_N_PLANES];   /* rolling resistance (_rolling.h) */
 } evaluation_t;
 
 /* The exact penetration acceleration rho'' of ``plane`` from the solved udot: rho = r -
@@ -220,6 +229,7 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
         ev->mode[plane] = exact_mode(flags, plane);
         ev->load[plane] = 0.0;
         for (int i = 0; i < 4; i++) ev->acceleration[plane][i] = 0.0;
+        ev->rolling[plane].mode[0] = ev->rolling[plane].mode[1] = BALLC_ROLLING_MODE_NONE;
     }
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
     for (int plane = 0; plane < NP; plane++) {
@@ -253,6 +263,11 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
             auxiliary_targets(pl, target);
             for (int i = 0; i < 4; i++) xdot[target[i]] += sum[BALLC_LAW_DISSIPATION + i];
         }
+        if (ballc_rolling_on(law_latch(latch, plane)))   /* the law's fourth part */
+            ballc_rolling_assemble(contact.state, PARAMS(params), contact.inputs,
+                                   law_latch(latch, plane), params->rolling_map[plane],
+                                   params->rolling_force_map[plane], &ev->rolling[plane],
+                                   force, xdot);
         if (ev->mode[plane] == MODE_NONE) continue;
         slip_t *slip = &ev->slip[plane];
         slip_of(params, plane, contact.state, slip);
@@ -354,6 +369,12 @@ static int stick_response(const schur_t *factor, const slip_t *slip, double z[2]
     return BALLC_OK;
 }
 
+/* schur_solve as _rolling.h's ballc_mass_solve */
+static void mass_solve(const void *factor, double *b)
+{
+    schur_solve((const schur_t *)factor, b);
+}
+
 /* udot (6) and the auxiliary rates.  A sticking plane's constraint force lambda makes
  * du/dt = 0: lambda = -W^-1 (du/d speeds) udot_0, udot = udot_0 + z lambda.  (The
  * planes are handled one after the other: both can only touch the ball at once when
@@ -367,6 +388,28 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
     if (status != BALLC_OK) return status;
     schur_solve(factor, udot);
     for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+        ballc_rolling_eval *roll = &ev->rolling[plane];
+        int held = ballc_rolling_held(roll);
+        if (held) {   /* rolling or twisting held (and the slip, when it sticks): one solve */
+            int stick = ev->mode[plane] == MODE_STICK;
+            const slip_t *slip = &ev->slip[plane];
+            double *lambda = ev->lambda[plane];
+            status = ballc_rolling_hold(held | (stick ? BALLC_HOLD_SLIP : 0),
+                                        stick ? slip->du : NULL, stick ? slip->G : NULL,
+                                        roll, mass_solve, factor, udot, lambda);
+            if (status != BALLC_OK) return status;
+            if (stick) {
+                ev->contact_force[3 * plane] += lambda[0];       /* along t1, t2 */
+                ev->contact_force[3 * plane + 1] += lambda[1];
+                if (xdot)
+                    xdot[BALLC_STATE_DISSIPATED_TANGENTIAL] -=
+                        lambda[0] * slip->u[0] + lambda[1] * slip->u[1];
+            }
+            if (xdot)
+                for (int i = 0; i < BALLC_ROLLING_W; i++)
+                    xdot[BALLC_STATE_DISSIPATED_ROLLING] -= roll->lambda[i] * roll->w[i];
+            continue;
+        }
         if (ev->mode[plane] != MODE_STICK) continue;
         const slip_t *slip = &ev->slip[plane];
         const double *du = slip->du;
@@ -403,6 +446,18 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
 static int any_stick(int flags)
 {
     return exact_mode(flags, 0) == MODE_STICK || exact_mode(flags, 1) == MODE_STICK;
+}
+
+/* Whether a plane in contact holds its rolling or twisting velocity (its latch). */
+static int any_held(int flags, const double *latch)
+{
+    for (int plane = 0; plane < NP; plane++) {
+        if (!in_contact(flags, plane)) continue;
+        const double *l = law_latch(latch, plane);
+        for (int part = 0; part < 2; part++)
+            if (ballc_rolling_mode(l, part) == BALLC_ROLLING_MODE_HOLDING) return 1;
+    }
+    return 0;
 }
 
 /* The public entry points' part of the checks: finite parameters and latch, and the
@@ -584,7 +639,22 @@ static int difference_jacobian(const double *state, const ballc_parameters_t *pa
     int status = ballc_rhs_checked_inputs(state, params, latch, flags, f0);
     if (status != BALLC_OK) return status;
     memcpy(y, state, sizeof y);
+    /* columns the right-hand side does not read are 0 (f1 - f0 would be exactly 0):
+     * the dissipated work, and the rolling springs unless an sds part acts */
+    int springs = 0;
+    for (int plane = 0; plane < NP; plane++)
+        for (int part = 0; part < 2; part++)
+            springs |= in_contact(flags, plane)
+                       && ballc_rolling_mode(law_latch(latch, plane), part)
+                          >= BALLC_ROLLING_MODE_SPRING;
     for (int j = 0; j < NS; j++) {
+        int output = j == BALLC_STATE_DISSIPATED_NORMAL || j == BALLC_STATE_DISSIPATED_TANGENTIAL
+                     || j == BALLC_STATE_DISSIPATED_ROLLING
+                     || (!springs && j > BALLC_STATE_DISSIPATED_ROLLING);
+        if (output) {
+            for (int i = 0; i < NS; i++) jac[i * NS + j] = 0.0;
+            continue;
+        }
         y[j] = state[j] + 1.4901161193847656e-08 * fmax(1.0, fabs(state[j]));
         double h = y[j] - state[j];
         status = ballc_rhs_checked_inputs(y, params, latch, flags, f1);
@@ -643,7 +713,8 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
     evaluation_t ev;
     double udot[NU];
     if (!all_finite(state, NS)) return BALLC_NOT_FINITE;
-    if (any_stick(flags)) return difference_jacobian(state, params, latch, flags, jac);
+    if (any_stick(flags) || any_held(flags, latch))
+        return difference_jacobian(state, params, latch, flags, jac);
     int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
 
@@ -676,6 +747,13 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
                 for (int j = 0; j < NS; j++)
                     jac[target[i] * NS + j] += buf[(BALLC_LAW_DISSIPATION + i) * NS + j];
         }
+        if (ballc_rolling_on(law_latch(latch, plane))) {   /* the law's fourth part */
+            double rolling[BALLC_PLANE_ROLLING_JAC_NOUT], rows[BALLC_PLANE_ROLLING_JAC_NOUT / NC * NS];
+            ballc_plane_rolling_jac(contact.state, PARAMS(params), contact.inputs, rolling);
+            ballc_plane_state_columns(pl, rolling, BALLC_PLANE_ROLLING_JAC_NOUT / NC, rows);
+            ballc_rolling_jacobian(&ev.rolling[plane], params->values, law_latch(latch, plane),
+                                   rows + BALLC_ROLLING_W * NS, dF, jac);
+        }
     }
     /* d udot / dx_j = M^-1 (dF/dx_j - d(M udot)/dx_j); M depends on q only. */
     for (int j = 0; j < NS; j++) {
@@ -697,7 +775,71 @@ void ballc_energy(const double *state, const ballc_parameters_t *params, double 
         ballc_plane_energy(local, PARAMS(params), NULL, e);
         out[2 + p] = e[0];
         out[2 + NP + p] = e[1];
+        ballc_plane_rolling_energy(local, PARAMS(params), NULL, out + 2 + 2 * NP + p);
     }
+}
+
+int ballc_rolling_state(const double *state, const ballc_parameters_t *params,
+                        const double *latch, int flags, int plane, double *out)
+{
+    schur_t factor;
+    evaluation_t ev;
+    double udot[NU];
+    for (int i = 0; i < BALLC_ROLLING_STATE_NOUT; i++) out[i] = NAN;
+    if (plane < 0 || plane >= NP || !in_contact(flags, plane)) return BALLC_SINGULAR;
+    if (!all_finite(state, NS) || !all_finite(latch, BALLC_N_LATCH)) return BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+    if (status != BALLC_OK) return status;
+    const ballc_rolling_eval *roll = &ev.rolling[plane];
+    if (roll->mode[0] == BALLC_ROLLING_MODE_NONE && roll->mode[1] == BALLC_ROLLING_MODE_NONE) {
+        /* rolling resistance off: its velocities and load all the same */
+        plane_contact_t contact;
+        double w[BALLC_PLANE_ROLLING_NOUT];
+        plane_contact(params, plane, state, latch, &contact);
+        ballc_plane_rolling(contact.state, PARAMS(params), contact.inputs, w);
+        for (int i = 0; i < 3; i++) out[i] = 0.0;
+        out[3] = w[3];
+        out[4] = params->values[BALLC_PARAMETER_ROLLING_RESISTANCE] * w[3];
+        out[5] = params->values[BALLC_PARAMETER_TWISTING_RESISTANCE] * w[3];
+        for (int i = 0; i < 3; i++) out[6 + i] = w[i];
+        return all_finite(out, BALLC_ROLLING_STATE_NOUT) ? BALLC_OK : BALLC_NOT_FINITE;
+    }
+    for (int i = 0; i < 3; i++) out[i] = roll->lambda[i];
+    out[3] = roll->load;
+    out[4] = params->values[BALLC_PARAMETER_ROLLING_RESISTANCE] * roll->load
+             - hypot(roll->lambda[0], roll->lambda[1]);
+    out[5] = params->values[BALLC_PARAMETER_TWISTING_RESISTANCE] * roll->load
+             - fabs(roll->lambda[2]);
+    for (int i = 0; i < 3; i++) out[6 + i] = roll->w[i];
+    return all_finite(out, BALLC_ROLLING_STATE_NOUT) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+int ballc_remove_velocities(const double *state, const ballc_parameters_t *params,
+                            const double *latch, int flags, int plane, int mask,
+                            double *state_out)
+{
+    schur_t factor;
+    evaluation_t ev;
+    double force[NU];
+    memcpy(state_out, state, NS * sizeof(double));
+    if (plane < 0 || plane >= NP) return BALLC_SINGULAR;
+    if (!all_finite(state, NS) || !all_finite(latch, BALLC_N_LATCH)) return BALLC_NOT_FINITE;
+    /* the mass matrix, the slip and the rolling part's velocities and maps at the state */
+    assemble(state, params, latch, flags, &ev, force, NULL);
+    int status = schur_factor(ev.mass, &factor);
+    if (status != BALLC_OK) return status;
+    plane_contact_t contact;
+    plane_contact(params, plane, state, latch, &contact);
+    slip_t slip;
+    slip_of(params, plane, contact.state, &slip);
+    ballc_rolling_eval *roll = &ev.rolling[plane];
+    ballc_rolling_assemble(contact.state, PARAMS(params), contact.inputs,
+                           law_latch(latch, plane), params->rolling_map[plane],
+                           params->rolling_force_map[plane], roll, force, NULL);
+    status = ballc_rolling_impulse(mask, slip.u, slip.du, slip.G, roll, mass_solve, &factor,
+                                   state_out + NQ);
+    if (status != BALLC_OK) return status;
+    return all_finite(state_out, NS) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 void ballc_contact_kinematics(const double *state, const ballc_parameters_t *params,

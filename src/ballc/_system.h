@@ -77,7 +77,7 @@ int ballc_jacobian(const double *state, const double *params, const double *latc
  * once per segment by the integrator's adapter, once per call by the entry points that
  * take a plain parameter vector.  The constants and planes are never taken from a
  * caller, so they cannot belong to other parameters. */
-typedef struct {
+typedef struct ballc_parameters {
     const double *values;                               /* BALLC_N_PARAMETERS, borrowed */
     double constants[BALLC_N_PARAMETER_CONSTANTS];
     ballc_plane_t planes[BALLC_N_PLANES];
@@ -85,13 +85,18 @@ typedef struct {
      * unit tangential force along its t1, t2 (6 x 2, inertial): constants */
     double slip_map[BALLC_N_PLANES][2 * BALLC_N_STATES];
     double slip_force_map[BALLC_N_PLANES][12];
+    /* each plane's rolling and twisting velocities' map dw/dx (3 x BALLC_N_STATES) and the
+     * generalized-force map of a unit rolling force along t1, t2 and a unit twisting
+     * force (6 x 3, inertial): constants (_rolling.h) */
+    double rolling_map[BALLC_N_PLANES][3 * BALLC_N_STATES];
+    double rolling_force_map[BALLC_N_PLANES][18];
 } ballc_parameters_t;
 
 void ballc_parameters_init(ballc_parameters_t *prepared, const double *params);
 
-/* Energies (J): kinetic, potential, then per plane the Hertz spring's and per plane the
- * compliant law's tangential spring's. */
-#define BALLC_ENERGY_NOUT (2 + 2 * BALLC_N_PLANES)
+/* Energies (J): kinetic, potential, then per plane the Hertz spring's, per plane the
+ * compliant law's tangential spring's and per plane the rolling part's sds springs'. */
+#define BALLC_ENERGY_NOUT (2 + 3 * BALLC_N_PLANES)
 void ballc_energy(const double *state, const ballc_parameters_t *params, double *out);
 
 /* Per plane: rho, rhodot and the contact point's velocity (inertial x, y, z). */
@@ -143,6 +148,23 @@ int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t 
  * along the plane's tangents t1, t2. */
 int ballc_stick_state(const double *state, const double *params, const double *latch,
                       int flags, int plane, double *out);
+
+/* Rolling resistance (_rolling.h) of ``plane`` under ``flags`` and ``latch`` (its modes):
+ * out = [lambda (3: the rolling force along t1, t2 and the twisting force that hold its
+ * held parts, 0 for the others), F_n, the rolling margin mu_r F_n - |lambda_r|, the
+ * twisting margin mu_t F_n - |lambda_w|, the rolling velocity (2), the twisting
+ * velocity].  The margins end a holding part (its release event). */
+#define BALLC_ROLLING_STATE_NOUT 9
+int ballc_rolling_state(const double *state, const ballc_parameters_t *params,
+                        const double *latch, int flags, int plane, double *out);
+
+/* state_out = state with the velocities of ``plane`` in ``mask`` (_rolling.h
+ * BALLC_HOLD_*: its slip, rolling and twisting velocities) set to zero by one impulse
+ * of the constraint forces that hold them (P = -W^-1 v, W their Delassus matrix); used
+ * where a velocity starts being held and what is left of it is at rounding level. */
+int ballc_remove_velocities(const double *state, const ballc_parameters_t *params,
+                            const double *latch, int flags, int plane, int mask,
+                            double *state_out);
 
 /* state_out = state with the slip velocity of ``plane`` set to zero by a tangential
  * impulse at the contact point (the impulse P = -W^-1 u, W the 2x2 Delassus matrix);

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from . import _core, layout
+from . import _core, automaton, layout
 from .orientation import angles_123_from_quaternion
 
 _STATE = layout.INDEX
@@ -281,26 +281,33 @@ class Result:
         """name -> (n,) array (J).
 
         ``kinetic``, ``potential`` (gravity), ``spring`` (Hertz, 2/5 k0 rho^(5/2)),
-        ``tangential_spring`` (the compliant law's, ``1/2 k_t |s|^2``; 0 for the others) and
-        their sum ``total`` (the seed's total energy, plus the tangential spring's); ``dissipated_normal`` and
-        ``dissipated_tangential``: work dissipated by the contact forces since t = 0
-        (integrated with the motion; negative where a model injects energy, as dig-in
-        does), ``dissipated`` their sum, and ``balance`` = total + dissipated, which
-        stays at the initial energy to integration tolerance for every model.
+        ``tangential_spring`` (the compliant law's, ``1/2 k_t |s|^2``; 0 for the others),
+        ``rolling_spring`` (the sds rolling and twisting springs', ``1/2 k_r |xi_r|^2 +
+        1/2 k_w xi_w^2``; 0 without them) and their sum ``total`` (the seed's total
+        energy, plus the tangential and rolling springs'); ``dissipated_normal``,
+        ``dissipated_tangential`` and ``dissipated_rolling`` (the rolling and twisting
+        torques'): work dissipated by the contact forces since t = 0 (integrated with the
+        motion; negative where a model injects energy, as dig-in does), ``dissipated``
+        their sum, and ``balance`` = total + dissipated, which stays at the initial
+        energy to integration tolerance for every model.
         """
         if self._energy is None:
             e = _core.energies(np.ascontiguousarray(self.y.T), self.scene.parameter_vector())
             spring = e[:, 2] + e[:, 3]
             tangential_spring = e[:, 4] + e[:, 5]
-            total = e[:, 0] + e[:, 1] + spring + tangential_spring
+            rolling_spring = e[:, 6] + e[:, 7]
+            total = e[:, 0] + e[:, 1] + spring + tangential_spring + rolling_spring
             normal = self.y[_STATE["dissipated_normal"]]
             tangential = self.y[_STATE["dissipated_tangential"]]
+            rolling = self.y[_STATE["dissipated_rolling"]]
             self._energy = {"kinetic": e[:, 0], "potential": e[:, 1], "spring": spring,
                             "tangential_spring": tangential_spring,
+                            "rolling_spring": rolling_spring,
                             "total": total, "dissipated_normal": normal,
                             "dissipated_tangential": tangential,
-                            "dissipated": normal + tangential,
-                            "balance": total + normal + tangential}
+                            "dissipated_rolling": rolling,
+                            "dissipated": normal + tangential + rolling,
+                            "balance": total + normal + tangential + rolling}
         return self._energy
 
     def contacts_dataframe(self):
@@ -517,6 +524,13 @@ SEGMENT_FIELDS = {
     "rearm_plane": ("", "... its plane, or ''"),
     "rearm_before": ("", "... that plane's mode before it, or ''"),
     "rearm_after": ("", "... and after it, or ''"),
+    "rolling_before": ("", "each plane's rolling part's mode during the segment (floor, "
+                       "ceiling; ballc.automaton.ROLLING_PART_MODES: none, rolling, "
+                       "rolling_fixed, holding, spring, slider)"),
+    "rolling_after": ("", "... once its end was handled"),
+    "twisting_before": ("", "each plane's twisting part's mode during the segment (none, "
+                        "twisting, holding, spring, slider)"),
+    "twisting_after": ("", "... once its end was handled"),
 }
 
 
@@ -531,13 +545,17 @@ def segment_table(raw: bytes) -> np.ndarray:
     low = min(methods)
     method_names = np.array([methods.get(k, str(k)) for k in range(low, max(methods) + 1)])
     ends = np.array(_core.SEGMENT_ENDS + ("",))
+    rolling = np.array(automaton.ROLLING_PART_MODES["rolling"])
+    twisting = np.array(automaton.ROLLING_PART_MODES["twisting"])
     table = np.empty(log.size, dtype=[
         ("t_start", "f8"), ("t_end", "f8"), ("method", "U6"), ("method_end", "U6"),
         ("switches", "i4"), ("nfev", "i8"), ("njev", "i8"), ("nlu", "i8"), ("nstep", "i8"),
         ("nreject", "i8"), ("end", "U13"),
         ("plane", "U7"), ("before", "U14", (2,)), ("after", "U14", (2,)), ("rearms", "i4"),
         ("rearm_kind", "U8"), ("rearm_plane", "U7"), ("rearm_before", "U14"),
-        ("rearm_after", "U14")])
+        ("rearm_after", "U14"), ("rolling_before", "U13", (2,)),
+        ("rolling_after", "U13", (2,)), ("twisting_before", "U13", (2,)),
+        ("twisting_after", "U13", (2,))])
     for name in ("t_start", "t_end", "switches", "nfev", "njev", "nlu", "nstep", "nreject",
                  "rearms"):
         table[name] = log[name]
@@ -552,6 +570,9 @@ def segment_table(raw: bytes) -> np.ndarray:
     table["rearm_plane"] = planes[log["rearm_plane"]]
     table["rearm_before"] = modes[log["rearm_before"]]
     table["rearm_after"] = modes[log["rearm_after"]]
+    for part, names in (("rolling", rolling), ("twisting", twisting)):
+        for when in ("before", "after"):
+            table[f"{part}_{when}"] = names[log[f"{part}_{when}"]]
     table.flags.writeable = False
     return table
 

@@ -535,6 +535,10 @@ def _motion_message(scene, plane, t, y, kind):
     v = float(np.hypot(*y[layout.VELOCITY][:2]))
     what = "rolls uniformly" if kind == "rolling" else (
         "slides uniformly (no force opposes its slip)")
+    if kind == "rolling" and scene.rolling_resistance > 0:   # held: it can only spin
+        spin = float(y[layout.ANGULAR_VELOCITY][2])
+        what = (f"is held by its rolling resistance and sticks, spinning about the normal "
+                f"at {spin:.6g} rad/s (no twisting resistance stops it),")
     return (f"{SUCCESS} The ball {what} on the {plane} from t = "
             f"{t:.9g} s at {v:.6g} m/s (ballc.resting: static Hertz "
             f"equilibrium, penetration "
@@ -717,6 +721,9 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
             result = _simulate_c(scene, options, y_start, config, progress)
             if result is not None:
                 return result
+    if scene.rolling_resistance > 0 or scene.twisting_resistance > 0:
+        raise RuntimeError("rolling resistance runs in the C loop only (issue 31), and this "
+                           "run fell back to the Python driver")
     run = _Run(scene, options, y_start)
     run.driver = "python"
     t_end, t_eval = options.t_end, options.t_eval
@@ -999,6 +1006,7 @@ def _c_config(scene, options, progress, rest):
     modes_on = compliantmodes.uses_modes(scene)
     arm_depth = segment_events.arm_depth or {plane: 0.0 for plane in PLANES}
     return dict(
+        **rolling_config(scene),
         compliant_modes=int(modes_on), **_FLAG_BITS,
         arm_depth=[float(arm_depth[plane]) for plane in PLANES],
         ulp8=[8 * math.ulp(compliantmodes.plane_position(scene, plane)) for plane in PLANES],
@@ -1032,6 +1040,23 @@ def _c_config(scene, options, progress, rest):
         threshold_base=[entry[5] for entry in planes],
         slip_terms=terms,
         slip_map=np.ascontiguousarray([stickslip.slip_map(params, plane) for plane in PLANES]))
+
+
+def rolling_config(scene):
+    """The rolling part's constants of a C run (_driver.h): each part's model (0 off, 1
+    exact, 2 sds) and the integrators' norm divisor, which leaves the rolling states out
+    of the error norms in a scene without rolling resistance (its results are then those
+    of the state without them, bit for bit)."""
+    model = ROLLING_MODEL_CODES[scene.rolling_model]
+    rolling = model if scene.rolling_resistance > 0 else 0
+    twisting = model if scene.twisting_resistance > 0 else 0
+    on = rolling or twisting
+    return dict(rolling=rolling, twisting=twisting,
+                norm_states=0 if on else _core.N_STATES - _core.N_ROLLING_STATES)
+
+
+#: Scene.rolling_model -> the C loop's code (_driver.h ballc_drive_config.rolling)
+ROLLING_MODEL_CODES = {"exact": 1, "sds": 2}
 
 
 def _c_user_events(events):

@@ -1,0 +1,186 @@
+/* Rolling resistance: the contact law's fourth part (docs/contact_laws.md, "Rolling
+ * resistance"), as LAMMPS GRANULAR composes a contact of normal, damping, tangential,
+ * rolling and twisting sub-models.
+ *
+ * A plane's rolling part has two parts of its own, each with a mode in the plane's latch
+ * (BALLC_LATCH_ROLLING_MODE, BALLC_LATCH_TWISTING_MODE; codes BALLC_ROLLING_MODE_*):
+ *
+ *   rolling:  the rolling velocity v_roll = r (omega x n) (2, along the plane's t1, t2),
+ *             resisted by a rolling force F_r in the plane whose torque is r n x F_r;
+ *   twisting: the twisting velocity v_twist = r omega . n (1), resisted by a twisting
+ *             force F_w whose torque is r F_w n.
+ *
+ * Both are capped at mu F_n (mu = rolling_resistance, twisting_resistance; F_n the
+ * contact's normal force, codegen contact.rolling_load), so the torques at mu r F_n.
+ * Two models (codegen/contact.py derives the velocities, the load and the maps):
+ *
+ *   exact (Ai et al. 2011, type A, with holding), in the modes of exact Coulomb friction:
+ *     FREE   F = -mu F_n e, e the unit velocity, oriented along the latched direction d
+ *            (so that it continues through v . d = 0, where the stop event sits);
+ *     FIXED  F = -mu F_n d (the last approach to 0 and the first departure from it;
+ *            twisting is always FIXED: its direction is a sign);
+ *     HOLDING the velocity held constant (at ~0) by a constraint force, solved with the
+ *            equations of motion together with Coulomb's stick constraint when the
+ *            plane sticks too (ballc_rolling_hold); released where |lambda| = mu F_n.
+ *   sds (LAMMPS rolling sds / twisting sds, ballc's passive form): the generated
+ *     kernels of the spring (below the cap) and the slider (at it).
+ *
+ * Mode changes are events of the segment loop (_driver.c); this file holds the physics
+ * both use: the forces and their Jacobian in the equations, the constraint solve, the
+ * impulse that removes what is left of a velocity when it is held, and the guards.
+ */
+#ifndef BALLC_ROLLING_H
+#define BALLC_ROLLING_H
+
+#include "ballc_kernels.h"
+
+#define BALLC_ROLLING_W 3   /* rolling (2) and twisting (1) velocities */
+
+/* The velocities a plane may hold with constraint forces (a mask): its slip (Coulomb's
+ * stick), its rolling and its twisting velocity. */
+enum { BALLC_HOLD_SLIP = 1, BALLC_HOLD_ROLLING = 2, BALLC_HOLD_TWISTING = 4 };
+
+/* A plane's rolling part in one evaluation of the equations. */
+typedef struct {
+    int mode[2];            /* rolling, twisting: BALLC_ROLLING_MODE_* (from the latch) */
+    double w[BALLC_ROLLING_W];        /* rolling velocity (t1, t2), twisting velocity */
+    double load;            /* F_n (N) */
+    double e[BALLC_ROLLING_W];        /* exact FREE / FIXED: the force is -mu F_n e */
+    double lambda[BALLC_ROLLING_W];   /* HOLDING: the constraint forces */
+    const double *dw;       /* dw/dx (3 x N_STATES), constants */
+    const double *G;        /* generalized force of unit F_r (t1, t2), F_w (6 x 3, inertial) */
+} ballc_rolling_eval;
+
+/* The part modes in a plane's latch block (BALLC_N_LATCH_PER_PLANE values). */
+static inline int ballc_rolling_mode(const double *plane_latch, int part)
+{
+    return (int)plane_latch[part ? BALLC_LATCH_TWISTING_MODE : BALLC_LATCH_ROLLING_MODE];
+}
+
+/* Whether any part of a plane's rolling part acts (its latch block). */
+static inline int ballc_rolling_on(const double *plane_latch)
+{
+    return ballc_rolling_mode(plane_latch, 0) != BALLC_ROLLING_MODE_NONE
+        || ballc_rolling_mode(plane_latch, 1) != BALLC_ROLLING_MODE_NONE;
+}
+
+/* The mask of the parts held (BALLC_HOLD_ROLLING, BALLC_HOLD_TWISTING). */
+int ballc_rolling_held(const ballc_rolling_eval *roll);
+
+/* A plane's rolling part at the contact state ``local`` (its frame) with the plane
+ * kernel inputs ``inputs``: its modes from ``plane_latch``, its velocities and load, and
+ * (exact FREE and FIXED parts) its forces added to ``force`` (6, generalized, inertial)
+ * and their dissipation to xdot[dissipated_rolling] (xdot may be NULL).  ``dw`` and
+ * ``G`` the plane's maps (ballc_parameters_t.rolling_map, rolling_force_map). */
+void ballc_rolling_assemble(const double *local, const double *params, const double *constants,
+                            const double *inputs, const double *plane_latch,
+                            const double *dw, const double *G, ballc_rolling_eval *roll,
+                            double *force, double *xdot);
+
+/* M z = b solved in place (b: 6), by the caller's factor of the mass matrix. */
+typedef void (*ballc_mass_solve)(const void *factor, double *b);
+
+/* Hold the velocities in ``mask`` of one plane constant: the slip u (BALLC_HOLD_SLIP:
+ * ``slip_du`` 2 x N_STATES and ``slip_G`` 6 x 2, its force at the contact point) and the
+ * held parts of ``roll``.  The constraint forces lambda solve W lambda = -(dv/d speeds)
+ * udot_0 (W the Delassus matrix of the held velocities, at most 5 x 5); udot (6) becomes
+ * udot_0 + M^-1 G lambda.  lambda goes to slip_lambda (2) and roll->lambda.  Returns
+ * 0, or BALLC_SINGULAR (_system.h) when W is singular. */
+int ballc_rolling_hold(int mask, const double *slip_du, const double *slip_G,
+                       ballc_rolling_eval *roll, ballc_mass_solve solve, const void *factor,
+                       double *udot, double *slip_lambda);
+
+/* The impulse that sets the velocities in ``mask`` to 0 (v = current values: the slip u
+ * (2) first when BALLC_HOLD_SLIP, then the rolling (2) and the twisting (1) velocity):
+ * P = -W^-1 v, added to the speeds (6) as M^-1 G P.  Returns 0 or BALLC_SINGULAR. */
+int ballc_rolling_impulse(int mask, const double *slip_u, const double *slip_du,
+                          const double *slip_G, const ballc_rolling_eval *roll,
+                          ballc_mass_solve solve, const void *factor, double *speeds);
+
+/* Add the exact FREE / FIXED forces' derivatives: F = -mu F_n e(w) (de/dw = sign (I - e
+ * e^T) / |w| for a FREE rolling part, 0 otherwise), to dF (6 x N_STATES) through G, and
+ * those of their dissipation rate mu F_n (e . w) to the row of dissipated_rolling of
+ * ``jac``.  ``load_jac``: dF_n/dx (N_STATES). */
+void ballc_rolling_jacobian(const ballc_rolling_eval *roll, const double *params,
+                            const double *plane_latch, const double *load_jac, double *dF,
+                            double *jac);
+
+/* ---- the segment loop's part (_driver.c): the exact modes' guards and resets ---- */
+
+/* The events of a plane's rolling part, in the order a segment lists them (the segment
+ * loop's event kinds follow the Coulomb and compliant ones in this order). */
+enum {
+    BALLC_ROLLING_APPROACH = 0,  /* FREE: v_roll . d - approach falls through 0 */
+    BALLC_ROLLING_STOP,          /* FIXED: v_roll . d + margin falls through 0 */
+    BALLC_ROLLING_CLEAR,         /* FIXED: v_roll . d - 2 clear rises through 0 */
+    BALLC_ROLLING_RELEASE,       /* HOLDING: mu_r F_n - |lambda_r| + scale falls through 0 */
+    BALLC_TWISTING_STOP,         /* FIXED: v_twist d + margin falls through 0 */
+    BALLC_TWISTING_RELEASE,      /* HOLDING: mu_t F_n - |lambda_w| + scale falls through 0 */
+    BALLC_ROLLING_EVENTS
+};
+
+/* What the segment loop keeps of a plane's exact rolling modes between segments. */
+typedef struct {
+    double approach;        /* the next approach event's speed (when has_approach) */
+    int has_approach;
+    long relatches;         /* approaches that re-latched the direction (at most 1000) */
+} ballc_rolling_run;
+
+/* One guard of a plane's rolling part: linear, g = row . y + offset, or not, g = the
+ * margin (ballc_rolling_guard_value) + offset. */
+typedef struct {
+    int event;              /* BALLC_ROLLING_* */
+    int linear;
+    double row[BALLC_N_STATES];
+    double offset;
+    int direction;
+} ballc_rolling_guard;
+
+/* The scales of a run the guards and resets use: error = rtol (|v| + r |omega|) + atol
+ * at the segment's start (stickslip.error_speed), clear = 100 error, margin = 4 ulp of
+ * |v| + r |omega|, weight = (m + m_o) |g| (the force scale 64 eps (weight + |F_n|)). */
+typedef struct { double error, clear, margin, weight; } ballc_rolling_scales;
+
+struct ballc_parameters;   /* _system.h's ballc_parameters_t */
+
+/* The guards of plane ``plane``'s rolling part in its modes (``latch``) at the segment's
+ * start y0 under ``flags`` (the segment's): at most 3, written to ``out``; the count, or
+ * -1 when a kernel failed. */
+int ballc_rolling_guards(const struct ballc_parameters *params, int plane, const double *y0,
+                         const double *latch, int flags, const ballc_rolling_run *run,
+                         const ballc_rolling_scales *scales, ballc_rolling_guard *out);
+
+/* A non-linear guard's margin at y (without its offset): BALLC_ROLLING_RELEASE's
+ * mu_r F_n - |lambda_r|, BALLC_TWISTING_RELEASE's mu_t F_n - |lambda_w|. */
+int ballc_rolling_guard_value(const struct ballc_parameters *params, int plane, int event,
+                              const double *y, const double *latch, int flags, double *g);
+
+/* The reset of ``event`` on ``plane`` at (y, latch), both updated in place (``stick``:
+ * the plane's Coulomb mode sticks, its slip is held with the rolling part's velocities).
+ * 0, or -1 when a kernel failed. */
+int ballc_rolling_transition(const struct ballc_parameters *params, int plane, int event,
+                             double *y, double *latch, int flags, int stick,
+                             ballc_rolling_run *run, const ballc_rolling_scales *scales);
+
+/* A contact starts on ``plane`` with the exact rolling (``rolling``) and twisting
+ * (``twisting``) parts on: their first modes (as Coulomb's start: free, fixed, or
+ * settled); 0 or -1. */
+int ballc_rolling_start(const struct ballc_parameters *params, int plane, int rolling,
+                        int twisting, double *y, double *latch, int flags, int stick,
+                        ballc_rolling_run *run, const ballc_rolling_scales *scales);
+
+/* After a reset of ``plane`` that moved the state (an impulse that removed a velocity
+ * left over), each exact rolling and twisting part that slides must still be on its
+ * guard's side: its velocity along its latched direction above the approach speed
+ * (free) or above -margin (fixed) -- else its guard, starting below 0, would never fire,
+ * and its force would push along the motion.  A part that is not starts afresh (as at a
+ * contact's start).  Returns the number of parts restarted, or -1. */
+int ballc_rolling_recheck(const struct ballc_parameters *params, int plane, double *y,
+                          double *latch, int flags, int stick, ballc_rolling_run *run,
+                          const ballc_rolling_scales *scales);
+
+/* The held velocities of ``plane`` (its latch), with its slip when ``stick``: the mask
+ * an impulse that zeroes one of them must hold the others with (BALLC_HOLD_*). */
+int ballc_rolling_held_mask(const double *latch, int plane, int stick);
+
+#endif
