@@ -734,6 +734,30 @@ static int settles(run_t *r, int p)
     return 0;
 }
 
+/* A stick's release: slip from rest along -lambda (the slip removed). */
+static int coulomb_release(run_t *r, int p)
+{
+    double out[4], y1[N], dir[2];
+    if (ballc_stick_state(r->y, r->c->params, r->latch, run_flags(r, 1), p, out)
+            != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    double size = hypot(out[0], out[1]);
+    const double *d = NULL;
+    if (size > 0) {
+        dir[0] = -out[0] / size;
+        dir[1] = -out[1] / size;
+        d = dir;
+    }
+    if (remove_slip(r, p, run_flags(r, 0), y1) != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    memcpy(r->y, y1, sizeof y1);
+    return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
+}
+
 /* _Run.coulomb_event */
 static int coulomb_event(run_t *r, int kind, int p)
 {
@@ -759,27 +783,8 @@ static int coulomb_event(run_t *r, int kind, int p)
                         py_min(clear, APPROACH_FRACTION * speed));
     case K_CLEAR:
         return set_mode(r, p, BALLC_MODE_SLIP, direction, 0, 0.0);
-    default: {   /* release */
-        double out[4], y1[N];
-        if (ballc_stick_state(r->y, r->c->params, r->latch, run_flags(r, 1), p, out)
-                != BALLC_OK) {
-            r->failed_kernel = 1;
-            return -1;
-        }
-        double size = hypot(out[0], out[1]);
-        const double *d = NULL;
-        if (size > 0) {
-            dir[0] = -out[0] / size;
-            dir[1] = -out[1] / size;
-            d = dir;
-        }
-        if (remove_slip(r, p, run_flags(r, 0), y1) != BALLC_OK) {
-            r->failed_kernel = 1;
-            return -1;
-        }
-        memcpy(r->y, y1, sizeof y1);
-        return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
-    }
+    default:   /* release */
+        return coulomb_release(r, p);
     }
 }
 
@@ -809,12 +814,14 @@ static int start_rolling(run_t *r, int p)
     return recheck_modes(r, p);
 }
 
-/* After a reset of plane p that moved the state (an impulse: a settle, a release), the
- * exact modes that slide must still be on their guards' side (_rolling.h,
+/* After a reset of plane p that moved the state or changed what holds (a settle, a
+ * release), every exact mode must still be on its guard's side (_rolling.h,
  * ballc_rolling_recheck): a Coulomb slip with u . d above its approach speed (free) or
- * above -margin (fixed), and so the rolling and twisting parts; one that is not starts
- * afresh, which may move the state again (a few passes).  Only with rolling
- * resistance: without it, Coulomb's resets keep their own invariants. */
+ * above -margin (fixed), a stick with its margin mu N - |lambda| above -scale (a hold
+ * that starts next to it shares the load: a ball held from rolling on an incline needs
+ * all of m g sin(theta) from friction), and so the rolling and twisting parts; one that
+ * is not starts afresh, or is released, which may move the state again (a few passes).
+ * Only with rolling resistance: without it, Coulomb's resets keep their own invariants. */
 static int recheck_modes(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
@@ -832,6 +839,17 @@ static int recheck_modes(run_t *r, int p)
                            : -4 * ballc_py_ulp(speed_scale(r, r->y));
             if (!(along > guard)) {
                 if (start_coulomb(r, p)) return -1;
+                restarted++;
+            }
+        } else if (c->exact && mode == BALLC_MODE_STICK) {
+            double out[4];
+            if (ballc_stick_state(r->y, c->params, r->latch, run_flags(r, 1), p, out)
+                    != BALLC_OK) {
+                r->failed_kernel = 1;
+                return -1;
+            }
+            if (out[3] < -force_scale(r, out[2])) {
+                if (coulomb_release(r, p)) return -1;
                 restarted++;
             }
         }

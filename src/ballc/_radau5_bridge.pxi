@@ -65,6 +65,7 @@ cdef extern from "_integrator.h":
         int auto_implicit
         int (*poll)(void *, double) noexcept nogil
         int jacobian_every_step
+        int norm_states
     ctypedef struct radau5_result:
         int status
         char message[240]
@@ -563,10 +564,13 @@ cdef object _solve(radau5_fun fun, radau5_jac jac, void *ctx, int n, t_span, y0,
                    list users=None, bint dense_output=False, controller=None,
                    bint outputs_checked=False, bint refine_events=True,
                    ball_ctx *ball=NULL, method="radau5", bint jacobian_ahead=False,
-                   bint auto_implicit=False, bint jacobian_every_step=False):
+                   bint auto_implicit=False, bint jacobian_every_step=False,
+                   int norm_states=0):
     """``ball``: ballc's system context (solve_system), which re-arms events;
-    ``jacobian_ahead``, ``auto_implicit``, ``jacobian_every_step``: radau5_problem's."""
+    ``jacobian_ahead``, ``auto_implicit``, ``jacobian_every_step``, ``norm_states``:
+    radau5_problem's."""
     cdef radau5_problem p
+    p.norm_states = norm_states
     p.method = _method_code(method)
     p.jacobian_ahead = jacobian_ahead
     p.auto_implicit = auto_implicit
@@ -731,12 +735,25 @@ def solve_system(params, latch, int flags, t_span, y0, *, rtol, atol,
                  (flags & (BALLC_FLOOR_COMPLIANT | BALLC_CEILING_COMPLIANT)) != 0,
                  bool(auto_implicit),
                  (flags & (BALLC_FLOOR_COMPLIANT_SLIDING
-                           | BALLC_CEILING_COMPLIANT_SLIDING)) != 0)
+                           | BALLC_CEILING_COMPLIANT_SLIDING)) != 0,
+                 _norm_states(params))
     if errors:
         raise errors[0]
     # each system event's code at the end (a capacity guard re-armed in C has toggled)
     sol.system_events = planes_array[:len(events or ())]
     return sol
+
+
+cdef int _norm_states(params):
+    """radau5_problem.norm_states of ballc's system with ``params``: without rolling
+    resistance its rolling states (last, constant) are left out of the error norms."""
+    if params[_ROLLING_RESISTANCE] == 0 and params[_TWISTING_RESISTANCE] == 0:
+        return BALLC_N_STATES - BALLC_N_ROLLING_STATES
+    return 0
+
+
+_ROLLING_RESISTANCE = PARAMETER_NAMES.index("rolling_resistance")
+_TWISTING_RESISTANCE = PARAMETER_NAMES.index("twisting_resistance")
 
 
 def solve_linear(A, t_span, y0, *, rtol, atol, max_step=np.inf, t_eval=None, events=(),

@@ -445,6 +445,18 @@ int ballc_rolling_recheck(const ballc_parameters_t *params, int plane, double *y
     int restarted = 0;
     for (int part = 0; part < 2; part++) {
         int mode = ballc_rolling_mode(l, part);
+        if (mode == BALLC_ROLLING_MODE_HOLDING) {   /* within its cap, or released */
+            double state[BALLC_ROLLING_STATE_NOUT];
+            if (ballc_rolling_state(y, params, latch, flags, plane, state) != BALLC_OK)
+                return -1;
+            if (state[4 + part] >= -force_scale(scales, state[3])) continue;
+            int event = part ? BALLC_TWISTING_RELEASE : BALLC_ROLLING_RELEASE;
+            if (ballc_rolling_transition(params, plane, event, y, latch, flags, stick, run,
+                                         scales))
+                return -1;
+            restarted++;
+            continue;
+        }
         if (!exact_sliding(mode)) continue;
         velocities(params, plane, y, w);
         const double *d = l + DIRECTION[part], *v = w + FIRST[part];
