@@ -251,6 +251,7 @@ def plane_kernels(model: Model, pieces: dict):
                 "mu = 0 (its normal share, weighted):")
     kernels += slip_kernels(model, plane, pieces["force_map"])
     kernels += rolling_kernels(model, plane, inputs, extra_doc)
+    kernels += sds_kernels(model, plane, inputs, extra_doc)
     margins = contact.compliant_margins(model, plane)
     accel = contact.penetration_acceleration(plane)
     restick = _affine_coefficient(margins[1], accel, "the re-stick margin")
@@ -461,6 +462,95 @@ def rolling_kernels(model: Model, plane: str, inputs, extra_doc):
                "twisting force (6x3 row-major).", constant, [],
                state=CONTACT_STATE_SYMBOLS),
     ]
+
+
+def _generalized_torque(model: Model, torque):
+    """The generalized forces (6) of a torque on the ball (N m): its dot products with
+    the ball's partial angular velocities."""
+    N = model.frame
+    partials = me.partial_velocity([model.ball_frame.ang_vel_in(N)], model.speeds, N)[0]
+    return [me.dot(torque, partial) for partial in partials]
+
+
+def sds_outputs(model: Model, plane: str, part: str, force, rate, dissipation):
+    """An sds kernel's outputs (SDS_LAYOUT): the generalized force of the part's torque
+    (6, the plane's frame), its dissipation rate (1) and the rates of the plane's three
+    rolling spring states (the other part's 0)."""
+    first, count = contact.ROLLING_PARTS[part]
+    rolling_force, twisting_force = contact._part_forces(part, force)
+    torque = contact.rolling_torque(model, plane, rolling_force, twisting_force)
+    rates = [0, 0, 0]
+    rates[first:first + count] = rate
+    return _generalized_torque(model, torque) + [dissipation] + rates
+
+
+#: An sds kernel's outputs: generalized force (6), dissipation rate (1), rates of the
+#: rolling spring states rolling_x, rolling_y, twisting (3).
+SDS_LAYOUT = (("GENERALIZED_FORCE", 6), ("DISSIPATION", 1), ("SPRING_RATE", 3))
+
+
+def sds_kernels(model: Model, plane: str, inputs, extra_doc):
+    """The rolling part's sds model on a plane, in its own frame, per part (rolling,
+    twisting): ``plane_<part>_spring`` (below the cap) and ``plane_<part>_slider`` (at
+    it; its rates at rho'' = 0, and ``plane_<part>_slider_acceleration`` their
+    coefficients of the exact penetration acceleration rho'', which the C core adds after
+    the solve), each with its Jacobian (d/d contact state; the slider's with the
+    contact's own rho''), and ``plane_<part>_margins`` (yield margin, re-stick margin at
+    rho'' = 0, the deflection at the cap mu F_n / k, the re-stick margin's coefficient
+    of rho'')."""
+    state = CONTACT_STATE_SYMBOLS
+    n = len(state)
+    accel = contact.penetration_acceleration(plane)
+    kernels = []
+
+    def local(expressions, name):
+        return contact_state(model, expressions, f"plane kernel {name}")
+
+    layout = "generalized force (6), dissipation rate (1), rolling spring rates (3)"
+    for part in contact.ROLLING_PARTS:
+        spring = sds_outputs(model, plane, part, *contact.sds_spring(model, plane, part))
+        name = f"plane_{part}_spring"
+        doc = f"A plane's contact in its own frame, the {part} part's sds spring (below its cap):"
+        kernels.append(Kernel(name, f"{doc} {layout}.", local(spring, name), inputs,
+                              extra_doc, state=state))
+        kernels.append(jacobian_kernel(model, f"{name}_jac", f"{doc} d(outputs)/d(contact "
+                                       f"state) ({len(spring)}x{n} row-major).",
+                                       local(spring, name), inputs, extra_doc, state=state))
+        slider = sds_outputs(model, plane, part,
+                             *contact.sds_slider(model, plane, part, accel))
+        grows = sm.Symbol(f"{plane}_{part}_slider_grows")
+        own = sds_outputs(model, plane, part,
+                          *contact.sds_slider(model, plane, part, grows=grows))
+        frozen = [(grows, local([contact.slider_grows(model, plane)], name)[0])]
+        name = f"plane_{part}_slider"
+        doc = f"A plane's contact in its own frame, the {part} part's sds slider (at its cap):"
+        for i in range(6):
+            if sm.sympify(slider[i]).has(accel):
+                raise ValueError(f"{name}: a torque depends on {accel}")
+        coefficients = [_affine_coefficient(o, accel, f"{name} output {i}")
+                        for i, o in enumerate(slider[6:], 6)]
+        value = [sm.sympify(o).xreplace({accel: 0}) for o in slider]
+        kernels.append(Kernel(f"{name}_acceleration", f"{doc} the coefficients of the exact "
+                              "penetration acceleration rho'' in its dissipation rate and "
+                              "spring rates (4); the value kernel's are at rho'' = 0.",
+                              local(coefficients, name), inputs, extra_doc, state=state))
+        kernels.append(Kernel(name, f"{doc} {layout}.", local(value, name), inputs, extra_doc,
+                              state=state))
+        kernels.append(jacobian_kernel(model, f"{name}_jac", f"{doc} d(outputs)/d(contact "
+                                       f"state) ({len(own)}x{n} row-major; the contact's own "
+                                       "rho'', the radial form held).", local(own, name),
+                                       inputs, extra_doc, frozen=frozen, state=state))
+        margins = contact.sds_margins(model, plane, part, accel)
+        restick = _affine_coefficient(margins[1], accel, f"the {part} re-stick margin")
+        name = f"plane_{part}_margins"
+        kernels.append(Kernel(
+            name, f"A plane's contact in its own frame, the {part} part's sds mode guards "
+            "(contact.sds_margins): yield margin 1 - k |xi| / (mu F_n), re-stick margin "
+            "(m/s) at rho'' = 0, the deflection at the cap mu F_n / k (m), the re-stick "
+            "margin's coefficient of rho'' (s).",
+            local([margins[0], margins[1].xreplace({accel: 0}), margins[2], restick], name),
+            inputs, extra_doc, state=state))
+    return kernels
 
 
 def output_kernels(model: Model):

@@ -70,7 +70,7 @@ def test_random_oblique_spinning_impacts_never_gain_energy(damping):
 
 
 #: The rolling resistance models the impacts below draw (ballc.scene.ROLLING_MODELS).
-ROLLING_MODELS = ("exact",)
+ROLLING_MODELS = ("exact", "sds")
 
 
 @pytest.mark.parametrize("model", ROLLING_MODELS)
@@ -82,8 +82,12 @@ def test_random_impacts_with_rolling_resistance_never_gain_energy(model):
     dissipated = []
     for _ in range(12):
         scene, v, w = random_impact(rng, restitution=0.6)
+        springs = {} if model == "exact" else dict(   # (no gravity: no default stiffness)
+            rolling_stiffness=10 ** rng.uniform(1, 5), twisting_stiffness=10 ** rng.uniform(1, 5),
+            rolling_damping=rng.uniform(0, 2), twisting_damping=rng.uniform(0, 2))
         scene = scene.replace(rolling_resistance=rng.uniform(0.0, 0.5),
-                              twisting_resistance=rng.uniform(0.0, 0.5), rolling_model=model)
+                              twisting_resistance=rng.uniform(0.0, 0.5), rolling_model=model,
+                              **springs)
         hit = ballc.impact(scene, v, w, rtol=1e-10)
         before, after = kinetic(scene, v, w), kinetic(scene, hit.velocity_after,
                                                      hit.angular_velocity_after)

@@ -69,7 +69,7 @@ def scenes(draw, models=MODELS, mirror_ready=False):
 
 
 #: The rolling resistance models drawn (ballc.scene.ROLLING_MODELS).
-ROLLING_MODELS = ("exact",)
+ROLLING_MODELS = ("exact", "sds")
 
 #: ballc's two compiled integrators: radau5 (the default) and the explicit dop853.
 METHODS = ("radau5", "dop853")

@@ -10,6 +10,10 @@ against closed forms.
   and tan(theta) <= mu; with tan(theta) > mu_r it rolls down at
   g (sin(theta) - mu_r cos(theta)) / (1 + I/(m r^2)); with mu < tan(theta) it slides.
 * The seed's throw with mu_r = 0.01 runs to 1e9 s and ends in closed form.
+* The sds model (LAMMPS' rolling sds, ballc's passive form): a ball rolling a little on
+  its spring oscillates at Omega = sqrt(k_r / (m (1 + I/(m r^2)))), damped by its dashpot
+  as theta'' + gamma_r / (m (1 + I/(m r^2))) theta' + Omega^2 theta = 0; rolling
+  faster, its spring yields to the slider, whose torque is the exact model's.
 * Bad rolling parameters are refused by name.
 """
 import math
@@ -198,3 +202,65 @@ def test_the_seed_throw_with_rolling_resistance_ends_in_closed_form(twisting):
 def test_bad_rolling_parameters_are_refused_by_name(fields, name):
     with pytest.raises(ballc.SceneError, match=name):
         ballc.Scene(**fields)
+
+
+def zero_crossings(t, v):
+    """The times where v changes sign, interpolated linearly."""
+    k = np.flatnonzero(np.sign(v[1:]) * np.sign(v[:-1]) < 0)
+    return t[k] - v[k] * (t[k + 1] - t[k]) / (v[k + 1] - v[k])
+
+
+@pytest.mark.parametrize("gamma", [0.0, 1.0])
+@pytest.mark.parametrize("hollow", [False, True], ids=["solid", "hollow"])
+def test_the_sds_spring_oscillates_at_its_closed_form_frequency(gamma, hollow):
+    """A ball held by the sds rolling spring (below its cap; Coulomb sticks), pushed a
+    little: the rolling angle obeys (I + m r^2) theta'' + gamma r^2 theta' + k r^2 theta
+    = 0, so v_x crosses 0 every half period pi / sqrt(Omega^2 - beta^2), Omega^2 =
+    k / (m (1 + I/(m r^2))), beta = gamma / (2 m (1 + I/(m r^2)))."""
+    k, m, r, v0 = 100.0, 1.0, 0.1, 1e-3
+    ratio = 2 / 3 if hollow else 2 / 5
+    scene = stiff_scene(rolling_model="sds", rolling_resistance=0.1, rolling_stiffness=k,
+                        rolling_damping=gamma, inertia=(ratio * m * r * r,) * 3,
+                        velocity=(v0, 0, 0), angular_velocity=(0, v0 / r, 0))
+    result = ballc.simulate(scene, 3.0, rtol=1e-10, atol=1e-12, rest=False)
+    assert result.status == 0, result.message
+    assert set(result.segments["rolling_before"][:, 0]) == {"spring"}
+    assert set(result.segments["before"][:, 0]) == {"stick"}
+    omega2 = k / (m * (1 + ratio))
+    beta = gamma / (2 * m * (1 + ratio))
+    half = math.pi / math.sqrt(omega2 - beta ** 2)
+    crossings = zero_crossings(result.t, result.y[S["vx"]])
+    assert len(crossings) >= 6
+    np.testing.assert_allclose(np.diff(crossings), half, rtol=1e-5)
+    energy = result.energy
+    assert np.ptp(energy["balance"]) < 1e-9 * energy["total"][0]
+    if gamma:   # the dashpot dissipates; the spring stores and gives back
+        assert energy["dissipated_rolling"][-1] > 0
+        assert np.all(np.diff(energy["dissipated_rolling"]) >= -1e-18)
+    else:
+        assert abs(energy["dissipated_rolling"][-1]) < 1e-15
+        # all the kinetic energy in the spring at the turning points (the samples come
+        # within 1e-5 of them)
+        assert energy["rolling_spring"].max() == pytest.approx(
+            0.5 * m * v0 ** 2 * (1 + ratio), rel=1e-4)
+
+
+def test_the_sds_slider_decelerates_as_the_exact_model():
+    """Rolling fast, the sds spring yields to its slider at once (roll_yield), whose
+    torque is mu_r r F_n: the ball stops where the exact model's does, then springs back
+    by the spring's deflection at the cap, mu_r m g / k_r."""
+    k, v0, mu_r = 1e4, 1.0, 0.01
+    scene = stiff_scene(rolling_model="sds", rolling_resistance=mu_r, rolling_stiffness=k,
+                        rolling_damping=10.0, velocity=(v0, 0, 0), angular_velocity=(0, 10.0, 0))
+    result = ballc.simulate(scene, 30.0, rtol=1e-9, atol=1e-10)
+    assert result.status == 0, result.message
+    log = result.segments
+    assert log["end"][0] == "roll_yield" and log["rolling_after"][0, 0] == "slider"
+    a = mu_r * G / 1.4
+    restick = log[log["end"] == "roll_restick"]
+    assert restick["t_end"][0] == pytest.approx(v0 / a, rel=1e-7)
+    assert result.y[S["x"], -1] == pytest.approx(v0 ** 2 / (2 * a) - mu_r * G / k, rel=1e-7)
+    assert "came to rest" in result.message
+    energy = result.energy
+    assert energy["dissipated_rolling"][-1] == pytest.approx(0.7, rel=1e-7)
+    assert np.ptp(energy["balance"]) < 1e-9

@@ -65,7 +65,9 @@ cdef extern from "_system.h":
                                 double *) nogil
     int ballc_compliant_margins_prepared(const double *, const ballc_parameters_t *,
                                          const double *, int, int, double *) nogil
-    int BALLC_ROLLING_STATE_NOUT
+    int BALLC_ROLLING_STATE_NOUT, BALLC_SDS_MARGINS
+    int ballc_rolling_margins(const double *, const ballc_parameters_t *, const double *, int,
+                              int, double *) nogil
     int ballc_rolling_state(const double *, const ballc_parameters_t *, const double *, int,
                             int, double *) nogil
     int ballc_remove_velocities(const double *, const ballc_parameters_t *, const double *,
@@ -417,6 +419,23 @@ def rolling_state(const double[::1] y, const double[::1] params, const double[::
     cdef int status = ballc_rolling_state(&y[0], &prepared, &latch[0], flags, plane, &o[0])
     if status != BALLC_OK:
         raise FloatingPointError(f"rolling state failed with C status {status}")
+    return out
+
+
+def rolling_margins(const double[::1] y, const double[::1] params, const double[::1] latch,
+                    int flags, int plane):
+    """The sds model's guards on ``plane`` (codegen contact.sds_margins), per part
+    (rolling, twisting): yield margin 1 - k |xi| / (mu F_n), re-stick margin (m/s, with
+    the penetration acceleration of the dynamics under ``flags`` and ``latch``) and the
+    deflection at the cap mu F_n / k (m)."""
+    _check_plane_call(y, params, latch, plane)
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
+    out = np.empty(BALLC_SDS_MARGINS)
+    cdef double[::1] o = out
+    cdef int status = ballc_rolling_margins(&y[0], &prepared, &latch[0], flags, plane, &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"rolling margins failed with C status {status}")
     return out
 
 

@@ -242,6 +242,7 @@ typedef char k_codes_are_segment_ends[((int)K_ENTER == (int)BALLC_SEG_ENTER
                                        && (int)K_DEEPEST == (int)BALLC_SEG_DEEPEST
                                        && (int)K_CAPACITY == (int)BALLC_SEG_CAPACITY
                                        && (int)K_ROLL_FIRST == (int)BALLC_SEG_ROLL_APPROACH
+                                       && (int)K_USER == (int)BALLC_SEG_TWIST_RESTICK + 1
                                        && (int)K_USER == (int)BALLC_SEG_USER) ? 1 : -1];
 
 typedef char integrator_prof_fits[RADAU5_PROF_N == 7 ? 1 : -1];
@@ -253,7 +254,8 @@ const char *const ballc_plane_mode_names[BALLC_N_PLANE_MODES] = {
 const char *const ballc_segment_end_names[BALLC_N_SEGMENT_ENDS] = {
     "enter", "leave", "through", "deepest", "approach", "stop", "clear", "release", "arm",
     "yield", "restick", "capacity", "roll_approach", "roll_stop", "roll_clear",
-    "roll_release", "twist_stop", "twist_release", "user", "t_end", "rest check",
+    "roll_release", "twist_stop", "twist_release", "roll_yield", "roll_restick",
+    "twist_yield", "twist_restick", "user", "t_end", "rest check",
     "uniform check",
     "orbit check", "step bound", "failed"};
 
@@ -688,10 +690,8 @@ static int begin_contact(run_t *r, int p)
 static void end_contact(run_t *r, int p)
 {
     ballc_drive_output *o = r->o;
-    double *l = r->latch + p * NLP;   /* the rolling part rests with the contact */
-    l[BALLC_LATCH_ROLLING_MODE] = l[BALLC_LATCH_TWISTING_MODE] = BALLC_ROLLING_MODE_NONE;
-    l[BALLC_LATCH_ROLLING_DIRECTION_X] = l[BALLC_LATCH_ROLLING_DIRECTION_Y] = 0.0;
-    l[BALLC_LATCH_TWISTING_DIRECTION] = 0.0;
+    if (r->c->rolling || r->c->twisting)   /* the rolling part rests with the contact */
+        ballc_rolling_end(&r->prepared, p, r->y, r->latch);
     r->rest_check[p] = INFINITY;
     r->in_contact[p] = 0;
     r->coulomb[p] = BALLC_MODE_NONE;
@@ -791,21 +791,37 @@ static int coulomb_event(run_t *r, int kind, int p)
 /* ---- rolling resistance's exact modes (_rolling.h) ---- */
 
 /* The scales of the rolling part's guards and resets at y (_rolling.h). */
-static ballc_rolling_scales rolling_scales(const run_t *r, const double *y)
+static ballc_rolling_scales rolling_scales(const run_t *r, int p, const double *y)
 {
-    double error = error_speed(r, y);
-    ballc_rolling_scales s = {error, CLEAR_FACTOR * error, 4 * ballc_py_ulp(speed_scale(r, y)),
-                              r->c->weight};
+    double error = error_speed(r, y), speed = speed_scale(r, y);
+    /* the compliant guards' rounding, with rho at least the arming depth: below it the
+     * margins, of a cap ~ rho^(3/2), are not resolved (compliantmodes.arm_penetration) */
+    double rounding = py_max(64 * DBL_EPSILON,
+                             r->c->ulp8[p] / py_max(rho_of(r, p, y), r->c->rolling_arm[p]));
+    ballc_rolling_scales s = {error, CLEAR_FACTOR * error, 4 * ballc_py_ulp(speed),
+                              r->c->weight, rounding, speed};
     return s;
 }
 
-/* A contact starts: the exact rolling and twisting parts' first modes. */
+/* Whether a plane's sds slider acts: its segments take a Jacobian at every step, as the
+ * compliant law's sliding mode (its turn's stiffness (e . w) / |xi| follows |xi|). */
+static int rolling_slides(const run_t *r)
+{
+    for (int p = 0; p < 2; p++)
+        for (int part = 0; part < 2; part++)
+            if (r->in_contact[p]
+                    && ballc_rolling_mode(r->latch + p * NLP, part) == BALLC_ROLLING_MODE_SLIDER)
+                return 1;
+    return 0;
+}
+
+/* A contact starts: the rolling and twisting parts' first modes. */
 static int start_rolling(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
-    if (c->rolling != 1 && c->twisting != 1) return 0;
-    ballc_rolling_scales scales = rolling_scales(r, r->y);
-    if (ballc_rolling_start(&r->prepared, p, c->rolling == 1, c->twisting == 1, r->y,
+    if (!c->rolling && !c->twisting) return 0;
+    ballc_rolling_scales scales = rolling_scales(r, p, r->y);
+    if (ballc_rolling_start(&r->prepared, p, c->rolling, c->twisting, r->y,
                             r->latch, run_flags(r, 1), r->coulomb[p] == BALLC_MODE_STICK,
                             &r->rolling_run[p], &scales)) {
         r->failed_kernel = 1;
@@ -825,7 +841,7 @@ static int start_rolling(run_t *r, int p)
 static int recheck_modes(run_t *r, int p)
 {
     const ballc_drive_config *c = r->c;
-    if (c->rolling != 1 && c->twisting != 1) return 0;
+    if (!c->rolling && !c->twisting) return 0;
     for (int pass = 0; pass < 8; pass++) {
         int restarted = 0;
         int mode = r->coulomb[p];
@@ -853,7 +869,7 @@ static int recheck_modes(run_t *r, int p)
                 restarted++;
             }
         }
-        ballc_rolling_scales scales = rolling_scales(r, r->y);
+        ballc_rolling_scales scales = rolling_scales(r, p, r->y);
         int n = ballc_rolling_recheck(&r->prepared, p, r->y, r->latch, run_flags(r, 1),
                                       r->coulomb[p] == BALLC_MODE_STICK,
                                       &r->rolling_run[p], &scales);
@@ -870,7 +886,7 @@ static int recheck_modes(run_t *r, int p)
 static int rolling_event(run_t *r, int kind, int p)
 {
     if (!settles(r, p)) return 0;
-    ballc_rolling_scales scales = rolling_scales(r, r->y);
+    ballc_rolling_scales scales = rolling_scales(r, p, r->y);
     r->transitions[p] += 1;
     if (ballc_rolling_transition(&r->prepared, p, kind - K_ROLL_FIRST, r->y, r->latch,
                                  run_flags(r, 1), r->coulomb[p] == BALLC_MODE_STICK,
@@ -942,7 +958,7 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     double out[6];
     (void)t;
     int code = r->ev_plane_code[e];
-    if (r->ev_kind[e] >= K_ROLL_FIRST && r->ev_kind[e] < K_USER)   /* rolling's release */
+    if (r->ev_kind[e] >= K_ROLL_FIRST && r->ev_kind[e] < K_USER)   /* the rolling part's */
         return ballc_rolling_guard_value(&r->prepared, r->ev_plane[e],
                                          r->ev_kind[e] - K_ROLL_FIRST, y, r->latch,
                                          r->seg_flags, g);
@@ -1114,7 +1130,7 @@ static int segment_events(run_t *r, int flags)
         }
         if (r->in_contact[p] && ballc_rolling_on(r->latch + p * NLP)) {   /* _rolling.h */
             ballc_rolling_guard guards[4];
-            ballc_rolling_scales scales = rolling_scales(r, y0);
+            ballc_rolling_scales scales = rolling_scales(r, p, y0);
             int n = ballc_rolling_guards(&r->prepared, p, y0, r->latch, flags,
                                          &r->rolling_run[p], &scales, guards);
             if (n < 0) {
@@ -1461,11 +1477,11 @@ static int at_rest(const run_t *r, const double *y, double t_start, double t)
     const ballc_drive_config *c = r->c;
     if (t - t_start < c->rest_period) return 0;
     double across = 0.0, up = 0.0;
-    /* a ball whose rolling is held rests wherever its observer is: it cannot roll the
-     * observer lower (the holding torque is within its cap, or it would have let go) */
-    int held = c->resting_plane >= 0
-               && ballc_rolling_mode(r->latch + c->resting_plane * NLP, 0)
-                  == BALLC_ROLLING_MODE_HOLDING;
+    /* a ball whose rolling is held (the exact model's holding, or the sds spring below
+     * its cap) rests wherever its observer is: it cannot roll the observer lower */
+    int roll_mode = c->resting_plane >= 0
+                    ? ballc_rolling_mode(r->latch + c->resting_plane * NLP, 0) : 0;
+    int held = roll_mode == BALLC_ROLLING_MODE_HOLDING || roll_mode == BALLC_ROLLING_MODE_SPRING;
     if (c->observer_massive && !held) {   /* resting._observer_offset */
         double where[BALLC_OBSERVER_POSITION_NOUT], d[3];
         ballc_observer_position(y, c->params, r->prepared.constants, NULL, where);
@@ -1476,8 +1492,7 @@ static int at_rest(const run_t *r, const double *y, double t_start, double t)
     }
     double e[BALLC_ENERGY_NOUT];
     energy_of(r, y, e);
-    double kinetic = e[0], spring = e[4] + e[5];
-    for (int i = 6; i < BALLC_ENERGY_NOUT; i++) spring += e[i];   /* rolling springs */
+    double kinetic = e[0], spring = e[4] + e[5];   /* (a rolling spring's is a static load's) */
     double rho = c->radius - y[BALLC_STATE_Z];
     double x = (rho - c->rho_eq) / c->rho_eq;
     double normal = INFINITY;
@@ -1713,9 +1728,7 @@ static int end_state(run_t *r, int p)
         new_y[BALLC_STATE_Z] = c->z_eq;
         new_y[BALLC_STATE_FLOOR_DEFLECTION_X] = new_y[BALLC_STATE_FLOOR_DEFLECTION_Y] = 0.0;
         new_y[BALLC_STATE_CEILING_DEFLECTION_X] = new_y[BALLC_STATE_CEILING_DEFLECTION_Y] = 0.0;
-        for (int q = 0; q < BALLC_N_PLANES; q++)   /* the rolling springs relax */
-            for (int i = 0; i < 3; i++) new_y[r->prepared.planes[q].rolling + i] = 0.0;
-        booked(r, r->y, new_y);
+        booked(r, r->y, new_y);   /* (the rolling springs keep the load they hold) */
         memcpy(r->y, new_y, sizeof new_y);
         return BALLC_END_REST;
     }
@@ -2019,7 +2032,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.rearm = drv_rearm;
         pr.method = c->method;
         pr.jacobian_ahead = (flags & c->compliant_any) != 0;
-        pr.jacobian_every_step = (flags & c->compliant_sliding_any) != 0;
+        pr.jacobian_every_step = (flags & c->compliant_sliding_any) != 0
+                                 || rolling_slides(r);
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
         pr.poll = drv_poll;
@@ -2209,6 +2223,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         case K_ROLL_FIRST + BALLC_ROLLING_APPROACH: case K_ROLL_FIRST + BALLC_ROLLING_STOP:
         case K_ROLL_FIRST + BALLC_ROLLING_CLEAR: case K_ROLL_FIRST + BALLC_ROLLING_RELEASE:
         case K_ROLL_FIRST + BALLC_TWISTING_STOP: case K_ROLL_FIRST + BALLC_TWISTING_RELEASE:
+        case K_ROLL_FIRST + BALLC_ROLLING_YIELD: case K_ROLL_FIRST + BALLC_ROLLING_RESTICK:
+        case K_ROLL_FIRST + BALLC_TWISTING_YIELD: case K_ROLL_FIRST + BALLC_TWISTING_RESTICK:
             handled = rolling_event(r, kind, p);
             break;
         default:

@@ -174,6 +174,8 @@ typedef struct {                       /* constants of one run, filled by the br
      * .norm_states: N_STATES - N_ROLLING_STATES without rolling resistance, else 0) */
     int rolling, twisting;
     int norm_states;
+    double rolling_arm[2];             /* compliantmodes.arm_penetration: the rounding of
+                                        * the sds guards takes rho at least this deep */
 } ballc_drive_config;
 
 /* how a run ended at a rest check (ballc.resting): the state from end_t on is end_y */
@@ -222,7 +224,8 @@ enum {
     BALLC_SEG_YIELD, BALLC_SEG_RESTICK, BALLC_SEG_CAPACITY,
     /* rolling resistance's exact modes (_rolling.h, BALLC_ROLLING_* in its order) */
     BALLC_SEG_ROLL_APPROACH, BALLC_SEG_ROLL_STOP, BALLC_SEG_ROLL_CLEAR, BALLC_SEG_ROLL_RELEASE,
-    BALLC_SEG_TWIST_STOP, BALLC_SEG_TWIST_RELEASE,
+    BALLC_SEG_TWIST_STOP, BALLC_SEG_TWIST_RELEASE, BALLC_SEG_ROLL_YIELD,
+    BALLC_SEG_ROLL_RESTICK, BALLC_SEG_TWIST_YIELD, BALLC_SEG_TWIST_RESTICK,
     BALLC_SEG_USER,
     BALLC_SEG_T_END,            /* reached t_end */
     BALLC_SEG_REST_CHECK,       /* a rest check that found rest */

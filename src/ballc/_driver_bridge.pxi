@@ -81,6 +81,7 @@ cdef extern from "_driver.h":
         int (*rearm_fun)(void *, int, double, const double *, double *, double *,
                          double *) noexcept nogil
         int rolling, twisting, norm_states
+        double rolling_arm[2]
     ctypedef struct ballc_contact_rec:
         int plane, ended, passed_through, rate_is_kernel_value
         double t_start, t_end
@@ -439,6 +440,8 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
     c.rolling = k.get("rolling", 0)
     c.twisting = k.get("twisting", 0)
     c.norm_states = k.get("norm_states", 0)
+    for p in range(2):
+        c.rolling_arm[p] = k["rolling_arm"][p] if "rolling_arm" in k else 0.0
     c.compliant_modes = k["compliant_modes"]
     c.compliant_any = k["compliant_any"]
     c.compliant_sliding_any = k["compliant_sliding_any"]

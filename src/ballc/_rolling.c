@@ -7,6 +7,7 @@
 #include "_system.h"
 
 #define NS BALLC_N_STATES
+#define NC BALLC_N_CONTACT_STATES
 #define NQ 7   /* coordinates: the speeds start here */
 #define NU 6
 #define MAX_HELD 5
@@ -29,38 +30,83 @@ static int exact_sliding(int mode)
     return mode == BALLC_ROLLING_MODE_FREE || mode == BALLC_ROLLING_MODE_FIXED;
 }
 
-void ballc_rolling_assemble(const double *local, const double *params, const double *constants,
-                            const double *inputs, const double *plane_latch,
-                            const double *dw, const double *G, ballc_rolling_eval *roll,
-                            double *force, double *xdot)
+typedef void (*kernel_fn)(const double *restrict, const double *restrict,
+                          const double *restrict, const double *restrict, double *restrict);
+
+/* The sds kernels per part (rolling, twisting): spring, slider, the slider's rho''
+ * coefficients, their Jacobians, the margins. */
+static const struct {
+    kernel_fn spring, spring_jac, slider, slider_jac, slider_acceleration, margins;
+} SDS[2] = {
+    {ballc_plane_rolling_spring, ballc_plane_rolling_spring_jac, ballc_plane_rolling_slider,
+     ballc_plane_rolling_slider_jac, ballc_plane_rolling_slider_acceleration,
+     ballc_plane_rolling_margins},
+    {ballc_plane_twisting_spring, ballc_plane_twisting_spring_jac, ballc_plane_twisting_slider,
+     ballc_plane_twisting_slider_jac, ballc_plane_twisting_slider_acceleration,
+     ballc_plane_twisting_margins},
+};
+#define SDS_NOUT BALLC_PLANE_ROLLING_SPRING_NOUT   /* 6 + 1 + 3: kernels.SDS_LAYOUT */
+typedef char sds_layouts_agree[(BALLC_PLANE_ROLLING_SLIDER_NOUT == SDS_NOUT
+                                && BALLC_PLANE_TWISTING_SPRING_NOUT == SDS_NOUT
+                                && BALLC_PLANE_TWISTING_SLIDER_NOUT == SDS_NOUT) ? 1 : -1];
+
+static int sds(int mode)
 {
+    return mode == BALLC_ROLLING_MODE_SPRING || mode == BALLC_ROLLING_MODE_SLIDER;
+}
+
+void ballc_rolling_assemble(const ballc_parameters_t *params, int plane, const double *local,
+                            const double *inputs, const double *plane_latch,
+                            ballc_rolling_eval *roll, double *force, double *xdot)
+{
+    const ballc_plane_t *pl = &params->planes[plane];
+    const double *values = params->values, *constants = params->constants;
     double out[BALLC_PLANE_ROLLING_NOUT];
     for (int part = 0; part < 2; part++) roll->mode[part] = ballc_rolling_mode(plane_latch, part);
-    roll->dw = dw;
-    roll->G = G;
+    roll->dw = params->rolling_map[plane];
+    roll->G = params->rolling_force_map[plane];
     for (int i = 0; i < BALLC_ROLLING_W; i++) roll->e[i] = roll->lambda[i] = 0.0;
-    ballc_plane_rolling(local, params, constants, inputs, out);
+    for (int i = 0; i < 4; i++) roll->acceleration[i] = 0.0;
+    ballc_plane_rolling(local, values, constants, inputs, out);
     for (int i = 0; i < BALLC_ROLLING_W; i++) roll->w[i] = out[i];
     roll->load = out[BALLC_ROLLING_W];
     for (int part = 0; part < 2; part++) {
-        if (!exact_sliding(roll->mode[part])) continue;
+        int mode = roll->mode[part];
+        if (sds(mode)) {   /* the generated spring or slider, in the plane's frame */
+            double k[SDS_NOUT];
+            int slider = mode == BALLC_ROLLING_MODE_SLIDER;
+            (slider ? SDS[part].slider : SDS[part].spring)(local, values, constants, inputs, k);
+            ballc_plane_to_inertial(pl, k, 2);   /* torque and force */
+            for (int i = 0; i < NU; i++) force[i] += k[i];
+            if (xdot) {
+                xdot[BALLC_STATE_DISSIPATED_ROLLING] += k[NU];
+                for (int i = 0; i < 3; i++) xdot[pl->rolling + i] += k[NU + 1 + i];
+                if (slider) {
+                    double c[4];
+                    SDS[part].slider_acceleration(local, values, constants, inputs, c);
+                    for (int i = 0; i < 4; i++) roll->acceleration[i] += c[i];
+                }
+            }
+            continue;
+        }
+        if (!exact_sliding(mode)) continue;
         const int first = FIRST[part], count = COUNT[part];
         const double *d = plane_latch + DIRECTION[part];
         const double *w = roll->w + first;
         double *e = roll->e + first;
         double speed = count == 2 ? sqrt(w[0] * w[0] + w[1] * w[1]) : fabs(w[0]);
-        if (speed > 0 && roll->mode[part] == BALLC_ROLLING_MODE_FREE) {
+        if (speed > 0 && mode == BALLC_ROLLING_MODE_FREE) {
             double along = count == 2 ? w[0] * d[0] + w[1] * d[1] : w[0] * d[0];
             double sign = along < 0 ? -1.0 : 1.0;
             for (int i = 0; i < count; i++) e[i] = sign * w[i] / speed;
         } else {
             for (int i = 0; i < count; i++) e[i] = d[i];
         }
-        const double cap = params[MU[part]] * roll->load;
+        const double cap = values[MU[part]] * roll->load;
         for (int i = 0; i < count; i++) {
             double f = -cap * e[i];
-            const double *g = G + first + i;   /* column first + i of 6 x 3 */
-            for (int k = 0; k < NU; k++) force[k] += g[3 * k] * f;
+            const double *g = roll->G + first + i;   /* column first + i of 6 x 3 */
+            for (int j = 0; j < NU; j++) force[j] += g[3 * j] * f;
             if (xdot) xdot[BALLC_STATE_DISSIPATED_ROLLING] -= f * w[i];
         }
     }
@@ -157,18 +203,43 @@ int ballc_rolling_impulse(int mask, const double *slip_u, const double *slip_du,
     return BALLC_OK;
 }
 
-void ballc_rolling_jacobian(const ballc_rolling_eval *roll, const double *params,
-                            const double *plane_latch, const double *load_jac, double *dF,
-                            double *jac)
+void ballc_rolling_jacobian(const ballc_parameters_t *params, int plane, const double *local,
+                            const double *inputs, const double *plane_latch,
+                            const ballc_rolling_eval *roll, double *dF, double *jac)
 {
+    const ballc_plane_t *pl = &params->planes[plane];
+    const double *values = params->values, *constants = params->constants;
+    double load_jac[BALLC_PLANE_ROLLING_JAC_NOUT], rows[BALLC_PLANE_ROLLING_JAC_NOUT / NC * NS];
+    int have_load = 0;
     for (int part = 0; part < 2; part++) {
-        if (!exact_sliding(roll->mode[part])) continue;
+        int mode = roll->mode[part];
+        if (sds(mode)) {
+            double k[SDS_NOUT * NC], krows[SDS_NOUT * NS];
+            (mode == BALLC_ROLLING_MODE_SLIDER ? SDS[part].slider_jac : SDS[part].spring_jac)(
+                local, values, constants, inputs, k);
+            ballc_plane_state_columns(pl, k, SDS_NOUT, krows);
+            ballc_plane_rows_to_inertial(pl, krows, NS, 0, 2);   /* torque and force rows */
+            for (int i = 0; i < NU * NS; i++) dF[i] += krows[i];
+            for (int j = 0; j < NS; j++) {
+                jac[BALLC_STATE_DISSIPATED_ROLLING * NS + j] += krows[NU * NS + j];
+                for (int i = 0; i < 3; i++)
+                    jac[(pl->rolling + i) * NS + j] += krows[(NU + 1 + i) * NS + j];
+            }
+            continue;
+        }
+        if (!exact_sliding(mode)) continue;
+        if (!have_load) {   /* dF_n/dx: the last row of plane_rolling's Jacobian */
+            ballc_plane_rolling_jac(local, values, constants, inputs, load_jac);
+            ballc_plane_state_columns(pl, load_jac, BALLC_PLANE_ROLLING_JAC_NOUT / NC, rows);
+            have_load = 1;
+        }
+        const double *dN_dx = rows + BALLC_ROLLING_W * NS;
         const int first = FIRST[part], count = COUNT[part];
-        const double mu = params[MU[part]], N = roll->load;
+        const double mu = values[MU[part]], N = roll->load;
         const double *e = roll->e + first, *w = roll->w + first;
         const double *d = plane_latch + DIRECTION[part];
         double de[2][2] = {{0, 0}, {0, 0}};
-        if (count == 2 && roll->mode[part] == BALLC_ROLLING_MODE_FREE) {
+        if (count == 2 && mode == BALLC_ROLLING_MODE_FREE) {
             double speed = hypot(w[0], w[1]);
             if (speed > 0) {
                 double sign = w[0] * d[0] + w[1] * d[1] < 0 ? -1.0 : 1.0;
@@ -180,7 +251,7 @@ void ballc_rolling_jacobian(const ballc_rolling_eval *roll, const double *params
         double ew = 0;
         for (int i = 0; i < count; i++) ew += e[i] * w[i];
         for (int j = 0; j < NS; j++) {
-            double dN = load_jac[j], dwj[2], df[2], de_w = 0;
+            double dN = dN_dx[j], dwj[2], df[2], de_w = 0;
             for (int i = 0; i < count; i++) dwj[i] = roll->dw[(first + i) * NS + j];
             for (int a = 0; a < count; a++) {
                 double turn = 0;
@@ -276,6 +347,14 @@ int ballc_rolling_guards(const ballc_parameters_t *params, int plane, const doub
             c->direction = 1;
             c->event = BALLC_ROLLING_CLEAR;
             c->offset = -2 * scales->clear;
+        } else if (sds(mode)) {   /* the yield or re-stick margin, evaluated in C */
+            ballc_rolling_guard *g = &out[n++];
+            int slider = mode == BALLC_ROLLING_MODE_SLIDER;
+            g->event = part ? (slider ? BALLC_TWISTING_RESTICK : BALLC_TWISTING_YIELD)
+                            : (slider ? BALLC_ROLLING_RESTICK : BALLC_ROLLING_YIELD);
+            g->linear = 0;
+            g->direction = -1;
+            g->offset = slider ? scales->rounding * scales->speed : scales->rounding;
         } else if (mode == BALLC_ROLLING_MODE_HOLDING) {
             if (!have_state
                     && ballc_rolling_state(y0, params, latch, flags, plane, state) != BALLC_OK)
@@ -294,6 +373,14 @@ int ballc_rolling_guards(const ballc_parameters_t *params, int plane, const doub
 int ballc_rolling_guard_value(const ballc_parameters_t *params, int plane, int event,
                               const double *y, const double *latch, int flags, double *g)
 {
+    if (event >= BALLC_ROLLING_YIELD) {   /* the sds margins */
+        double m[BALLC_SDS_MARGINS];
+        int status = ballc_rolling_margins(y, params, latch, flags, plane, m);
+        int part = event >= BALLC_TWISTING_YIELD;
+        int restick = event == BALLC_ROLLING_RESTICK || event == BALLC_TWISTING_RESTICK;
+        *g = m[3 * part + restick];
+        return status;
+    }
     double state[BALLC_ROLLING_STATE_NOUT];
     int status = ballc_rolling_state(y, params, latch, flags, plane, state);
     *g = state[event == BALLC_TWISTING_RELEASE ? 5 : 4];
@@ -344,6 +431,83 @@ static int settle(const ballc_parameters_t *params, int plane, int part, double 
     return 0;
 }
 
+/* ---- the sds model's modes (spring, slider) ---- */
+
+static const int STIFFNESS[2] = {BALLC_PARAMETER_ROLLING_STIFFNESS,
+                                 BALLC_PARAMETER_TWISTING_STIFFNESS};
+
+/* |xi| of a part's spring at y, and its unit direction (0 when |xi| is 0) */
+static double spring_of(const ballc_parameters_t *params, int plane, int part, const double *y,
+                        double *dir)
+{
+    const double *xi = y + params->planes[plane].rolling + FIRST[part];
+    double size = COUNT[part] == 2 ? hypot(xi[0], xi[1]) : fabs(xi[0]);
+    for (int i = 0; i < COUNT[part]; i++) dir[i] = size > 0 ? xi[i] / size : 0.0;
+    return size;
+}
+
+/* The part's spring set to ``size`` along ``dir``; the energy it releases booked as
+ * dissipated (1/2 k (|xi|^2 - size^2)). */
+static void set_spring(const ballc_parameters_t *params, int plane, int part, double *y,
+                       double size, const double *dir)
+{
+    double *xi = y + params->planes[plane].rolling + FIRST[part], old[2];
+    double before = spring_of(params, plane, part, y, old);
+    for (int i = 0; i < COUNT[part]; i++) xi[i] = size * dir[i];
+    y[BALLC_STATE_DISSIPATED_ROLLING] +=
+        0.5 * params->values[STIFFNESS[part]] * (before * before - size * size);
+}
+
+/* compliantmodes.decide for an sds part at its cap (a yield): the slider when its
+ * re-stick margin with the spring at the cap is >= 0 (the elastic law would stretch it
+ * past the cap), else the spring (it only touched the cap), brought back to the cap
+ * when beyond it.  Without load (the cap 0: a contact's last instants) the spring is
+ * relaxed. */
+static int sds_decide(const ballc_parameters_t *params, int plane, int part, double *y,
+                      double *latch, int flags)
+{
+    double *l = latch + plane * NLP, m[BALLC_SDS_MARGINS], dir[2], w[BALLC_ROLLING_W];
+    if (ballc_rolling_margins(y, params, latch, flags, plane, m) != BALLC_OK) return -1;
+    double cap = m[3 * part + 2];
+    double size = spring_of(params, plane, part, y, dir);
+    if (!(cap > 0)) {
+        set_spring(params, plane, part, y, 0.0, dir);
+        set_part(l, part, BALLC_ROLLING_MODE_SPRING, NULL);
+        return 0;
+    }
+    if (!(size > 0)) {   /* along the velocity, or the spring it is */
+        velocities(params, plane, y, w);
+        if (!(part_velocity(w, part, dir) > 0)) {
+            set_part(l, part, BALLC_ROLLING_MODE_SPRING, NULL);
+            return 0;
+        }
+    }
+    double trial[NS];
+    memcpy(trial, y, sizeof trial);
+    set_spring(params, plane, part, trial, cap, dir);
+    set_part(l, part, BALLC_ROLLING_MODE_SLIDER, NULL);
+    if (ballc_rolling_margins(trial, params, latch, flags, plane, m) != BALLC_OK) return -1;
+    if (m[3 * part + 1] >= 0) {
+        memcpy(y, trial, sizeof trial);
+        return 0;
+    }
+    set_part(l, part, BALLC_ROLLING_MODE_SPRING, NULL);
+    if (size > cap) set_spring(params, plane, part, y, cap, dir);
+    return 0;
+}
+
+/* A slider re-sticks: the spring, brought back to the cap when beyond it. */
+static int sds_restick(const ballc_parameters_t *params, int plane, int part, double *y,
+                       double *latch, int flags)
+{
+    double m[BALLC_SDS_MARGINS], dir[2];
+    if (ballc_rolling_margins(y, params, latch, flags, plane, m) != BALLC_OK) return -1;
+    double size = spring_of(params, plane, part, y, dir);
+    set_part(latch + plane * NLP, part, BALLC_ROLLING_MODE_SPRING, NULL);
+    if (size > m[3 * part + 2]) set_spring(params, plane, part, y, fmax(m[3 * part + 2], 0.0), dir);
+    return 0;
+}
+
 /* _Run.start_coulomb for a part: FREE when clear of 0 (rolling only), FIXED when moving,
  * else settled. */
 static int start_part(const ballc_parameters_t *params, int plane, int part, double *y,
@@ -368,10 +532,18 @@ int ballc_rolling_start(const ballc_parameters_t *params, int plane, int rolling
                         int twisting, double *y, double *latch, int flags, int stick,
                         ballc_rolling_run *run, const ballc_rolling_scales *scales)
 {
+    const int model[2] = {rolling, twisting};
     run->relatches = 0;
     run->has_approach = 0;
-    if (rolling && start_part(params, plane, 0, y, latch, flags, stick, run, scales)) return -1;
-    if (twisting && start_part(params, plane, 1, y, latch, flags, stick, run, scales)) return -1;
+    for (int part = 0; part < 2; part++) {
+        if (model[part] == 1) {   /* exact */
+            if (start_part(params, plane, part, y, latch, flags, stick, run, scales)) return -1;
+        } else if (model[part] == 2) {   /* sds: the spring from rest (its yield follows) */
+            double *xi = y + params->planes[plane].rolling + FIRST[part];
+            for (int i = 0; i < COUNT[part]; i++) xi[i] = 0.0;
+            set_part(latch + plane * NLP, part, BALLC_ROLLING_MODE_SPRING, NULL);
+        }
+    }
     return 0;
 }
 
@@ -380,6 +552,12 @@ int ballc_rolling_transition(const ballc_parameters_t *params, int plane, int ev
                              ballc_rolling_run *run, const ballc_rolling_scales *scales)
 {
     double *l = latch + plane * NLP, w[BALLC_ROLLING_W], dir[2];
+    if (event >= BALLC_ROLLING_YIELD) {   /* the sds model */
+        int sds_part = event >= BALLC_TWISTING_YIELD;
+        if (event == BALLC_ROLLING_YIELD || event == BALLC_TWISTING_YIELD)
+            return sds_decide(params, plane, sds_part, y, latch, flags);
+        return sds_restick(params, plane, sds_part, y, latch, flags);
+    }
     int part = event == BALLC_TWISTING_STOP || event == BALLC_TWISTING_RELEASE;
     velocities(params, plane, y, w);
     double speed = part_velocity(w, part, dir);
@@ -457,6 +635,18 @@ int ballc_rolling_recheck(const ballc_parameters_t *params, int plane, double *y
             restarted++;
             continue;
         }
+        if (sds(mode)) {   /* the spring within its cap, the slider stretched */
+            double m[BALLC_SDS_MARGINS];
+            if (ballc_rolling_margins(y, params, latch, flags, plane, m) != BALLC_OK) return -1;
+            int slider = mode == BALLC_ROLLING_MODE_SLIDER;
+            double margin = m[3 * part + slider];
+            double guard = slider ? scales->rounding * scales->speed : scales->rounding;
+            if (margin >= -guard || !(m[3 * part + 2] > 0)) continue;   /* or no load */
+            if ((slider ? sds_restick : sds_decide)(params, plane, part, y, latch, flags))
+                return -1;
+            restarted++;
+            continue;
+        }
         if (!exact_sliding(mode)) continue;
         velocities(params, plane, y, w);
         const double *d = l + DIRECTION[part], *v = w + FIRST[part];
@@ -468,4 +658,14 @@ int ballc_rolling_recheck(const ballc_parameters_t *params, int plane, double *y
         restarted++;
     }
     return restarted;
+}
+
+void ballc_rolling_end(const ballc_parameters_t *params, int plane, double *y, double *latch)
+{
+    double *l = latch + plane * NLP, dir[2];
+    for (int part = 0; part < 2; part++) {
+        if (spring_of(params, plane, part, y, dir) > 0) set_spring(params, plane, part, y, 0.0, dir);
+        l[MODE[part]] = BALLC_ROLLING_MODE_NONE;
+        for (int i = 0; i < COUNT[part]; i++) l[DIRECTION[part] + i] = 0.0;
+    }
 }

@@ -49,6 +49,9 @@ typedef struct {
     double lambda[BALLC_ROLLING_W];   /* HOLDING: the constraint forces */
     const double *dw;       /* dw/dx (3 x N_STATES), constants */
     const double *G;        /* generalized force of unit F_r (t1, t2), F_w (6 x 3, inertial) */
+    /* sds sliders: the coefficients of rho'' in the rolling dissipation rate and the
+     * rolling spring rates (x, y, twisting), added after the solve (0 without) */
+    double acceleration[4];
 } ballc_rolling_eval;
 
 /* The part modes in a plane's latch block (BALLC_N_LATCH_PER_PLANE values). */
@@ -67,14 +70,18 @@ static inline int ballc_rolling_on(const double *plane_latch)
 /* The mask of the parts held (BALLC_HOLD_ROLLING, BALLC_HOLD_TWISTING). */
 int ballc_rolling_held(const ballc_rolling_eval *roll);
 
+struct ballc_parameters;   /* _system.h's ballc_parameters_t */
+
 /* A plane's rolling part at the contact state ``local`` (its frame) with the plane
  * kernel inputs ``inputs``: its modes from ``plane_latch``, its velocities and load, and
- * (exact FREE and FIXED parts) its forces added to ``force`` (6, generalized, inertial)
- * and their dissipation to xdot[dissipated_rolling] (xdot may be NULL).  ``dw`` and
- * ``G`` the plane's maps (ballc_parameters_t.rolling_map, rolling_force_map). */
-void ballc_rolling_assemble(const double *local, const double *params, const double *constants,
-                            const double *inputs, const double *plane_latch,
-                            const double *dw, const double *G, ballc_rolling_eval *roll,
+ * its forces added to ``force`` (6, generalized, inertial): the exact FREE and FIXED
+ * parts' -mu F_n e through the plane's maps, the sds parts' generated kernels; their
+ * dissipation to xdot[dissipated_rolling] and the sds springs' rates to the plane's
+ * rolling spring states (xdot may be NULL; the sliders' rho'' shares are left in
+ * roll->acceleration). */
+void ballc_rolling_assemble(const struct ballc_parameters *params, int plane,
+                            const double *local, const double *inputs,
+                            const double *plane_latch, ballc_rolling_eval *roll,
                             double *force, double *xdot);
 
 /* M z = b solved in place (b: 6), by the caller's factor of the mass matrix. */
@@ -97,13 +104,15 @@ int ballc_rolling_impulse(int mask, const double *slip_u, const double *slip_du,
                           const double *slip_G, const ballc_rolling_eval *roll,
                           ballc_mass_solve solve, const void *factor, double *speeds);
 
-/* Add the exact FREE / FIXED forces' derivatives: F = -mu F_n e(w) (de/dw = sign (I - e
- * e^T) / |w| for a FREE rolling part, 0 otherwise), to dF (6 x N_STATES) through G, and
- * those of their dissipation rate mu F_n (e . w) to the row of dissipated_rolling of
- * ``jac``.  ``load_jac``: dF_n/dx (N_STATES). */
-void ballc_rolling_jacobian(const ballc_rolling_eval *roll, const double *params,
-                            const double *plane_latch, const double *load_jac, double *dF,
-                            double *jac);
+/* Add the rolling part's derivatives: the exact FREE / FIXED forces F = -mu F_n e(w)
+ * (de/dw = sign (I - e e^T) / |w| for a FREE rolling part, 0 otherwise) to dF
+ * (6 x N_STATES) through G, and those of their dissipation rate mu F_n (e . w) to the row
+ * of dissipated_rolling of ``jac``; the sds parts' from their Jacobian kernels (the
+ * sliders' with the contact's own rho''), their spring rates' rows too. */
+void ballc_rolling_jacobian(const struct ballc_parameters *params, int plane,
+                            const double *local, const double *inputs,
+                            const double *plane_latch, const ballc_rolling_eval *roll,
+                            double *dF, double *jac);
 
 /* ---- the segment loop's part (_driver.c): the exact modes' guards and resets ---- */
 
@@ -116,6 +125,11 @@ enum {
     BALLC_ROLLING_RELEASE,       /* HOLDING: mu_r F_n - |lambda_r| + scale falls through 0 */
     BALLC_TWISTING_STOP,         /* FIXED: v_twist d + margin falls through 0 */
     BALLC_TWISTING_RELEASE,      /* HOLDING: mu_t F_n - |lambda_w| + scale falls through 0 */
+    /* the sds model (spring below the cap, slider at it), per part */
+    BALLC_ROLLING_YIELD,         /* SPRING: 1 - k |xi| / (mu F_n) + rounding falls */
+    BALLC_ROLLING_RESTICK,       /* SLIDER: (e . w) - mu F_n' / k + offset falls */
+    BALLC_TWISTING_YIELD,
+    BALLC_TWISTING_RESTICK,
     BALLC_ROLLING_EVENTS
 };
 
@@ -138,10 +152,10 @@ typedef struct {
 
 /* The scales of a run the guards and resets use: error = rtol (|v| + r |omega|) + atol
  * at the segment's start (stickslip.error_speed), clear = 100 error, margin = 4 ulp of
- * |v| + r |omega|, weight = (m + m_o) |g| (the force scale 64 eps (weight + |F_n|)). */
-typedef struct { double error, clear, margin, weight; } ballc_rolling_scales;
-
-struct ballc_parameters;   /* _system.h's ballc_parameters_t */
+ * |v| + r |omega|, weight = (m + m_o) |g| (the force scale 64 eps (weight + |F_n|)),
+ * rounding = the compliant guards' (8 ulp of the plane's position over rho, >= 64 eps)
+ * and speed = |v| + r |omega| (the sds guards' offsets: rounding, rounding speed). */
+typedef struct { double error, clear, margin, weight, rounding, speed; } ballc_rolling_scales;
 
 /* The guards of plane ``plane``'s rolling part in its modes (``latch``) at the segment's
  * start y0 under ``flags`` (the segment's): at most 3, written to ``out``; the count, or
@@ -151,7 +165,8 @@ int ballc_rolling_guards(const struct ballc_parameters *params, int plane, const
                          const ballc_rolling_scales *scales, ballc_rolling_guard *out);
 
 /* A non-linear guard's margin at y (without its offset): BALLC_ROLLING_RELEASE's
- * mu_r F_n - |lambda_r|, BALLC_TWISTING_RELEASE's mu_t F_n - |lambda_w|. */
+ * mu_r F_n - |lambda_r|, BALLC_TWISTING_RELEASE's mu_t F_n - |lambda_w|, the sds
+ * yield and re-stick margins (ballc_rolling_margins). */
 int ballc_rolling_guard_value(const struct ballc_parameters *params, int plane, int event,
                               const double *y, const double *latch, int flags, double *g);
 
@@ -162,12 +177,20 @@ int ballc_rolling_transition(const struct ballc_parameters *params, int plane, i
                              double *y, double *latch, int flags, int stick,
                              ballc_rolling_run *run, const ballc_rolling_scales *scales);
 
-/* A contact starts on ``plane`` with the exact rolling (``rolling``) and twisting
- * (``twisting``) parts on: their first modes (as Coulomb's start: free, fixed, or
- * settled); 0 or -1. */
+/* A contact starts on ``plane`` with the rolling (``rolling``) and twisting
+ * (``twisting``) parts on, each 1 (exact) or 2 (sds), 0 off: their first modes (exact:
+ * as Coulomb's start: free, fixed, or settled; sds: its spring relaxed, and the slider
+ * when the part moves -- the cap starts at 0, the spring would stretch past it -- the
+ * spring otherwise); 0 or -1. */
 int ballc_rolling_start(const struct ballc_parameters *params, int plane, int rolling,
                         int twisting, double *y, double *latch, int flags, int stick,
                         ballc_rolling_run *run, const ballc_rolling_scales *scales);
+
+/* A contact ends on ``plane``: its rolling part rests -- the modes none, the directions
+ * 0, and the sds springs relaxed, the energy they held booked as dissipated (with no
+ * contact there is no spring). */
+void ballc_rolling_end(const struct ballc_parameters *params, int plane, double *y,
+                       double *latch);
 
 /* After a reset of ``plane`` that moved the state (an impulse that removed a velocity
  * left over), each exact rolling and twisting part that slides must still be on its

@@ -230,6 +230,7 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
         ev->load[plane] = 0.0;
         for (int i = 0; i < 4; i++) ev->acceleration[plane][i] = 0.0;
         ev->rolling[plane].mode[0] = ev->rolling[plane].mode[1] = BALLC_ROLLING_MODE_NONE;
+        for (int i = 0; i < 4; i++) ev->rolling[plane].acceleration[i] = 0.0;
     }
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
     for (int plane = 0; plane < NP; plane++) {
@@ -264,10 +265,8 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
             for (int i = 0; i < 4; i++) xdot[target[i]] += sum[BALLC_LAW_DISSIPATION + i];
         }
         if (ballc_rolling_on(law_latch(latch, plane)))   /* the law's fourth part */
-            ballc_rolling_assemble(contact.state, PARAMS(params), contact.inputs,
-                                   law_latch(latch, plane), params->rolling_map[plane],
-                                   params->rolling_force_map[plane], &ev->rolling[plane],
-                                   force, xdot);
+            ballc_rolling_assemble(params, plane, contact.state, contact.inputs,
+                                   law_latch(latch, plane), &ev->rolling[plane], force, xdot);
         if (ev->mode[plane] == MODE_NONE) continue;
         slip_t *slip = &ev->slip[plane];
         slip_of(params, plane, contact.state, slip);
@@ -439,6 +438,14 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
             auxiliary_targets(&params->planes[plane], target);
             double rho_dd = penetration_acceleration(params, plane, udot);
             for (int i = 0; i < 4; i++) xdot[target[i]] += coefficients[i] * rho_dd;
+        }
+    if (xdot)   /* the rolling part's sds sliders: their rho'' shares (_rolling.h) */
+        for (int plane = 0; plane < BALLC_N_PLANES; plane++) {
+            const double *c = ev->rolling[plane].acceleration;
+            if (!c[0] && !c[1] && !c[2] && !c[3]) continue;
+            double rho_dd = penetration_acceleration(params, plane, udot);
+            xdot[BALLC_STATE_DISSIPATED_ROLLING] += c[0] * rho_dd;
+            for (int i = 0; i < 3; i++) xdot[params->planes[plane].rolling + i] += c[1 + i] * rho_dd;
         }
     return all_finite(udot, NU) ? BALLC_OK : BALLC_NOT_FINITE;
 }
@@ -747,13 +754,9 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
                 for (int j = 0; j < NS; j++)
                     jac[target[i] * NS + j] += buf[(BALLC_LAW_DISSIPATION + i) * NS + j];
         }
-        if (ballc_rolling_on(law_latch(latch, plane))) {   /* the law's fourth part */
-            double rolling[BALLC_PLANE_ROLLING_JAC_NOUT], rows[BALLC_PLANE_ROLLING_JAC_NOUT / NC * NS];
-            ballc_plane_rolling_jac(contact.state, PARAMS(params), contact.inputs, rolling);
-            ballc_plane_state_columns(pl, rolling, BALLC_PLANE_ROLLING_JAC_NOUT / NC, rows);
-            ballc_rolling_jacobian(&ev.rolling[plane], params->values, law_latch(latch, plane),
-                                   rows + BALLC_ROLLING_W * NS, dF, jac);
-        }
+        if (ballc_rolling_on(law_latch(latch, plane)))   /* the law's fourth part */
+            ballc_rolling_jacobian(params, plane, contact.state, contact.inputs,
+                                   law_latch(latch, plane), &ev.rolling[plane], dF, jac);
     }
     /* d udot / dx_j = M^-1 (dF/dx_j - d(M udot)/dx_j); M depends on q only. */
     for (int j = 0; j < NS; j++) {
@@ -814,6 +817,33 @@ int ballc_rolling_state(const double *state, const ballc_parameters_t *params,
     return all_finite(out, BALLC_ROLLING_STATE_NOUT) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
+int ballc_rolling_margins(const double *state, const ballc_parameters_t *params,
+                          const double *latch, int flags, int plane, double *out)
+{
+    static void (*const MARGINS[2])(const double *restrict, const double *restrict,
+                                    const double *restrict, const double *restrict,
+                                    double *restrict) = {ballc_plane_rolling_margins,
+                                                         ballc_plane_twisting_margins};
+    for (int i = 0; i < BALLC_SDS_MARGINS; i++) out[i] = NAN;
+    if (plane < 0 || plane >= NP) return BALLC_SINGULAR;
+    if (!all_finite(state, NS) || !all_finite(latch, BALLC_N_LATCH)) return BALLC_NOT_FINITE;
+    schur_t factor;
+    evaluation_t ev;
+    double udot[NU], m[BALLC_PLANE_ROLLING_MARGINS_NOUT];
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+    if (status != BALLC_OK) return status;
+    double rho_dd = penetration_acceleration(params, plane, udot);
+    plane_contact_t contact;
+    plane_contact(params, plane, state, latch, &contact);
+    for (int part = 0; part < 2; part++) {
+        MARGINS[part](contact.state, PARAMS(params), contact.inputs, m);
+        out[3 * part] = m[0];
+        out[3 * part + 1] = m[1] + m[3] * rho_dd;
+        out[3 * part + 2] = m[2];
+    }
+    return all_finite(out, BALLC_SDS_MARGINS) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
 int ballc_remove_velocities(const double *state, const ballc_parameters_t *params,
                             const double *latch, int flags, int plane, int mask,
                             double *state_out)
@@ -833,9 +863,8 @@ int ballc_remove_velocities(const double *state, const ballc_parameters_t *param
     slip_t slip;
     slip_of(params, plane, contact.state, &slip);
     ballc_rolling_eval *roll = &ev.rolling[plane];
-    ballc_rolling_assemble(contact.state, PARAMS(params), contact.inputs,
-                           law_latch(latch, plane), params->rolling_map[plane],
-                           params->rolling_force_map[plane], roll, force, NULL);
+    ballc_rolling_assemble(params, plane, contact.state, contact.inputs,
+                           law_latch(latch, plane), roll, force, NULL);
     status = ballc_rolling_impulse(mask, slip.u, slip.du, slip.G, roll, mass_solve, &factor,
                                    state_out + NQ);
     if (status != BALLC_OK) return status;

@@ -158,6 +158,14 @@ int ballc_stick_state(const double *state, const double *params, const double *l
 int ballc_rolling_state(const double *state, const ballc_parameters_t *params,
                         const double *latch, int flags, int plane, double *out);
 
+/* The sds model's mode guards of ``plane``'s rolling and twisting parts (_rolling.h,
+ * codegen contact.sds_margins), 3 per part: the yield margin 1 - k |xi| / (mu F_n), the
+ * re-stick margin (m/s, with the exact penetration acceleration of the dynamics under
+ * ``flags`` and ``latch``: one solve) and the deflection at the cap mu F_n / k (m). */
+#define BALLC_SDS_MARGINS 6
+int ballc_rolling_margins(const double *state, const ballc_parameters_t *params,
+                          const double *latch, int flags, int plane, double *out);
+
 /* state_out = state with the velocities of ``plane`` in ``mask`` (_rolling.h
  * BALLC_HOLD_*: its slip, rolling and twisting velocities) set to zero by one impulse
  * of the constraint forces that hold them (P = -W^-1 v, W their Delassus matrix); used

@@ -1052,7 +1052,9 @@ def rolling_config(scene):
     twisting = model if scene.twisting_resistance > 0 else 0
     on = rolling or twisting
     return dict(rolling=rolling, twisting=twisting,
-                norm_states=0 if on else _core.N_STATES - _core.N_ROLLING_STATES)
+                norm_states=0 if on else _core.N_STATES - _core.N_ROLLING_STATES,
+                rolling_arm=[float(compliantmodes.arm_penetration(scene, plane))
+                             for plane in PLANES])
 
 
 #: Scene.rolling_model -> the C loop's code (_driver.h ballc_drive_config.rolling)
