@@ -534,8 +534,9 @@ def _resolve_rolling(s: Scene) -> None:
     if s.rolling_model != "sds" or not (s.rolling_resistance > 0 or s.twisting_resistance > 0):
         return
     derived = list(s._derived)
-    missing = [name for name in ("rolling_stiffness", "twisting_stiffness")
-               if getattr(s, name) is None]
+    missing = [f"{part}_stiffness" for part in ("rolling", "twisting")
+               if getattr(s, f"{part}_resistance") > 0
+               and getattr(s, f"{part}_stiffness") is None]
     if missing and not s.gravity > 0:
         _fail(missing[0], None, "needs a value without gravity: its default is Ai et al.'s "
               "2.25 mu_r^2 k_n at the ball's static load, which gravity = 0 does not have")
@@ -552,7 +553,7 @@ def _resolve_rolling(s: Scene) -> None:
     inertia = {"rolling_damping": (sum(s.inertia) / 3 + mass * radius ** 2, "rolling_stiffness"),
                "twisting_damping": (sum(s.inertia) / 3, "twisting_stiffness")}
     for name, (moment, spring) in inertia.items():
-        if getattr(s, name) is None:
+        if getattr(s, name) is None and getattr(s, spring) is not None:
             gamma = ROLLING_DAMPING_FRACTION * 2 * math.sqrt(moment * getattr(s, spring)) / radius
             object.__setattr__(s, name, float(gamma))
             derived.append(name)
