@@ -55,6 +55,17 @@ def _shallow_start():
     return scene, y0
 
 
+def _spinning_stiff_ball():
+    """A stiff ball at rest on the floor, spinning about the normal, sds twisting."""
+    scene = ballc.Scene(tangential_model="friction", observer_mass=0.0, radius=0.1,
+                        ball_youngs_modulus=2e11, plane_youngs_modulus=2e11, c_tau=0.5,
+                        friction_coefficient=0.5, rolling_resistance=0.05,
+                        twisting_resistance=0.1, rolling_model="sds", position=(0, 0, 0.1),
+                        velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 10.0))
+    depth = ballc.resting.equilibrium_penetration(scene)
+    return scene.replace(position=(0.0, 0.0, scene.radius - depth)), None
+
+
 SCENES = {
     # the seed: exact Coulomb friction (approach, stop, clear, stick, release); its slips
     # that approach zero and grow again (clear) come after its first 5 s
@@ -77,6 +88,12 @@ SCENES = {
     # holding): every one of their events within the seed's ~44 s to rest
     "rolling resistance": (lambda: (ballc.Scene(rolling_resistance=0.1,
                                                 twisting_resistance=0.05), None), 100.0),
+    # its sds model (spring, slider) with the compliant law; a stiff ball spinning on the
+    # floor about the normal, whose twisting slider re-sticks as the spin stops
+    "rolling resistance, sds": (lambda: (ballc.Scene(
+        rolling_resistance=0.05, twisting_resistance=0.05, rolling_model="sds",
+        tangential_model="compliant"), None), 5.0),
+    "rolling resistance, spin sds": (_spinning_stiff_ball, 3.0),
 }
 
 
@@ -195,8 +212,10 @@ def test_the_rolling_part_has_a_mode_exactly_while_its_plane_is_in_contact(runs)
         for part, modes in (("rolling", automaton.EXACT_ROLLING_MODES),
                             ("twisting", automaton.EXACT_TWISTING_MODES)):
             before = segments[f"{part}_before"]
-            if name != "rolling resistance":
+            if not name.startswith("rolling resistance"):
                 assert set(before.ravel()) == {"none"}, name
                 continue
+            if name.endswith("sds"):
+                modes = automaton.SDS_MODES
             assert set(before[flight]) == {"none"}
             assert set(before[~flight & (segments["before"] != "resting")]) <= set(modes)

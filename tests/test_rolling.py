@@ -264,3 +264,37 @@ def test_the_sds_slider_decelerates_as_the_exact_model():
     energy = result.energy
     assert energy["dissipated_rolling"][-1] == pytest.approx(0.7, rel=1e-7)
     assert np.ptp(energy["balance"]) < 1e-9
+
+
+@pytest.mark.parametrize("model", ["exact", "sds"])
+def test_a_spinning_ball_stops_its_spin_at_the_closed_form_time(model):
+    """Twisting resistance: a stiff ball at rest on the floor spinning about the normal at
+    omega0 feels mu_t r m g against the spin, so it stops at t = I omega0 / (mu_t r m g)
+    -- the exact model holds there (twist_stop -> holding); the sds slider re-sticks on
+    its spring (twist_restick) later by half its loading time t_y = xi_cap / (r omega0),
+    xi_cap = mu_t m g / k_w (its spring stretched to the cap carried half the torque
+    meanwhile) -- and its rolling is never touched."""
+    w0, mu_t, r, m = 10.0, 0.1, 0.1, 1.0
+    springs = dict(twisting_stiffness=1e4, twisting_damping=0.0) if model == "sds" else {}
+    scene = stiff_scene(rolling_model=model, rolling_resistance=0.05, twisting_resistance=mu_t,
+                        angular_velocity=(0, 0, w0), **springs)
+    result = ballc.simulate(scene, 1.0, rtol=1e-9, atol=1e-10, rest=False)
+    assert result.status == 0, result.message
+    delay = 0.0 if model == "exact" else \
+        0.5 * mu_t * m * G / springs["twisting_stiffness"] / (r * w0)
+    t_stop = scene.inertia[2] * w0 / (mu_t * r * m * G) + delay
+    log = result.segments
+    end = "twist_stop" if model == "exact" else "twist_restick"
+    after = "holding" if model == "exact" else "spring"
+    stop = log[(log["end"] == end) & (log["twisting_after"][:, 0] == after)]
+    assert stop["t_end"][0] == pytest.approx(t_stop, rel=1e-7 if model == "exact" else 1e-6)
+    before = (result.t < 0.9 * t_stop) & (result.t > 1e-3)
+    np.testing.assert_allclose(result.y[S["omega_z"], before],
+                               w0 - mu_t * r * m * G / scene.inertia[2]
+                               * (result.t[before] - delay),
+                               rtol=0, atol=1e-7)
+    assert np.abs(result.y[S["vx"]:S["vx"] + 3]).max() < 1e-12
+    energy = result.energy
+    assert energy["dissipated_rolling"][-1] == pytest.approx(
+        0.5 * scene.inertia[2] * w0 ** 2 - energy["rolling_spring"][-1]
+        - energy["kinetic"][-1], rel=1e-6)

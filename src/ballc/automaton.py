@@ -56,6 +56,7 @@ ROLLING_PART_MODES = {
 }
 EXACT_ROLLING_MODES = ("rolling", "rolling_fixed", "holding")
 EXACT_TWISTING_MODES = ("twisting", "holding")
+SDS_MODES = ("spring", "slider")
 
 
 @dataclass(frozen=True)
@@ -167,6 +168,23 @@ TRANSITIONS = (
     Transition("twist_release", ("holding",), ("twisting",),
                "mu_t F_n - |lambda_w| + scale falls through 0",
                "twists from rest along -lambda_w", "rolling_event", "twisting"),
+    # the sds model (LAMMPS' rolling sds / twisting sds, ballc's passive form): a spring
+    # below the cap, a slider at it, for each part; a contact starts with the spring
+    # relaxed, and its end relaxes it (the energy booked as dissipated)
+    Transition("roll_yield", ("spring",), SDS_MODES,
+               "1 - k_r |xi| / (mu_r F_n) + rounding falls through 0",
+               "decide at the cap: slider when the re-stick margin there is >= 0, else the "
+               "spring brought back to the cap; without load the spring relaxed",
+               "rolling_event", "rolling"),
+    Transition("roll_restick", ("slider",), ("spring",),
+               "(e . v_roll) - mu_r F_n' / k_r + offset falls through 0 (the spring would "
+               "stretch slower than the cap grows)", "the spring, at (or brought back to) "
+               "the cap", "rolling_event", "rolling"),
+    Transition("twist_yield", ("spring",), SDS_MODES, "as roll_yield, for the twisting part",
+               "as roll_yield", "rolling_event", "twisting"),
+    Transition("twist_restick", ("slider",), ("spring",),
+               "as roll_restick, for the twisting part", "as roll_restick", "rolling_event",
+               "twisting"),
 )
 
 #: How simultaneous events are handled: the earliest terminal event that fired ends the
@@ -177,7 +195,8 @@ TRANSITIONS = (
 #: time of the last one counts as stalled, and 100 in a row stop the run (status -1).
 SIMULTANEOUS = ("leave", "enter", "through", "deepest", "approach", "stop", "clear",
                 "release", "roll_approach", "roll_stop", "roll_clear", "roll_release",
-                "twist_stop", "twist_release", "arm", "yield", "capacity", "restick", "user")
+                "twist_stop", "twist_release", "roll_yield", "roll_restick", "twist_yield",
+                "twist_restick", "arm", "yield", "capacity", "restick", "user")
 
 _HANDLERS = {transition.event: transition.handler for transition in TRANSITIONS}
 
