@@ -63,6 +63,7 @@ cdef extern from "_driver.h":
         const int *user_rearm
         int (*rearm_fun)(void *, int, double, const double *, double *, double *,
                          double *) noexcept nogil
+        int rolling, twisting
     ctypedef struct ballc_contact_rec:
         int plane, ended, passed_through, rate_is_kernel_value
         double t_start, t_end
@@ -84,7 +85,7 @@ cdef extern from "_driver.h":
         long step0, n_steps, coef0
         int terms
         int flight
-        double y0[27]
+        double y0[46]
         int own
         long interpolant
     enum: BALLC_N_PLANE_MODES, BALLC_N_SEGMENT_ENDS
@@ -97,6 +98,10 @@ cdef extern from "_driver.h":
         signed char before[6]
         signed char after[6]
         signed char rearm_kind, rearm_plane, rearm_before, rearm_after
+        signed char rolling_before[6]
+        signed char rolling_after[6]
+        signed char twisting_before[6]
+        signed char twisting_after[6]
     ctypedef struct ballc_drive_output:
         int n_planes, n_states, n_latch
         long n
@@ -136,7 +141,7 @@ cdef extern from "_driver.h":
         long segments
         int end_kind, end_plane
         double end_t
-        double end_y[27]
+        double end_y[46]
         double end_acceleration[3]
         int profiled
         double integrator_ns, drive_ns
@@ -178,13 +183,19 @@ cdef object _segment_record():
                <char *>&g.plane - at, <char *>&g.rearms - at, <char *>&g.before[0] - at,
                <char *>&g.after[0] - at, <char *>&g.rearm_kind - at,
                <char *>&g.rearm_plane - at, <char *>&g.rearm_before - at,
-               <char *>&g.rearm_after - at]
+               <char *>&g.rearm_after - at, <char *>&g.rolling_before[0] - at,
+               <char *>&g.rolling_after[0] - at, <char *>&g.twisting_before[0] - at,
+               <char *>&g.twisting_after[0] - at]
     fields = [("t_start", "f8"), ("t_end", "f8"), ("nfev", "l"), ("njev", "l"), ("nlu", "l"),
               ("nstep", "l"), ("nreject", "l"), ("method", "intc"), ("method_end", "intc"), ("switches", "intc"),
               ("end", "intc"), ("plane", "intc"), ("rearms", "intc"),
               ("before", ("i1", (BALLC_MAX_PLANES,))), ("after", ("i1", (BALLC_MAX_PLANES,))),
               ("rearm_kind", "i1"),
-              ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1")]
+              ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1"),
+              ("rolling_before", ("i1", (BALLC_MAX_PLANES,))),
+              ("rolling_after", ("i1", (BALLC_MAX_PLANES,))),
+              ("twisting_before", ("i1", (BALLC_MAX_PLANES,))),
+              ("twisting_after", ("i1", (BALLC_MAX_PLANES,)))]
     return np.dtype(dict(names=[f[0] for f in fields], formats=[f[1] for f in fields],
                          offsets=offsets, itemsize=sizeof(ballc_segment_rec)))
 
@@ -346,7 +357,7 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
     cdef const int[::1] ulinear = k["user_linear"], uindex = k["user_index"]
     cdef const int[::1] ucount = k["user_count"], udirection = k["user_direction"]
     cdef int n_planes = _planes_of(params)
-    cdef int width = _states(n_planes), n_latch = _latches(n_planes)
+    cdef int width = _states(params, n_planes), n_latch = _latches(n_planes)
     cdef list user_ctx = [k["user_events"], [], k["user_rearms"], progress, (width, n_latch)]
     cdef const int[::1] urearm = k["user_rearm"]
     cdef const double[::1] atol_states = k["atol_states"]   # None: one atol
@@ -418,6 +429,8 @@ def drive(const double[::1] params, const double[::1] y0, dict k, progress=None)
         c.user_index = &uindex[0]
         c.user_count = &ucount[0]
         c.user_direction = &udirection[0]
+    c.rolling = k["rolling"]
+    c.twisting = k["twisting"]
     c.compliant_modes = k["compliant_modes"]
     c.starts_armed = k["starts_armed"]
     c.arm_force_depth = k["arm_force_depth"]

@@ -547,6 +547,10 @@ def _motion_message(scene, plane, t, y, kind):
         v = float(np.linalg.norm(velocity - (velocity @ n) * n))
     what = "rolls uniformly" if kind == "rolling" else (
         "slides uniformly (no force opposes its slip)")
+    if kind == "rolling" and scene.rolling_resistance > 0:   # held: it can only spin
+        spin = float(y[layout.ANGULAR_VELOCITY] @ n)
+        what = (f"is held by its rolling resistance and sticks, spinning about the normal "
+                f"at {spin:.6g} rad/s (no twisting resistance stops it),")
     return (f"{SUCCESS} The ball {what} on the {plane} from t = "
             f"{t:.9g} s at {v:.6g} m/s (ballc.resting: static Hertz "
             f"equilibrium, penetration "
@@ -740,6 +744,11 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
                 "this run needs what only the Python driver does (a kernel that failed where "
                 "it raises), and the Python driver runs only the seed's floor and ceiling "
                 "with gravity along -z: simulate() cannot run this scene")
+        if scene.rolling_on:
+            raise SceneError(
+                "this run needs what only the Python driver does (a kernel that failed where "
+                "it raises), and rolling resistance runs in the C loop only: simulate() "
+                "cannot run this scene")
     run = _Run(scene, options, y_start)
     run.driver = "python"
     t_end, t_eval = options.t_end, options.t_eval
@@ -1013,6 +1022,7 @@ def _c_config(scene, options, progress, rest, checked=False):
             half_mass=0.5 * resting.total_mass(scene))
     modes_on = compliantmodes.uses_modes(scene)
     return dict(
+        **rolling_config(scene),
         compliant_modes=int(modes_on),
         starts_armed=int(compliantmodes.starts_armed(scene)),
         arm_force_depth=compliantmodes.arm_force_depth(scene),
@@ -1039,6 +1049,19 @@ def _c_config(scene, options, progress, rest, checked=False):
         checks_rest=int(bool(rest) and t_eval is None and not options.events),
         t_eval=t_eval, dense_output=int(bool(options.dense_output)),
         exact_flight=int(flight_allowed), **users)
+
+
+def rolling_config(scene):
+    """The rolling part's constants of a C run (_driver.h): each part's model (0 off, 1
+    exact, 2 sds); both 0 without rolling resistance (the run has no rolling states)."""
+    model = ROLLING_MODEL_CODES[scene.rolling_model]
+    rolling = model if scene.rolling_resistance > 0 else 0
+    twisting = model if scene.twisting_resistance > 0 else 0
+    return dict(rolling=rolling, twisting=twisting)
+
+
+#: Scene.rolling_model -> the C loop's code (_driver.h ballc_drive_config.rolling)
+ROLLING_MODEL_CODES = {"exact": 1, "sds": 2}
 
 
 def _c_user_events(events, width):
