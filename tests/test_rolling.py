@@ -53,10 +53,11 @@ def tilted(scene, theta):
     return scene
 
 
-def stop_of(result):
-    """(t, x) where the rolling part first holds (the segment log's roll_stop)."""
+def stop_of(result, plane=0):
+    """(t, x) where the rolling part of the plane with index ``plane`` first holds (the
+    segment log's roll_stop)."""
     log = result.segments
-    held = log[(log["end"] == "roll_stop") & (log["rolling_after"][:, 0] == "holding")]
+    held = log[(log["end"] == "roll_stop") & (log["rolling_after"][:, plane] == "holding")]
     assert held.size, "the ball never held"
     t = held["t_end"][0]
     k = np.searchsorted(result.t, t)
@@ -298,3 +299,104 @@ def test_a_spinning_ball_stops_its_spin_at_the_closed_form_time(model):
     assert energy["dissipated_rolling"][-1] == pytest.approx(
         0.5 * scene.inertia[2] * w0 ** 2 - energy["rolling_spring"][-1]
         - energy["kinetic"][-1], rel=1e-6)
+
+
+# --- on i30b's planes: the rolling part is the law's in a plane's own frame, applied per
+# plane at run time (any plane, any number of planes, its states per plane) -------------
+
+
+def plane_incline(theta, mu, mu_r, hollow=False):
+    """A stiff ball at rest at its static penetration on a real tilted plane (the only
+    plane: its normal (sin(theta), 0, cos(theta)), falling along +x), gravity along -z."""
+    ratio = 2 / 3 if hollow else 2 / 5
+    plane = ballc.Plane((0.0, 0.0, 0.0), (math.sin(theta), 0.0, math.cos(theta)), "incline")
+    scene = ballc.Scene(planes=(plane,), tangential_model="friction", observer_mass=0.0,
+                        radius=0.1, mass=1.0, inertia=(ratio * 0.01,) * 3,
+                        ball_youngs_modulus=2e11, plane_youngs_modulus=2e11, c_tau=0.5,
+                        friction_coefficient=mu, rolling_resistance=mu_r,
+                        position=(0.0, 0.0, 1.0), velocity=(0.0, 0.0, 0.0))
+    rho_eq = (G * math.cos(theta) / scene.hertz_stiffness) ** (2 / 3)
+    n = np.array(plane.unit_normal)
+    return scene.replace(position=tuple((0.1 - rho_eq) * n)), n, ratio
+
+
+def test_on_a_tilted_plane_a_ball_holds_when_tan_theta_is_within_mu_r():
+    """tan(theta) = 0.8 mu_r <= mu: held and sticking, still; to 1e3 s it rests on the
+    incline in closed form (the rest check of a held, sticking ball)."""
+    mu_r = 0.02
+    theta = math.atan(0.8 * mu_r)
+    scene, n, _ = plane_incline(theta, 0.5, mu_r)
+    result = ballc.simulate(scene, 1.0, rtol=1e-9, atol=1e-10, rest=False)
+    assert result.status == 0, result.message
+    log = result.segments
+    assert set(log["rolling_before"][:, 0]) == {"holding"}
+    assert set(log["before"][:, 0]) == {"stick"}
+    assert np.hypot.reduce(result.velocity, axis=0).max() < 1e-9
+    y = np.ascontiguousarray(result.y[:, -1])
+    state = _core.rolling_state(y, scene.parameter_vector(),
+                                np.ascontiguousarray(result.latch[:, -1]),
+                                int(result.flags[-1]), 0)
+    # the holding force balances the friction's moment: |lambda_r| = m g sin(theta)
+    assert np.hypot(state[0], state[1]) == pytest.approx(G * math.sin(theta), rel=1e-6)
+    assert state[3] == pytest.approx(G * math.cos(theta), rel=1e-6)
+    long = ballc.simulate(scene, 1e3)
+    assert long.status == 0 and "came to rest" in long.message, long.message
+    assert np.all(long.velocity[:, -1] == 0)
+
+
+@pytest.mark.parametrize("hollow", [False, True], ids=["solid", "hollow"])
+@pytest.mark.parametrize("mu_r", [0.01, 0.03])
+def test_on_a_tilted_plane_a_ball_rolls_down_at_the_closed_form_acceleration(mu_r, hollow):
+    """tan(theta) = 3 mu_r: a = g (sin(theta) - mu_r cos(theta)) / (1 + I/(m r^2)) down
+    the slope, rolling without slip, nothing across it or into the plane."""
+    theta = math.atan(3 * mu_r)
+    scene, n, ratio = plane_incline(theta, 0.5, mu_r, hollow)
+    result = ballc.simulate(scene, 1.0, rtol=1e-9, atol=1e-10, rest=False)
+    assert result.status == 0, result.message
+    down = np.array([math.cos(theta), 0.0, -math.sin(theta)])
+    later = result.t > 0.2
+    speed = down @ result.velocity[:, later]
+    slope = np.polyfit(result.t[later], speed, 1)[0]
+    assert slope == pytest.approx(G * (math.sin(theta) - mu_r * math.cos(theta)) / (1 + ratio),
+                                  rel=1e-6)
+    spin = np.cross(n, down) @ result.angular_velocity[:, later]
+    np.testing.assert_allclose(speed, 0.1 * spin, rtol=0, atol=1e-8)
+    assert np.abs(result.velocity[1]).max() < 1e-12
+    assert np.abs(n @ result.velocity).max() < 1e-8
+    assert result.segments["rolling_after"][-1, 0] in ("rolling", "rolling_fixed")
+
+
+@pytest.mark.parametrize("model", ["exact", "sds"])
+def test_the_floor_as_the_third_of_four_planes_stops_the_ball_as_alone(model):
+    """The rolling part of any plane of the table: the floor third of four planes (a
+    ceiling and two far walls first) stops a solid ball rolling at v0 as the floor alone
+    does, at t = 7 v0 / (5 mu_r g) (exact; sds: the same within its spring's loading),
+    with its own rolling spring states (``floor_rolling_x``, ...)."""
+    mu_r, v0 = 0.05, 1.0
+    planes = (ballc.Plane((0, 0, 2), (0, 0, -1), "ceiling"),
+              ballc.Plane((-5, 0, 0), (1, 0, 0), "west"),
+              ballc.Plane((0, 0, 0), (0, 0, 1), "floor"),
+              ballc.Plane((0, 5, 0), (0, -1, 0), "north"))
+    alone = stiff_scene(rolling_resistance=mu_r, rolling_model=model, velocity=(v0, 0, 0),
+                        angular_velocity=(0, v0 / 0.1, 0))
+    boxed = alone.replace(planes=planes)
+    assert boxed.state_names[15 + 8:] == (
+        "dissipated_rolling", "ceiling_rolling_x", "ceiling_rolling_y", "ceiling_twisting",
+        "west_rolling_x", "west_rolling_y", "west_twisting", "floor_rolling_x",
+        "floor_rolling_y", "floor_twisting", "north_rolling_x", "north_rolling_y",
+        "north_twisting")
+    t_stop = 7 * v0 / (5 * mu_r * G)
+    runs = [ballc.simulate(s, 2 * t_stop, rtol=1e-9, atol=1e-10, rest=False)
+            for s in (alone, boxed)]
+    for r in runs:
+        assert r.status == 0, r.message
+    a, b = runs
+    if model == "exact":
+        assert stop_of(b, 2)[0] == pytest.approx(t_stop, rel=1e-7)
+        assert stop_of(b, 2)[0] == pytest.approx(stop_of(a)[0], rel=1e-9)
+    names = b.state_names
+    np.testing.assert_allclose(b.y[names.index("x"), -1], a.y[S["x"], -1], rtol=1e-7)
+    np.testing.assert_allclose(b.energy["dissipated_rolling"][-1],
+                               a.energy["dissipated_rolling"][-1], rtol=1e-7)
+    for other in ("ceiling", "west", "north"):   # springs of planes never touched: 0
+        assert np.all(b.y[names.index(f"{other}_rolling_x")] == 0)
