@@ -124,11 +124,11 @@ def test_passive_model_never_creates_energy(method, scene):
 #: velocity is a pseudovector (x and z flip); the rotation R -> S R S flips qx and qz;
 #: tangential deflections and rolling springs flip their y component, twisting springs
 #: (about the normal, as omega_z) flip.  Everything else is unchanged.
-def _mirror_signs():
+def _mirror_signs(scene):
     flip = {"y", "vy", "omega_x", "omega_z", "qx", "qz"}
     return np.array([-1.0 if name in flip or name.endswith(("deflection_y", "rolling_y",
                                                             "twisting")) else 1.0
-                     for name in ballc.STATE_NAMES])
+                     for name in scene.state_names])
 
 
 def mirrored(scene):
@@ -167,7 +167,7 @@ def test_mirror_symmetric_scenes_stay_symmetric(models, data):
         # both stop at the same time, with the same samples of the grid before it
         assert one.t.size == two.t.size
         np.testing.assert_allclose(two.t, one.t, rtol=0, atol=tol * T_END)
-    expected = one.y * _mirror_signs()[:, None]
+    expected = one.y * _mirror_signs(scene)[:, None]
     scale = np.maximum(np.abs(one.y).max(axis=1, keepdims=True), 1.0)
     assert np.all(np.abs(two.y - expected) <= tol * scale)
     # the contact tables, one to one
