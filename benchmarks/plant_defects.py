@@ -329,6 +329,12 @@ DEFECTS = [
            "    return r * me.cross(force, normal) + r * twisting_force * normal\n",
            tests=("tests/test_rolling.py::"
                   "test_a_rolling_ball_stops_where_and_when_the_closed_form_says",)),
+    Defect("rolling resistance on the planes: every plane's rolling springs at the first "
+           "plane's states", "src/ballc/_system.c",
+           "                                          + BALLC_N_ROLLING_PLANE_STATES * p : -1;\n",
+           "                                          + BALLC_N_ROLLING_PLANE_STATES * 0 : -1;\n",
+           tests=("tests/test_rolling.py::"
+                  "test_the_floor_as_the_third_of_four_planes_stops_the_ball_as_alone",)),
     Defect("rolling resistance, sds: the slider's spring not rescaled with the cap (its "
            "radial rate dropped)", "codegen/contact.py",
            "    rate = [loaded * (a + d * growing + x * shrinking) for a, d, x in zip(across, "
