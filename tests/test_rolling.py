@@ -400,3 +400,34 @@ def test_the_floor_as_the_third_of_four_planes_stops_the_ball_as_alone(model):
                                a.energy["dissipated_rolling"][-1], rtol=1e-7)
     for other in ("ceiling", "west", "north"):   # springs of planes never touched: 0
         assert np.all(b.y[names.index(f"{other}_rolling_x")] == 0)
+
+
+def test_a_ball_rolling_along_a_grooves_two_planes_stops_at_the_closed_form_time():
+    """A V-groove of two planes at 40 degrees, the ball rolling along it without slip on
+    both (each carrying N = m g / (2 cos a)): the two rolling torques mu_r r N add up to
+    mu_r r m g about the groove's axis, and the ball decelerates at
+    a = mu_r g cos(a) / (I/(m r^2) + cos(a)^2), stops at v0 / a, then stays held -- both
+    planes' rolling parts and sticks solved together (_system.c's one Delassus solve)."""
+    angle, mu_r, v0 = math.radians(40), 0.05, 0.5
+    c = math.cos(angle)
+    planes = (ballc.Plane((0, 0, 0), (math.sin(angle), 0, c), "left"),
+              ballc.Plane((0, 0, 0), (-math.sin(angle), 0, c), "right"))
+    base = stiff_scene(rolling_resistance=mu_r, friction_coefficient=0.6).replace(
+        planes=planes, position=(0.0, 0.0, 0.5))
+    rho = (G / (2 * c) / base.hertz_stiffness) ** (2 / 3)
+    scene = base.replace(position=(0.0, 0.0, (0.1 - rho) / c), velocity=(0.0, v0, 0.0),
+                         angular_velocity=(-v0 / (0.1 * c), 0.0, 0.0))
+    a = mu_r * G * c / (0.4 + c * c)
+    result = ballc.simulate(scene, 1.5 * v0 / a, rtol=1e-9, atol=1e-10, rest=False)
+    assert result.status == 0, result.message
+    assert stop_of(result)[0] == pytest.approx(v0 / a, rel=1e-7)
+    mid = (result.t > 0.1 * v0 / a) & (result.t < 0.9 * v0 / a)
+    assert np.polyfit(result.t[mid], result.velocity[1, mid], 1)[0] == pytest.approx(-a,
+                                                                                     rel=1e-7)
+    assert tuple(result.segments["before"][-1]) == ("stick", "stick")
+    late = result.t > 1.05 * v0 / a
+    assert np.abs(result.velocity[:, late]).max() < 1e-12
+    assert np.abs(result.angular_velocity[:, late]).max() < 1e-11
+    kinetic = 0.5 * v0 ** 2 + 0.5 * 0.004 * (v0 / (0.1 * c)) ** 2
+    assert result.energy["dissipated_rolling"][-1] == pytest.approx(kinetic, rel=1e-7)
+    assert np.ptp(result.energy["balance"]) < 1e-9 * kinetic

@@ -483,6 +483,57 @@ static void hold_rolling(held_t *h, ballc_rolling_eval *roll, int part, int ns)
     }
 }
 
+/* Solve A x = b (m x m, row-major) in place (b becomes x) for a set of held velocities
+ * that may be redundant: Gaussian elimination with complete pivoting, and where every
+ * pivot left is below 1e-12 of the largest entry the remaining unknowns are 0 (a held
+ * velocity the others already hold -- a ball sticking on two planes at once, both
+ * holding its rolling: their forces are then statically indeterminate, and this takes
+ * one split of them).  BALLC_SINGULAR when A is not finite or is 0. */
+static int held_dense_solve(int m, double *A, double *b)
+{
+    int column[MAX_HELD], rank = m;
+    double largest = 0.0;
+    for (int i = 0; i < m * m; i++) {
+        if (!isfinite(A[i])) return BALLC_SINGULAR;
+        largest = fmax(largest, fabs(A[i]));
+    }
+    if (!(largest > 0)) return BALLC_SINGULAR;
+    for (int c = 0; c < m; c++) column[c] = c;
+    for (int c = 0; c < m; c++) {
+        int pr = c, pc = c;
+        for (int r = c; r < m; r++)
+            for (int j = c; j < m; j++)
+                if (fabs(A[r * m + j]) > fabs(A[pr * m + pc])) { pr = r; pc = j; }
+        if (!(fabs(A[pr * m + pc]) > 1e-12 * largest)) { rank = c; break; }
+        if (pr != c) {
+            for (int j = 0; j < m; j++) {
+                double t = A[c * m + j]; A[c * m + j] = A[pr * m + j]; A[pr * m + j] = t;
+            }
+            double t = b[c]; b[c] = b[pr]; b[pr] = t;
+        }
+        if (pc != c) {
+            for (int r = 0; r < m; r++) {
+                double t = A[r * m + c]; A[r * m + c] = A[r * m + pc]; A[r * m + pc] = t;
+            }
+            int t = column[c]; column[c] = column[pc]; column[pc] = t;
+        }
+        for (int r = c + 1; r < m; r++) {
+            double f = A[r * m + c] / A[c * m + c];
+            for (int j = c; j < m; j++) A[r * m + j] -= f * A[c * m + j];
+            b[r] -= f * b[c];
+        }
+    }
+    double x[MAX_HELD];
+    for (int c = m - 1; c >= 0; c--) {
+        if (c >= rank) { x[c] = 0.0; continue; }
+        double s = b[c];
+        for (int j = c + 1; j < m; j++) s -= A[c * m + j] * x[j];
+        x[c] = s / A[c * m + c];
+    }
+    for (int c = 0; c < m; c++) b[column[c]] = x[c];
+    return BALLC_OK;
+}
+
 /* The constraint forces (or impulses) of the held velocities ``h``: lambda solves
  * W lambda = target (W_ab = (dv_a/d speeds) M^-1 G_b, the Delassus matrix of all of
  * them), and M^-1 G lambda is added to ``speeds`` (6); each multiplier stored where its
@@ -503,7 +554,7 @@ static int hold_solve(const schur_t *factor, const held_t *h, const double *targ
             W[a * k + c] = s;
         }
     for (int c = 0; c < k; c++) lambda[c] = target[c];
-    int status = dense_solve(k, W, lambda);
+    int status = held_dense_solve(k, W, lambda);
     if (status != BALLC_OK) return status;
     for (int c = 0; c < k; c++) {
         for (int i = 0; i < NU; i++) speeds[i] += z[c][i] * lambda[c];
