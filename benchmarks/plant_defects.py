@@ -275,6 +275,34 @@ DEFECTS = [
            "        if (0 && ballc_flight_crossings(rho_of(r, q, y), c1, c2, 1, "
            "c->t_end - r->t, roots)) return 0;\n",
            tests=("tests/test_planes.py::test_rolling_down_an_incline_ends_in_closed_form",)),
+    # rolling resistance (issue 31)
+    Defect("rolling resistance: the cap on the friction force r mu F_n instead of r F_n "
+           "(mu_r r F_t of a sliding contact)", "codegen/contact.py",
+           "    f_n, _ = damped_normal(model, rho, rhodot, rate_at_impact)\n    return f_n\n",
+           "    f_n, _ = damped_normal(model, rho, rhodot, rate_at_impact)\n"
+           "    return model.p[\"friction_coefficient\"] * f_n\n",
+           tests=("tests/test_rolling.py::"
+                  "test_a_rolling_ball_stops_where_and_when_the_closed_form_says",)),
+    Defect("rolling resistance: the torque along the rolling direction (r F_r x n, not "
+           "r n x F_r)", "codegen/contact.py",
+           "    return r * me.cross(normal, force) + r * twisting_force * normal\n",
+           "    return r * me.cross(force, normal) + r * twisting_force * normal\n",
+           tests=("tests/test_rolling.py::"
+                  "test_a_rolling_ball_stops_where_and_when_the_closed_form_says",)),
+    Defect("rolling resistance on the planes: every plane's rolling springs at the first "
+           "plane's states", "src/ballc/_system.c",
+           "                                          + BALLC_N_ROLLING_PLANE_STATES * p : -1;\n",
+           "                                          + BALLC_N_ROLLING_PLANE_STATES * 0 : -1;\n",
+           tests=("tests/test_rolling.py::"
+                  "test_the_floor_as_the_third_of_four_planes_stops_the_ball_as_alone",)),
+    Defect("rolling resistance, sds: the slider's spring not rescaled with the cap (its "
+           "radial rate dropped)", "codegen/contact.py",
+           "    rate = [loaded * (a + d * growing + x * shrinking) for a, d, x in zip(across, "
+           "e, xi)]\n",
+           "    rate = [loaded * a for a, d, x in zip(across, e, xi)]\n",
+           tests=("tests/test_rolling.py::test_the_sds_slider_decelerates_as_the_exact_model",
+                  "tests/test_rolling_agreement.py::"
+                  "test_ballc_sds_agrees_with_lammps_without_a_dashpot")),
 ]
 
 

@@ -16,7 +16,8 @@ from .contact import TANGENTIAL_LAWS
 from .kernels import MASS_LAYOUT, build_kernels, contact_law_offsets, describe_contact_law_layout
 from .model import (BALL_STATE_NAMES, CONTACT_STATE_NAMES, LATCH_FIELDS, MAX_PLANES,
                     MECHANICAL_STATE_NAMES, PARAMETER_NAMES, PARAMETERS, PLANE_FIELDS,
-                    PLANE_INPUT_NAMES, PLANE_STATE_FIELDS)
+                    PLANE_INPUT_NAMES, PLANE_STATE_FIELDS, ROLLING_BALL_STATE_NAMES,
+                    ROLLING_MODE_CODES, ROLLING_SPRING_FIELDS)
 
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
 
@@ -69,7 +70,13 @@ def render(verbose=False) -> dict[str, str]:
          *[f"#define BALLC_PLANE_STATE_{name.upper()} {i}"
            for i, name in enumerate(PLANE_STATE_FIELDS)],
          f"#define BALLC_STATE_PLANES {n_ball}",
-         f"#define BALLC_MAX_STATES {n_ball + MAX_PLANES * n_plane_states}",
+         "/* with rolling resistance (and only then), after every plane's states: the",
+         "   rolling block, dissipated_rolling then BALLC_N_ROLLING_PLANE_STATES per plane */",
+         f"#define BALLC_N_ROLLING_BALL_STATES {len(ROLLING_BALL_STATE_NAMES)}",
+         f"#define BALLC_N_ROLLING_PLANE_STATES {len(ROLLING_SPRING_FIELDS)}",
+         "#define BALLC_MAX_STATES " + str(n_ball + MAX_PLANES * n_plane_states
+                                            + len(ROLLING_BALL_STATE_NAMES)
+                                            + MAX_PLANES * len(ROLLING_SPRING_FIELDS)),
          "/* parameter constants: ballc_parameter_constants(params, constants) */",
          f"#define BALLC_N_PARAMETER_CONSTANTS {len(constants)}",
          f"#define BALLC_N_LATCH_PER_PLANE {len(LATCH_FIELDS)}",
@@ -92,6 +99,9 @@ def render(verbose=False) -> dict[str, str]:
          *[f"#define BALLC_PARAMETER_{name.upper()} {i}"
            for i, name in enumerate(PARAMETER_NAMES)],
          *[f"#define BALLC_LATCH_{field[0].upper()} {i}" for i, field in enumerate(LATCH_FIELDS)],
+         "/* a plane's rolling and twisting modes, as its latch holds them */",
+         *[f"#define BALLC_ROLLING_MODE_{name.upper()} {code}"
+           for name, code in ROLLING_MODE_CODES],
          f"#define BALLC_N_MECHANICAL_STATES {len(MECHANICAL_STATE_NAMES)}",
          f"#define BALLC_CONTACT_LAW_NOUT {contact_law_nout}",
          "/* contact-law kernel outputs: " + describe_contact_law_layout() + " */",
@@ -99,6 +109,8 @@ def render(verbose=False) -> dict[str, str]:
          *sizes, "",
          c_string_array("BALLC_STATE_NAMES", BALL_STATE_NAMES).rstrip(),
          c_string_array("BALLC_PLANE_STATE_NAMES", PLANE_STATE_FIELDS).rstrip(),
+         c_string_array("BALLC_ROLLING_BALL_STATE_NAMES", ROLLING_BALL_STATE_NAMES).rstrip(),
+         c_string_array("BALLC_ROLLING_PLANE_STATE_NAMES", ROLLING_SPRING_FIELDS).rstrip(),
          c_string_array("BALLC_PARAMETER_NAMES", PARAMETER_NAMES).rstrip(),
          c_string_array("BALLC_PARAMETER_UNITS", units).rstrip(),
          c_string_array("BALLC_PLANE_FIELD_NAMES", [f[0] for f in PLANE_FIELDS]).rstrip(),

@@ -44,7 +44,8 @@ from dataclasses import dataclass
 import sympy as sm
 import sympy.physics.mechanics as me
 
-from .model import LATCH_FIELDS, Model, require_frame_plane, contact_point
+from .model import (LATCH_FIELDS, ROLLING_SPRING_FIELDS, Model, contact_point,
+                    require_frame_plane)
 
 
 def plane_geometry(model: Model, plane: str):
@@ -751,3 +752,191 @@ def spring_energy(model: Model, plane: str):
     """Hertz elastic energy 2/5 k0 rho^(5/2) stored in the contact with ``plane``."""
     _, rho = plane_geometry(model, plane)
     return sm.Rational(2, 5) * hertz_stiffness(model) * _positive(rho)**sm.Rational(5, 2)
+
+
+# --- the rolling part: the law's fourth part (LAMMPS GRANULAR's rolling and twisting
+# sub-models; docs/contact_laws.md, "Rolling resistance") --------------------------------
+
+
+def rolling_velocities(model: Model, plane: str):
+    """The contact's rolling and twisting velocities in the plane's frame (m/s): the
+    rolling velocity v_roll = r (omega x n) (2: along t1, t2; LAMMPS' vrl with
+    R_eff = r, Wang et al. 2015, eq. 31) and the twisting velocity v_twist = r omega . n
+    (LAMMPS' magtwist times r).  A ball rolling without slip along u at speed v has
+    v_roll = v u: the velocity of its centre."""
+    normal, _ = plane_geometry(model, plane)
+    N = model.frame
+    omega = model.ball_frame.ang_vel_in(N)
+    r = model.p["radius"]
+    rolling = r * me.cross(omega, normal)
+    return [me.dot(rolling, N.x), me.dot(rolling, N.y), r * me.dot(omega, normal)]
+
+
+def rolling_torque(model: Model, plane: str, rolling_force, twisting_force):
+    """The torque on the ball (about its centre) of a rolling force F_r (2: along t1,
+    t2) and a twisting force F_w (1): r n x F_r + r F_w n (N m), LAMMPS' torroll =
+    R_eff (n x F_r) and tortwist along n.  Its power on the ball is
+    F_r . v_roll + F_w v_twist (rolling_velocities): a force against the rolling
+    velocity is passive."""
+    normal, _ = plane_geometry(model, plane)
+    N = model.frame
+    r = model.p["radius"]
+    force = rolling_force[0] * N.x + rolling_force[1] * N.y
+    return r * me.cross(normal, force) + r * twisting_force * normal
+
+
+def rolling_load(model: Model, plane: str):
+    """The normal force F_n (N) that caps the rolling and twisting torques: the
+    contact's normal x damping parts (damped_normal: Hertz with the scene's normal
+    damping, clamped at 0), as LAMMPS' rolling sub-model reads Fncrit from its normal
+    sub-model.  For the friction and compliant laws it is their normal force; the seed's
+    dig-in law, whose force is along the direction latched at impact, has no normal
+    force of its own, and its share of the mixture adds none to the cap."""
+    _, _, rho, rhodot = contact_kinematics(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_n, _ = damped_normal(model, rho, rhodot, rate_at_impact)
+    return f_n
+
+
+
+def rolling_spring_symbols(model: Model, plane: str):
+    """The plane's rolling spring's deflection (xi_x, xi_y along t1, t2, xi_w about n;
+    m): model.ROLLING_SPRING_FIELDS (model.FRAME_PLANE only)."""
+    require_frame_plane(plane)
+    return [model.state(name) for name in ROLLING_SPRING_FIELDS]
+
+
+def rolling_spring_energy(model: Model, plane: str):
+    """The energy stored in the sds rolling and twisting springs (J):
+    1/2 k_r (xi_x^2 + xi_y^2) + 1/2 k_w xi_w^2 (0 for the exact model, whose spring
+    states stay 0)."""
+    xx, xy, xw = rolling_spring_symbols(model, plane)
+    return (model.p["rolling_stiffness"] * (xx**2 + xy**2)
+            + model.p["twisting_stiffness"] * xw**2) / 2
+
+
+# --- the rolling part's sds model (LAMMPS rolling sds / twisting sds, ballc's passive
+# form): a spring, a dashpot within the capacity the spring leaves, a slider at the cap --
+
+#: The rolling part's two parts: (first component of the velocities and springs, count).
+ROLLING_PARTS = {"rolling": (0, 2), "twisting": (2, 1)}
+
+
+def rolling_part(model: Model, plane: str, part: str):
+    """(spring deflection xi, velocity w, stiffness k, dashpot gamma, mu) of the part
+    ``part`` ("rolling": 2 components along t1, t2; "twisting": 1, about n)."""
+    first, count = ROLLING_PARTS[part]
+    xi = rolling_spring_symbols(model, plane)[first:first + count]
+    w = rolling_velocities(model, plane)[first:first + count]
+    p = model.p
+    return xi, w, p[f"{part}_stiffness"], p[f"{part}_damping"], p[f"{part}_resistance"]
+
+
+def _part_forces(part, force):
+    """(rolling force (2), twisting force) of a part's force (its components)."""
+    return (list(force), 0) if part == "rolling" else ([0, 0], force[0])
+
+
+def _rolling_loaded(normal_force):
+    """1 while the contact carries a load, as a factor of a spring's rate: F_n / max(F_n,
+    1e-12 N) (below the force floor a fraction: finite derivatives)."""
+    return normal_force / sm.Max(normal_force, sm.sqrt(_FORCE_FLOOR2))
+
+
+def sds_spring(model: Model, plane: str, part: str):
+    """The sds part below its cap (the spring mode): F = F_el + alpha V with the spring
+    F_el = -k xi and the dashpot V = -gamma w cut to the capacity the spring leaves,
+    alpha = min(1, max(0, mu F_n - |F_el|) / |V|) (the compliant law's capacity damping:
+    passive, |F| <= mu F_n); xi' = w while the contact carries a load.
+
+    LAMMPS caps the sum -k xi - gamma w instead and rescales xi so that the sum sits at
+    the cap; where the dashpot alone exceeds the cap (a contact's start, where the cap is
+    0) that rescale stores energy from nothing.  ballc keeps the spring below the cap and
+    the dashpot within what it leaves (Kratos' choice for the tangential law): the same
+    law when gamma = 0, and passive whatever gamma (docs/contact_laws.md).
+    Returns (force (the part's components), xi' (its components), dissipation rate (W)).
+    """
+    xi, w, k, gamma, mu = rolling_part(model, plane, part)
+    f_n = rolling_load(model, plane)
+    cap = mu * f_n
+    elastic = [-k * x for x in xi]
+    viscous = [-gamma * v for v in w]
+    spare = _positive(cap - sm.sqrt(sm.Max(sum(e**2 for e in elastic), _FORCE_FLOOR2)))
+    viscous_size = sm.sqrt(sm.Max(sum(v**2 for v in viscous), _FORCE_FLOOR2))
+    alpha = sm.Min(1, spare / viscous_size)
+    force = [e + alpha * v for e, v in zip(elastic, viscous)]
+    rate = [_rolling_loaded(f_n) * v for v in w]
+    dissipation = -sum(f * v for f, v in zip(force, w)) \
+        - k * sum(x * r for x, r in zip(xi, rate))
+    return force, rate, dissipation
+
+
+def slider_grows(model: Model, plane: str):
+    """1 while the cap grows (dF_n/dt >= 0 with the contact's own rho''), else 0: which
+    radial form the sds slider takes (sds_slider)."""
+    _, _, rho, rhodot = contact_kinematics(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_n = rolling_load(model, plane)
+    return sm.Heaviside(normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n), 0)
+
+
+def sds_slider(model: Model, plane: str, part: str, accel=None, grows=None):
+    """The sds part at its cap (the slider mode; LAMMPS' rescale in the limit dt -> 0):
+    F = -mu F_n e, e = xi/|xi|, no dashpot (no capacity left), and
+    xi' = (w - (e . w) e) f + radial: |xi| stays mu F_n / k (a mode change puts the
+    spring at the cap), and e turns towards w at (w - (e . w) e)/|xi|, the truncated
+    increment's direction (f = |xi| / max(|xi|, TURN_FLOOR); the twisting part has no
+    turn).  The radial part follows the cap: e mu dF_n/dt / k while it grows (open loop:
+    a relative rate xi dF_n/dt / F_n is ~ 3/t at a contact's start, where F_n grows from
+    0, and radau5 stepping over that growth turned the spring round), xi d ln(F_n)/dt
+    while it shrinks (closed loop: xi reaches 0 with the cap, not before or after, at a
+    contact's end) -- the same rate where |xi| = mu F_n / k, chosen by the sign of
+    dF_n/dt with the contact's own rho'' (so that the rates stay affine in the exact one).
+    dF_n/dt holds the penetration acceleration ``accel`` (rho'', normal_force_rate;
+    None: the contact's own).  Its dissipation rate is
+    mu F_n ((e . w) - mu dF_n/dt / k) >= 0 while it slides (its re-stick margin >= 0).
+    ``grows``: a symbol for slider_grows, held constant by the Jacobian (its derivative
+    is a Dirac delta).  Returns (force, xi', dissipation rate)."""
+    xi, w, k, gamma, mu = rolling_part(model, plane, part)
+    _, _, rho, rhodot = contact_kinematics(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_n = rolling_load(model, plane)
+    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n, accel)
+    cap = mu * f_n
+    size = sm.sqrt(sm.Max(sum(x**2 for x in xi), _DIRECTION_FLOOR2))
+    e = [x / size for x in xi]
+    along = sum(a * b for a, b in zip(e, w))
+    turn = size / sm.Max(size, TURN_FLOOR)
+    across = [(v - along * d) * turn for v, d in zip(w, e)] if len(xi) == 2 else [0]
+    if grows is None:
+        grows = slider_grows(model, plane)
+    growing = grows * mu * f_rate / sm.Max(k, _STIFFNESS_FLOOR)
+    shrinking = (1 - grows) * f_rate / sm.Max(f_n, sm.sqrt(_FORCE_FLOOR2))
+    loaded = _rolling_loaded(f_n)
+    rate = [loaded * (a + d * growing + x * shrinking) for a, d, x in zip(across, e, xi)]
+    force = [-cap * d for d in e]
+    dissipation = -sum(f * v for f, v in zip(force, w)) \
+        - k * sum(x * r for x, r in zip(xi, rate))
+    return force, rate, dissipation
+
+
+def sds_margins(model: Model, plane: str, part: str, accel):
+    """The sds part's mode guards: the yield margin 1 - k |xi| / (mu F_n) (the spring
+    mode ends where it falls below 0; -1 without load), the re-stick margin (m/s)
+    (e . w) - mu dF_n/dt / k (how much faster the spring would stretch than the cap
+    grows; the slider ends where it falls below 0; +1 without load), affine in the
+    penetration acceleration ``accel``, and the deflection at the cap mu F_n / k (m)."""
+    xi, w, k, gamma, mu = rolling_part(model, plane, part)
+    _, _, rho, rhodot = contact_kinematics(model, plane)
+    rate_at_impact = latch_symbols(model, plane)[0]
+    f_n = rolling_load(model, plane)
+    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n, accel)
+    cap = mu * f_n
+    stiffness = sm.Max(k, _STIFFNESS_FLOOR)
+    size = sm.sqrt(sm.Max(sum(x**2 for x in xi), _DIRECTION_FLOOR2))
+    along = sum(x / size * v for x, v in zip(xi, w))
+    in_contact = sm.Heaviside(f_n, 0)
+    idle = 1 - in_contact
+    yield_margin = 1 - k * sm.sqrt(sum(x**2 for x in xi)) / sm.Max(cap, sm.sqrt(_FORCE_FLOOR2))
+    restick = along - mu * f_rate / stiffness
+    return [in_contact * yield_margin - idle, in_contact * restick + idle, cap / stiffness]

@@ -258,6 +258,8 @@ def plane_kernels(model: Model, pieces: dict):
     law_kernels("friction_normal", "A plane's contact in its own frame, friction law with "
                 "mu = 0 (its normal share, weighted):")
     kernels += slip_kernels(model, plane, pieces["force_map"])
+    kernels += rolling_kernels(model, plane, inputs, extra_doc)
+    kernels += sds_kernels(model, plane, inputs, extra_doc)
     margins = contact.compliant_margins(model, plane)
     accel = contact.penetration_acceleration(plane)
     restick = _affine_coefficient(margins[1], accel, "the re-stick margin")
@@ -279,6 +281,11 @@ def plane_kernels(model: Model, pieces: dict):
         local([contact.spring_energy(model, plane),
                contact.tangential_spring_energy(model, plane)], "plane_energy"),
         [], state=state))
+    kernels.append(Kernel(
+        "plane_rolling_energy", "A plane's contact: the energy of the rolling part's sds "
+        "springs, 1/2 k_r |xi_roll|^2 + 1/2 k_w xi_twist^2 (J).",
+        local([contact.rolling_spring_energy(model, plane)], "plane_rolling_energy"), [],
+        state=state))
     kernels.append(Kernel(
         "plane_kinematics", "A plane's contact: rho, rhodot, the contact point's velocity "
         "in the plane's frame (3).",
@@ -413,6 +420,145 @@ def slip_kernels(model: Model, plane: str, force_map: sm.Matrix):
                "generalized-force map of a tangential force at the contact point "
                "(6x2 row-major).", constant, [], state=CONTACT_STATE_SYMBOLS),
     ]
+
+
+def rolling_kernels(model: Model, plane: str, inputs, extra_doc):
+    """What the rolling part (contact.rolling_velocities, rolling_torque, rolling_load)
+    needs on a plane, in its own frame: three kernels.
+
+    ``plane_rolling``: the rolling velocity (2, along t1, t2), the twisting velocity and
+    the normal force F_n that caps their torques; ``plane_rolling_jac`` its derivative
+    d/d(contact state) (4 x N_CONTACT_STATES), whose last row is dF_n/d(contact state)
+    (the exact rolling torque's Jacobian).  ``plane_rolling_map``: constants (the
+    velocities are linear in the contact state: checked) -- their derivative (3 x
+    N_CONTACT_STATES row-major) and the generalized-force map of a unit rolling force
+    along t1, t2 and a unit twisting force (6 x 3 row-major: the torque r n x F_r,
+    r F_w n in the plane's frame, no force), which the C core turns into a plane's maps
+    once per parameter vector, as the slip maps.  The exact rolling and twisting
+    torques and their holding constraint are applied through these maps
+    (src/ballc/_rolling.c), so where they act stays derived here.
+    """
+    N = model.frame
+    velocities = contact_state(model, contact.rolling_velocities(model, plane),
+                               "the rolling velocities")
+    load = contact_state(model, [contact.rolling_load(model, plane)], "the rolling load")
+    derivative = [v.diff(x) for v in velocities for x in CONTACT_STATE_SYMBOLS]
+    partials = me.partial_velocity([model.ball_frame.ang_vel_in(N)], model.speeds, N)[0]
+    units = [contact.rolling_torque(model, plane, [1, 0], 0),
+             contact.rolling_torque(model, plane, [0, 1], 0),
+             contact.rolling_torque(model, plane, [0, 0], 1)]
+    torque_map = contact_state(model, [me.dot(unit, partial) for partial in partials
+                                       for unit in units], "the rolling force map")
+    constant = derivative + torque_map
+    if any(sm.sympify(e).has(*CONTACT_STATE_SYMBOLS) for e in constant):
+        raise ValueError("the rolling velocities are not linear in the contact state, or "
+                         "their force map depends on it: plane_rolling_map would not be "
+                         "constant")
+    n = len(CONTACT_STATE_SYMBOLS)
+    outputs = velocities + load
+    return [
+        Kernel("plane_rolling", "A plane's contact in its own frame: the rolling velocity "
+               "r (omega x n) (2), the twisting velocity r omega . n and the normal force "
+               "F_n that caps their torques (contact.rolling_load).", outputs, inputs,
+               extra_doc, state=CONTACT_STATE_SYMBOLS),
+        jacobian_kernel(model, "plane_rolling_jac", "A plane's contact in its own frame: "
+                        f"d(plane_rolling)/d(contact state) ({len(outputs)}x{n} row-major).",
+                        outputs, inputs, extra_doc, state=CONTACT_STATE_SYMBOLS),
+        Kernel("plane_rolling_map", "A plane's contact in its own frame, constants: "
+               f"d(rolling and twisting velocities)/d(contact state) (3x{n} row-major), "
+               "generalized-force map of a unit rolling force along t1, t2 and a unit "
+               "twisting force (6x3 row-major).", constant, [],
+               state=CONTACT_STATE_SYMBOLS),
+    ]
+
+
+def _generalized_torque(model: Model, torque):
+    """The generalized forces (6) of a torque on the ball (N m): its dot products with
+    the ball's partial angular velocities."""
+    N = model.frame
+    partials = me.partial_velocity([model.ball_frame.ang_vel_in(N)], model.speeds, N)[0]
+    return [me.dot(torque, partial) for partial in partials]
+
+
+def sds_outputs(model: Model, plane: str, part: str, force, rate, dissipation):
+    """An sds kernel's outputs (SDS_LAYOUT): the generalized force of the part's torque
+    (6, the plane's frame), its dissipation rate (1) and the rates of the plane's three
+    rolling spring states (the other part's 0)."""
+    first, count = contact.ROLLING_PARTS[part]
+    rolling_force, twisting_force = contact._part_forces(part, force)
+    torque = contact.rolling_torque(model, plane, rolling_force, twisting_force)
+    rates = [0, 0, 0]
+    rates[first:first + count] = rate
+    return _generalized_torque(model, torque) + [dissipation] + rates
+
+
+#: An sds kernel's outputs: generalized force (6), dissipation rate (1), rates of the
+#: rolling spring states rolling_x, rolling_y, twisting (3).
+SDS_LAYOUT = (("GENERALIZED_FORCE", 6), ("DISSIPATION", 1), ("SPRING_RATE", 3))
+
+
+def sds_kernels(model: Model, plane: str, inputs, extra_doc):
+    """The rolling part's sds model on a plane, in its own frame, per part (rolling,
+    twisting): ``plane_<part>_spring`` (below the cap) and ``plane_<part>_slider`` (at
+    it; its rates at rho'' = 0, and ``plane_<part>_slider_acceleration`` their
+    coefficients of the exact penetration acceleration rho'', which the C core adds after
+    the solve), each with its Jacobian (d/d contact state; the slider's with the
+    contact's own rho''), and ``plane_<part>_margins`` (yield margin, re-stick margin at
+    rho'' = 0, the deflection at the cap mu F_n / k, the re-stick margin's coefficient
+    of rho'')."""
+    state = CONTACT_STATE_SYMBOLS
+    n = len(state)
+    accel = contact.penetration_acceleration(plane)
+    kernels = []
+
+    def local(expressions, name):
+        return contact_state(model, expressions, f"plane kernel {name}")
+
+    layout = "generalized force (6), dissipation rate (1), rolling spring rates (3)"
+    for part in contact.ROLLING_PARTS:
+        spring = sds_outputs(model, plane, part, *contact.sds_spring(model, plane, part))
+        name = f"plane_{part}_spring"
+        doc = f"A plane's contact in its own frame, the {part} part's sds spring (below its cap):"
+        kernels.append(Kernel(name, f"{doc} {layout}.", local(spring, name), inputs,
+                              extra_doc, state=state))
+        kernels.append(jacobian_kernel(model, f"{name}_jac", f"{doc} d(outputs)/d(contact "
+                                       f"state) ({len(spring)}x{n} row-major).",
+                                       local(spring, name), inputs, extra_doc, state=state))
+        slider = sds_outputs(model, plane, part,
+                             *contact.sds_slider(model, plane, part, accel))
+        grows = sm.Symbol(f"{plane}_{part}_slider_grows")
+        own = sds_outputs(model, plane, part,
+                          *contact.sds_slider(model, plane, part, grows=grows))
+        frozen = [(grows, local([contact.slider_grows(model, plane)], name)[0])]
+        name = f"plane_{part}_slider"
+        doc = f"A plane's contact in its own frame, the {part} part's sds slider (at its cap):"
+        for i in range(6):
+            if sm.sympify(slider[i]).has(accel):
+                raise ValueError(f"{name}: a torque depends on {accel}")
+        coefficients = [_affine_coefficient(o, accel, f"{name} output {i}")
+                        for i, o in enumerate(slider[6:], 6)]
+        value = [sm.sympify(o).xreplace({accel: 0}) for o in slider]
+        kernels.append(Kernel(f"{name}_acceleration", f"{doc} the coefficients of the exact "
+                              "penetration acceleration rho'' in its dissipation rate and "
+                              "spring rates (4); the value kernel's are at rho'' = 0.",
+                              local(coefficients, name), inputs, extra_doc, state=state))
+        kernels.append(Kernel(name, f"{doc} {layout}.", local(value, name), inputs, extra_doc,
+                              state=state))
+        kernels.append(jacobian_kernel(model, f"{name}_jac", f"{doc} d(outputs)/d(contact "
+                                       f"state) ({len(own)}x{n} row-major; the contact's own "
+                                       "rho'', the radial form held).", local(own, name),
+                                       inputs, extra_doc, frozen=frozen, state=state))
+        margins = contact.sds_margins(model, plane, part, accel)
+        restick = _affine_coefficient(margins[1], accel, f"the {part} re-stick margin")
+        name = f"plane_{part}_margins"
+        kernels.append(Kernel(
+            name, f"A plane's contact in its own frame, the {part} part's sds mode guards "
+            "(contact.sds_margins): yield margin 1 - k |xi| / (mu F_n), re-stick margin "
+            "(m/s) at rho'' = 0, the deflection at the cap mu F_n / k (m), the re-stick "
+            "margin's coefficient of rho'' (s).",
+            local([margins[0], margins[1].xreplace({accel: 0}), margins[2], restick], name),
+            inputs, extra_doc, state=state))
+    return kernels
 
 
 def output_kernels(model: Model):

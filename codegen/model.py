@@ -55,9 +55,20 @@ BALL_STATE_NAMES = MECHANICAL_STATE_NAMES + DISSIPATED_STATE_NAMES
 PLANE_STATE_FIELDS = ("deflection_x", "deflection_y")
 #: The most planes a run may have (the run-time arrays of the C core are sized by it).
 MAX_PLANES = 6
-#: The model's states: the ball's, and the deflection of the plane the contact laws are
-#: derived on (FRAME_PLANE, below); at run time each plane's own (src/ballc/_plane.c).
-STATE_NAMES = BALL_STATE_NAMES + PLANE_STATE_FIELDS
+#: The states of rolling resistance (a scene with rolling or twisting resistance only:
+#: without it a run has none of them, and its state is the layout above, bit for bit):
+#: after every plane's deflection, the work dissipated by the rolling and twisting
+#: torques (J), then per plane, plane after plane, its rolling spring (the rolling
+#: part's sds model, LAMMPS ``rolling sds`` and ``twisting sds``): the deflection of the
+#: rolling spring along the plane's t1, t2 and of the twisting spring about its normal,
+#: as displacements of the contact (m), named ``<plane name>_<field>``.
+ROLLING_BALL_STATE_NAMES = ("dissipated_rolling",)
+ROLLING_SPRING_FIELDS = ("rolling_x", "rolling_y", "twisting")
+#: The model's states: the ball's, and the deflection and rolling spring of the plane
+#: the contact laws are derived on (FRAME_PLANE, below); at run time each plane's own
+#: (src/ballc/_plane.c).
+STATE_NAMES = (BALL_STATE_NAMES + PLANE_STATE_FIELDS + ROLLING_BALL_STATE_NAMES
+               + ROLLING_SPRING_FIELDS)
 
 #: (name, seed symbol, unit, description)
 PARAMETERS = (
@@ -92,6 +103,15 @@ PARAMETERS = (
      "compliant model, viscoelastic normal damping: c_n = 2 gamma sqrt(m* k_n)"),
     ("tangential_damping_ratio", "-", "1",
      "compliant model's tangential damping: c_t = 2 gamma_t sqrt(m* k_t)"),
+    ("rolling_resistance", "-", "1",
+     "rolling resistance mu_r: the rolling torque is at most mu_r r F_n (0: none)"),
+    ("rolling_stiffness", "-", "N/m",
+     "sds rolling spring k_r: rolling force -k_r xi, torque r n x F"),
+    ("rolling_damping", "-", "N s/m", "sds rolling dashpot gamma_r: force -gamma_r v_roll"),
+    ("twisting_resistance", "-", "1",
+     "twisting resistance mu_t: the torque about the normal is at most mu_t r F_n"),
+    ("twisting_stiffness", "-", "N/m", "sds twisting spring k_t: force -k_t xi_t, torque r F n"),
+    ("twisting_damping", "-", "N s/m", "sds twisting dashpot: force -gamma_t v_twist"),
 )
 #: The plane table closes the parameters: its number of planes, then PLANE_FIELDS per
 #: plane, plane after plane (a run's parameter vector is PARAMETERS + PLANE_FIELDS per
@@ -124,7 +144,7 @@ CONTACT_STATE = (
     ("z", "z"), ("omega_x", "omega_x"), ("omega_y", "omega_y"), ("omega_z", "omega_z"),
     ("vx", "vx"), ("vy", "vy"), ("vz", "vz"),
     ("deflection_x", "deflection_x"), ("deflection_y", "deflection_y"),
-)
+) + tuple((name, name) for name in ROLLING_SPRING_FIELDS)
 CONTACT_STATE_NAMES = tuple(local for _, local in CONTACT_STATE)
 
 #: Values latched at the start of a contact, per plane, in this order (a run's latch is
@@ -140,7 +160,19 @@ LATCH_FIELDS = (
      "the segment start, along the plane's first tangent t1 (its frame, as the slip)"),
     ("slip_direction_y", "-", "1",
      "exact Coulomb friction: unit slip direction latched at the segment start, along t2"),
+    ("rolling_mode", "-", "1", "the rolling part's mode (ROLLING_MODE_CODES; 0: none)"),
+    ("rolling_direction_x", "-", "1", "exact rolling resistance: unit rolling-velocity "
+     "direction latched at the segment start, along t1 (the plane's frame)"),
+    ("rolling_direction_y", "-", "1", "exact rolling resistance: ... along t2"),
+    ("twisting_mode", "-", "1", "the twisting part's mode (ROLLING_MODE_CODES; 0: none)"),
+    ("twisting_direction", "-", "1",
+     "exact twisting resistance: the sign of the twisting velocity latched (+1 or -1)"),
 )
+#: The codes of a plane's rolling and twisting modes in its latch (rolling_mode,
+#: twisting_mode): exact (type A with holding) free, direction held, holding; sds
+#: spring (below the cap), slider (at the cap).
+ROLLING_MODE_CODES = (("none", 0), ("free", 1), ("fixed", 2), ("holding", 3), ("spring", 4),
+                      ("slider", 5))
 #: The latched symbols of FRAME_PLANE (the contact laws read them, turned into the
 #: plane's frame where they are vectors).
 LATCH_NAMES = tuple(f[0] for f in LATCH_FIELDS)

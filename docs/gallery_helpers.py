@@ -42,7 +42,7 @@ def gif_scraper(block, block_vars, gallery_conf):
 
 
 #: The order of the gallery: the seed first, then the questions it raises.
-ORDER = ["seed_reproduction.py", "superball.py", "superball_passive.py",
+ORDER = ["seed_reproduction.py", "superball.py", "superball_passive.py", "superball_rolling.py",
          "compare_tangential_models.py",
          "restitution_calibration.py", "sweep_mixture_mu.py", "plates_orientation.py",
          "fit_superball.py",

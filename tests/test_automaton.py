@@ -31,6 +31,11 @@ def transitions_of(segments):
         if end not in automaton._HANDLERS:   # t_end, a step bound, a failure, a user event
             continue
         k = layout.PLANES.index(plane)
+        part = automaton.transitions_from(end)[0].part
+        if part != "contact":   # the rolling part's own modes (its second factor)
+            seen.append((end, plane, str(row[f"{part}_before"][k]),
+                         str(row[f"{part}_after"][k])))
+            continue
         before, after = str(row["before"][k]), str(row["after"][k])
         if end in CHECKS:   # the checks before it found nothing: the mode stayed
             seen += [(check, plane, before, before) for check in CHECKS[:CHECKS.index(end)]]
@@ -47,6 +52,17 @@ def _shallow_start():
     y0[layout.INDEX["vz"]] = -1.0
     y0[layout.INDEX["vx"]] = 3.0
     return scene, y0
+
+
+def _spinning_stiff_ball():
+    """A stiff ball at rest on the floor, spinning about the normal, sds twisting."""
+    scene = ballc.Scene(tangential_model="friction", observer_mass=0.0, radius=0.1,
+                        ball_youngs_modulus=2e11, plane_youngs_modulus=2e11, c_tau=0.5,
+                        friction_coefficient=0.5, rolling_resistance=0.05,
+                        twisting_resistance=0.1, rolling_model="sds", position=(0, 0, 0.1),
+                        velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 10.0))
+    depth = ballc.resting.equilibrium_penetration(scene)
+    return scene.replace(position=(0.0, 0.0, scene.radius - depth)), None
 
 
 SCENES = {
@@ -67,6 +83,16 @@ SCENES = {
     "sliding": (lambda: (ballc.Scene(tangential_model="friction", friction_coefficient=0.0,
                                      observer_mass=0.0), None), 100.0),
     "seed, long": (lambda: (ballc.Scene(), None), 100.0),
+    # rolling resistance's exact modes (rolling, rolling_fixed, holding; twisting,
+    # holding): every one of their events within the seed's ~44 s to rest
+    "rolling resistance": (lambda: (ballc.Scene(rolling_resistance=0.1,
+                                                twisting_resistance=0.05), None), 100.0),
+    # its sds model (spring, slider) with the compliant law; a stiff ball spinning on the
+    # floor about the normal, whose twisting slider re-sticks as the spin stops
+    "rolling resistance, sds": (lambda: (ballc.Scene(
+        rolling_resistance=0.05, twisting_resistance=0.05, rolling_model="sds",
+        tangential_model="compliant"), None), 5.0),
+    "rolling resistance, spin sds": (_spinning_stiff_ball, 3.0),
 }
 
 
@@ -124,6 +150,9 @@ def test_the_log_is_the_run(runs):
         assert segments["t_start"][0] == 0.0, key
         np.testing.assert_array_equal(segments["t_start"][1:], segments["t_end"][:-1])
         np.testing.assert_array_equal(segments["before"][1:], segments["after"][:-1])
+        for part in ("rolling", "twisting"):
+            np.testing.assert_array_equal(segments[f"{part}_before"][1:],
+                                          segments[f"{part}_after"][:-1])
         assert np.all(segments["t_end"] >= segments["t_start"]), key
         assert (segments["nfev"].sum(), segments["njev"].sum(), segments["nlu"].sum()) == (
             result.nfev, result.njev, result.nlu), key
@@ -143,13 +172,14 @@ def test_the_log_is_the_run(runs):
 
 def test_every_handler_exists_and_modes_are_named():
     """Each row's handler is a function of the C loop (_driver.c) that takes the run, and
-    the loop calls it; the modes are the table's."""
+    the loop calls it; the modes are the table's (a rolling part's row: that part's)."""
     source = (Path(__file__).resolve().parent.parent / "src" / "ballc" / "_driver.c").read_text()
     for row in automaton.TRANSITIONS:
         assert re.search(rf"^static \w+ {row.handler}\((const )?run_t \*r\b", source, re.M), row
         assert len(re.findall(rf"\b{row.handler}\(r\b", source)) >= 1, row
-        assert set(row.sources) <= set(automaton.MODES) and set(row.targets) <= set(
-            automaton.MODES), row
+        modes = (automaton.MODES if row.part == "contact"
+                 else automaton.ROLLING_PART_MODES[row.part])
+        assert set(row.sources) <= set(modes) and set(row.targets) <= set(modes), row
     with pytest.raises(ValueError, match="not in the automaton"):
         automaton.handler_of("teleport")
 
@@ -161,3 +191,24 @@ def test_the_c_loop_names_the_modes_and_events_of_the_table():
     assert kinds <= set(ballc._core.SEGMENT_ENDS)
     assert set(CHECKS) <= set(ballc._core.SEGMENT_ENDS)
     assert set(automaton.SIMULTANEOUS) <= set(ballc._core.SEGMENT_ENDS)
+
+
+def test_the_rolling_part_has_a_mode_exactly_while_its_plane_is_in_contact(runs):
+    """With rolling resistance, a plane's rolling and twisting parts are in an exact mode
+    while it is in contact and "none" in flight (a contact's start sets them, its end
+    clears them); without it, "none" throughout."""
+    for (name, _), result in runs.items():
+        segments = result.segments
+        if segments is None:
+            continue
+        flight = segments["before"] == "flight"
+        for part, modes in (("rolling", automaton.EXACT_ROLLING_MODES),
+                            ("twisting", automaton.EXACT_TWISTING_MODES)):
+            before = segments[f"{part}_before"]
+            if not name.startswith("rolling resistance"):
+                assert set(before.ravel()) == {"none"}, name
+                continue
+            if name.endswith("sds"):
+                modes = automaton.SDS_MODES
+            assert set(before[flight]) == {"none"}
+            assert set(before[~flight & (segments["before"] != "resting")]) <= set(modes)

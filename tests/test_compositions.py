@@ -51,6 +51,10 @@ def random_point(rng, model, plane):
         "friction_regularization_speed": 10 ** rng.uniform(-10, -1),
         "smooth_friction": float(rng.integers(2)), "tangential_stiffness_ratio": 0.8,
         "normal_damping_model": 0.0, "damping_ratio": 0.1, "tangential_damping_ratio": 0.1,
+        # rolling resistance: its own part (tests/test_rolling.py); none of these laws
+        # reads it
+        "rolling_resistance": 0.0, "rolling_stiffness": 0.0, "rolling_damping": 0.0,
+        "twisting_resistance": 0.0, "twisting_stiffness": 0.0, "twisting_damping": 0.0,
     }
     p["plane_count"] = 1.0   # the plane table (run time): no law reads it
     assert set(p) == set(PARAMETER_NAMES)

@@ -401,6 +401,12 @@ REPORTED = {
     ("5 varying V_t", "compliant", "normalised spin r w'/(mu V_n)"),
     ("6 spin only", "compliant", "beta = -u'/u"),
     ("6 spin only", "compliant", "tan recoil angle"),
+    # rolling resistance's sds against LAMMPS' algorithm where the two laws differ (a
+    # dashpot; twisting): docs/contact_laws.md, "sds"
+    ("7 rolling resistance", "sds",
+     "sds vs LAMMPS rolling sds, dashpot 0.3 critical: worst rebound difference"),
+    ("7 rolling resistance", "sds",
+     "sds vs LAMMPS rolling sds, twisting, no dashpot: worst rebound difference"),
 }
 
 
@@ -424,7 +430,7 @@ def test_validation_runs(tmp_path):
     run = subprocess.run([sys.executable, "-m", "validation", "--out", str(tmp_path)],
                          cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert sorted(p.name for p in tmp_path.glob("*.png")) == [
-        f"test{k}.png" for k in (2, 3, 4, 5, 6)]
+        f"test{k}.png" for k in (2, 3, 4, 5, 6, 7)]
     failed = [line for line in run.stdout.splitlines() if " FAIL " in line]
     assert not failed, run.stdout
     assert run.returncode == 0, run.stdout + run.stderr

@@ -69,6 +69,38 @@ def test_random_oblique_spinning_impacts_never_gain_energy(damping):
         assert energy["tangential_spring"].max() > 0
 
 
+#: The rolling resistance models the impacts below draw (ballc.scene.ROLLING_MODELS).
+ROLLING_MODELS = ("exact", "sds")
+
+
+@pytest.mark.parametrize("model", ROLLING_MODELS)
+def test_random_impacts_with_rolling_resistance_never_gain_energy(model):
+    """Random oblique, spinning impacts with rolling and twisting resistance (mu_r, mu_t
+    drawn in [0, 0.5]): the kinetic energy never grows, the rolling part's dissipated
+    work never falls, and the balance closes with it (issue 31)."""
+    rng = np.random.default_rng(31)
+    dissipated = []
+    for _ in range(12):
+        scene, v, w = random_impact(rng, restitution=0.6)
+        springs = {} if model == "exact" else dict(   # (no gravity: no default stiffness)
+            rolling_stiffness=10 ** rng.uniform(1, 5), twisting_stiffness=10 ** rng.uniform(1, 5),
+            rolling_damping=rng.uniform(0, 2), twisting_damping=rng.uniform(0, 2))
+        scene = scene.replace(rolling_resistance=rng.uniform(0.0, 0.5),
+                              twisting_resistance=rng.uniform(0.0, 0.5), rolling_model=model,
+                              **springs)
+        hit = ballc.impact(scene, v, w, rtol=1e-10)
+        before, after = kinetic(scene, v, w), kinetic(scene, hit.velocity_after,
+                                                     hit.angular_velocity_after)
+        assert after <= before * (1 + 1e-9), (scene, before, after)
+        energy = hit.result.energy
+        rolling = energy["dissipated_rolling"]
+        assert np.all(np.diff(rolling) >= -1e-12 * before), np.diff(rolling).min()
+        drift = np.abs(energy["balance"] - energy["balance"][0]).max()
+        assert drift < 1e-6 * before, drift
+        dissipated.append(rolling[-1] / before)
+    assert max(dissipated) > 1e-3   # the rolling part took its share
+
+
 def test_tangential_dissipation_rate_is_non_negative_at_every_state():
     """The rate itself (the kernel's output), at states sampled along random impacts and
     at random perturbations of them: -F_t.v_t - d/dt(1/2 k_t |s|^2) >= 0."""

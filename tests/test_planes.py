@@ -60,7 +60,7 @@ def test_the_layout_follows_the_planes():
     assert scene.state_names[-2:] == ("north_deflection_x", "north_deflection_y")
     assert scene.initial_state().shape == (27,)
     params = scene.parameter_vector()
-    assert len(params) == len(scene.parameter_names) == 26 + 6 * 6
+    assert len(params) == len(scene.parameter_names) == 32 + 6 * 6   # rolling: 6 of 32
     assert params[scene.parameter_names.index("plane_count")] == 6
     unnamed = ballc.Scene(planes=[Plane(), Plane((0, 0, 3), (0, 0, -1))], position=(0, 0, 1.5))
     assert unnamed.plane_names == ("plane0", "plane1")

@@ -45,6 +45,10 @@ def scenes(draw, models=MODELS, mirror_ready=False):
         # the compliant law's k_t / k_n ratio (2/7: the superball; Mindlin: ~0.8);
         # the other laws ignore it
         tangential_stiffness_ratio=draw(st.floats(0.1, 1.5)),
+        # rolling resistance (issue 31): none, or mu_r, mu_t up to 0.5, in either model
+        rolling_resistance=draw(st.just(0.0) | st.floats(1e-3, 0.5)),
+        twisting_resistance=draw(st.just(0.0) | st.floats(1e-3, 0.5)),
+        rolling_model=draw(st.sampled_from(ROLLING_MODELS)),
     )
     # mu in [0, 1]; for the compliant law 0 or [1e-100, 1]: a vanishing but non-zero mu
     # crawled until issue 28 (test_compliant_law_with_a_vanishing_friction_coefficient
@@ -63,6 +67,9 @@ def scenes(draw, models=MODELS, mirror_ready=False):
         fields["angles"] = tuple(draw(st.floats(-3, 3)) for _ in range(3))
     return ballc.Scene(**fields)
 
+
+#: The rolling resistance models drawn (ballc.scene.ROLLING_MODELS).
+ROLLING_MODELS = ("exact", "sds")
 
 #: ballc's two compiled integrators: radau5 (the default) and the explicit dop853.
 METHODS = ("radau5", "dop853")
@@ -86,11 +93,13 @@ def test_no_nan_and_honest_status(method, scene):
 @SETTINGS
 @given(scene=scenes(models=("friction", "compliant")))
 def test_passive_model_never_creates_energy(method, scene):
-    """Friction and the compliant law with c_tau <= 1 are passive: E(t_j) <= E(t_i) for
-    all i < j, E = kinetic + potential + Hertz spring + the compliant law's tangential
-    spring (its stored energy: 0 for friction), up to integration tolerance (1e3 rtol of
-    the energy scale; see test_stress.energy_tolerance).  Oracle: the passivity of both
-    laws (docs/contact_laws.md): no ballc number is the expected value."""
+    """Friction and the compliant law with c_tau <= 1, with or without rolling
+    resistance, are passive: E(t_j) <= E(t_i) for all i < j, E = kinetic + potential +
+    Hertz spring + the compliant law's tangential spring (its stored energy: 0 for
+    friction) + the rolling part's sds springs, up to integration tolerance (1e3 rtol of
+    the energy scale; see test_stress.energy_tolerance), and the rolling part's
+    dissipated work never falls.  Oracle: the passivity of the laws
+    (docs/contact_laws.md): no ballc number is the expected value."""
     rtol = 1e-8
     result = ballc.simulate(scene, T_END, method=method, rtol=rtol, atol=1e-10)
     # a soft, heavy ball can honestly pass through the floor (rho reaches r: outside
@@ -99,8 +108,12 @@ def test_passive_model_never_creates_energy(method, scene):
     energy = result.energy
     total = energy["total"]
     np.testing.assert_allclose(total, energy["kinetic"] + energy["potential"]
-                               + energy["spring"] + energy["tangential_spring"],
-                               rtol=1e-12, atol=1e-12)
+                               + energy["spring"] + energy["tangential_spring"]
+                               + energy["rolling_spring"], rtol=1e-12, atol=1e-12)
+    rolling = energy["dissipated_rolling"]
+    assert np.all(np.diff(rolling) >= -1e3 * rtol * (abs(total[0]) + 1.0) - 1e-9)
+    if scene.rolling_resistance == 0 and scene.twisting_resistance == 0:
+        assert np.all(rolling == 0)
     if scene.tangential_model == "friction":
         assert np.all(energy["tangential_spring"] == 0.0)
     rise = np.max(total[1:] - np.minimum.accumulate(total)[:-1], initial=0.0)
@@ -109,11 +122,13 @@ def test_passive_model_never_creates_energy(method, scene):
 
 #: Reflection y -> -y: positions and velocities flip their y component; the angular
 #: velocity is a pseudovector (x and z flip); the rotation R -> S R S flips qx and qz;
-#: tangential deflections flip their y component.  Everything else is unchanged.
-def _mirror_signs():
+#: tangential deflections and rolling springs flip their y component, twisting springs
+#: (about the normal, as omega_z) flip.  Everything else is unchanged.
+def _mirror_signs(scene):
     flip = {"y", "vy", "omega_x", "omega_z", "qx", "qz"}
-    return np.array([-1.0 if name in flip or name.endswith("deflection_y") else 1.0
-                     for name in ballc.STATE_NAMES])
+    return np.array([-1.0 if name in flip or name.endswith(("deflection_y", "rolling_y",
+                                                            "twisting")) else 1.0
+                     for name in scene.state_names])
 
 
 def mirrored(scene):
@@ -152,7 +167,7 @@ def test_mirror_symmetric_scenes_stay_symmetric(models, data):
         # both stop at the same time, with the same samples of the grid before it
         assert one.t.size == two.t.size
         np.testing.assert_allclose(two.t, one.t, rtol=0, atol=tol * T_END)
-    expected = one.y * _mirror_signs()[:, None]
+    expected = one.y * _mirror_signs(scene)[:, None]
     scale = np.maximum(np.abs(one.y).max(axis=1, keepdims=True), 1.0)
     assert np.all(np.abs(two.y - expected) <= tol * scale)
     # the contact tables, one to one

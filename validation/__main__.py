@@ -19,7 +19,7 @@ def main(argv=None):
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, default=Path("ballc-output/validation"),
                         help="output folder (default: %(default)s)")
-    parser.add_argument("--only", default="", help="comma-separated test numbers (2..6)")
+    parser.add_argument("--only", default="", help="comma-separated test numbers (2..7)")
     args = parser.parse_args(argv)
     from .cases import TESTS
     chosen = [t.strip() for t in args.only.split(",") if t.strip()] or list(TESTS)

@@ -432,5 +432,11 @@ def test6_spin_only():
     return rows, fig
 
 
+def test7_rolling_resistance():
+    """Rolling resistance (issue 31): validation/rolling_cases.py."""
+    from .rolling_cases import test7_rolling_resistance as test
+    return test()
+
+
 TESTS = {"2": test2_elastic_normal, "3": test3_restitution, "4": test4_oblique_constant_speed,
-         "5": test5_tangential_velocity, "6": test6_spin_only}
+         "5": test5_tangential_velocity, "6": test6_spin_only, "7": test7_rolling_resistance}

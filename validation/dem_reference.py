@@ -21,8 +21,12 @@ a = -R n the arm to the contact point):
 * tangential damping: V = -c_t v_t, c_t = 2 gamma_t sqrt(m k_t), only with the capacity
   the elastic force leaves: alpha = min(1, max(0, mu F_n - |F_el|) / |V|),
   F_t = F_el + alpha V (so |F_t| <= mu F_n);
-* motion: m dv/dt = F_n n + F_t, I domega/dt = a x F_t, velocity Verlet with the forces
-  at step n+1 taken from the position at n+1 and the half-step velocities (as LAMMPS).
+* rolling and twisting (optional, ``rolling`` / ``twisting``): LAMMPS' rolling sds and
+  twisting sds (validation/rolling_reference.py) on F_n, their torques R n x F_r and
+  R F_w n;
+* motion: m dv/dt = F_n n + F_t, I domega/dt = a x F_t (+ the rolling and twisting
+  torques), velocity Verlet with the forces at step n+1 taken from the position at n+1
+  and the half-step velocities (as LAMMPS).
 
 The run starts at first touch (rho = 0) and stops when rho <= 0 again.
 """
@@ -31,6 +35,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from .rolling_reference import rolling_sds, twisting_sds
 
 #: Hertz's elastic impact lasts t_c = HERTZ_TIME_CONSTANT (m / k0)^(2/5) v^(-1/5):
 #: with rho_max = (5 m v^2 / (4 k0))^(2/5),
@@ -51,7 +57,7 @@ def hertz_contact_time(mass, k0, speed):
 def dem_impact(*, mass, radius, inertia, k0, kappa, mu, velocity,
                angular_velocity=(0.0, 0.0, 0.0), normal_damping="hunt_crossley",
                chi=0.0, gamma=0.0, gamma_t=0.0, steps_per_contact=20000,
-               midpoint_stiffness=False):
+               midpoint_stiffness=False, rolling=None, twisting=None):
     """One impact on the floor, stepped explicitly; see the module docstring.
 
     Parameters: mass m* (kg), radius R (m), inertia I (kg m^2, scalar), k0 (N/m^1.5),
@@ -62,6 +68,8 @@ def dem_impact(*, mass, radius, inertia, k0, kappa, mu, velocity,
     the k_t of the increment F_el -= k_t v_t dt at the step's mean penetration instead of
     the new one (the DEM codes'); the same law, but second order instead of first in the
     sticking phase (about 100 times smaller errors at the same N for high mu).
+    ``rolling``, ``twisting``: None, or dict(k=N/m, gamma=N s/m, mu=1) of LAMMPS' rolling
+    sds / twisting sds in force form (validation/rolling_reference.py).
 
     Returns a dict: velocity_after, angular_velocity_after (3-arrays), contact_time (s,
     rho's zero crossing interpolated linearly), max_penetration (m, sampled at the
@@ -84,11 +92,13 @@ def dem_impact(*, mass, radius, inertia, k0, kappa, mu, velocity,
     rho = rho_prev = rho_max = 0.0
     fx = fy = 0.0                      # stored elastic tangential force F_el (N)
     Fx = Fy = Fz = 0.0                 # total force on the ball at the current step (N)
+    Tx = Ty = Tz = 0.0                 # rolling and twisting torques at that step (N m)
+    roll_history, twist_history = [0.0, 0.0], [0.0]
     steps, max_steps = 0, 100 * steps_per_contact
     while True:
         # half kick (torque = a x F_t with a = (0, 0, -R): (R Fy, -R Fx, 0)), drift
         v[0] += hm * Fx; v[1] += hm * Fy; v[2] += hm * Fz
-        w[0] += hI * R * Fy; w[1] -= hI * R * Fx
+        w[0] += hI * R * Fy + hI * Tx; w[1] -= hI * R * Fx - hI * Ty; w[2] += hI * Tz
         rho_prev, rho = rho, rho - dt * v[2]
         steps += 1
         if rho <= 0.0:                 # contact over; no force at this step
@@ -124,9 +134,16 @@ def dem_impact(*, mass, radius, inertia, k0, kappa, mu, velocity,
         vis = ct * math.hypot(ux, uy)
         alpha = min(1.0, (cap - fel) / vis) if vis > 0.0 else 0.0
         Fx, Fy, Fz = fx - alpha * ct * ux, fy - alpha * ct * uy, Fn
+        Tx = Ty = Tz = 0.0
+        if rolling is not None:   # v_roll = R (omega x n), torque R n x F_r
+            frx, fry = rolling_sds(roll_history, (R * w[1], -R * w[0]), dt, normal_force=Fn,
+                                   **rolling)
+            Tx, Ty = -R * fry, R * frx
+        if twisting is not None:   # v_twist = R omega . n, torque R F_w n
+            Tz = R * twisting_sds(twist_history, R * w[2], dt, normal_force=Fn, **twisting)
         # second half kick
         v[0] += hm * Fx; v[1] += hm * Fy; v[2] += hm * Fz
-        w[0] += hI * R * Fy; w[1] -= hI * R * Fx
+        w[0] += hI * R * Fy + hI * Tx; w[1] -= hI * R * Fx - hI * Ty; w[2] += hI * Tz
 
     v1, w1 = np.array(v), np.array(w)
     kinetic = lambda vv, ww: 0.5 * mass * vv @ vv + 0.5 * inertia * ww @ ww  # noqa: E731

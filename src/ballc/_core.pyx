@@ -19,6 +19,8 @@ cdef extern from "ballc_kernels.h":
         BALLC_MAX_LATCH
         BALLC_MAX_PARAMETERS
     int BALLC_N_BALL_STATES, BALLC_N_PLANE_STATES
+    int BALLC_N_ROLLING_BALL_STATES, BALLC_N_ROLLING_PLANE_STATES
+    int BALLC_PARAMETER_ROLLING_RESISTANCE, BALLC_PARAMETER_TWISTING_RESISTANCE
     int BALLC_PARAMETER_PLANES, BALLC_PARAMETER_PLANE_COUNT, BALLC_N_PLANE_FIELDS
     int BALLC_N_LATCH_PER_PLANE
     int BALLC_N_PARAMETER_CONSTANTS
@@ -26,6 +28,8 @@ cdef extern from "ballc_kernels.h":
     void ballc_parameter_constants(const double *, double *) nogil
     const char *const BALLC_STATE_NAMES[]
     const char *const BALLC_PLANE_STATE_NAMES[]
+    const char *const BALLC_ROLLING_BALL_STATE_NAMES[]
+    const char *const BALLC_ROLLING_PLANE_STATE_NAMES[]
     const char *const BALLC_PARAMETER_NAMES[]
     const char *const BALLC_PARAMETER_UNITS[]
     const char *const BALLC_PLANE_FIELD_NAMES[]
@@ -81,6 +85,13 @@ cdef extern from "_system.h":
                                 double *) nogil
     int ballc_compliant_margins_prepared(const double *, const ballc_parameters_t *,
                                          const double *, ballc_flags, int, int, double *) nogil
+    int BALLC_ROLLING_STATE_NOUT, BALLC_SDS_MARGINS
+    int ballc_rolling_margins(const double *, const ballc_parameters_t *, const double *,
+                              ballc_flags, int, double *) nogil
+    int ballc_rolling_state(const double *, const ballc_parameters_t *, const double *,
+                            ballc_flags, int, double *) nogil
+    int ballc_remove_velocities(const double *, const ballc_parameters_t *, const double *,
+                                ballc_flags, int, int, double *) nogil
 
 #: The most planes a scene may have, and the layout of a run with n planes: the ball's
 #: states (BALL_STATE_NAMES), then PLANE_STATE_FIELDS per plane (``<plane>_<field>``);
@@ -90,6 +101,13 @@ MAX_PLANES = BALLC_MAX_PLANES
 BALL_STATE_NAMES = tuple(BALLC_STATE_NAMES[i].decode() for i in range(BALLC_N_BALL_STATES))
 PLANE_STATE_FIELDS = tuple(BALLC_PLANE_STATE_NAMES[i].decode()
                            for i in range(BALLC_N_PLANE_STATES))
+#: The states of rolling resistance (a run with rolling or twisting resistance only):
+#: after every plane's, ROLLING_BALL_STATE_NAMES, then ROLLING_PLANE_STATE_FIELDS per
+#: plane (its rolling springs, ``<plane>_<field>``).
+ROLLING_BALL_STATE_NAMES = tuple(BALLC_ROLLING_BALL_STATE_NAMES[i].decode()
+                                 for i in range(BALLC_N_ROLLING_BALL_STATES))
+ROLLING_PLANE_STATE_FIELDS = tuple(BALLC_ROLLING_PLANE_STATE_NAMES[i].decode()
+                                   for i in range(BALLC_N_ROLLING_PLANE_STATES))
 BASE_PARAMETER_NAMES = tuple(BALLC_PARAMETER_NAMES[i].decode()
                              for i in range(BALLC_PARAMETER_PLANES))
 BASE_PARAMETER_UNITS = tuple(BALLC_PARAMETER_UNITS[i].decode()
@@ -104,10 +122,15 @@ N_LATCH_PER_PLANE = BALLC_N_LATCH_PER_PLANE
 CONTACT_KINEMATICS_PER_PLANE = BALLC_CONTACT_KINEMATICS_PER_PLANE
 
 
-def state_names(planes):
-    """The state names of a run with the planes named ``planes``, in layout order."""
-    return BALL_STATE_NAMES + tuple(f"{plane}_{field}" for plane in planes
-                                    for field in PLANE_STATE_FIELDS)
+def state_names(planes, rolling=False):
+    """The state names of a run with the planes named ``planes``, in layout order;
+    ``rolling``: with rolling resistance (its states after every plane's)."""
+    names = BALL_STATE_NAMES + tuple(f"{plane}_{field}" for plane in planes
+                                     for field in PLANE_STATE_FIELDS)
+    if rolling:
+        names += ROLLING_BALL_STATE_NAMES + tuple(
+            f"{plane}_{field}" for plane in planes for field in ROLLING_PLANE_STATE_FIELDS)
+    return names
 
 
 def parameter_names(planes):
@@ -181,8 +204,19 @@ cdef int _planes_of(const double[::1] params) except -1:
     return n
 
 
-cdef inline int _states(int planes):
+cdef inline int _ball_and_plane_states(int planes):
+    """The number of states of a run with ``planes`` and no rolling resistance."""
     return BALLC_N_BALL_STATES + BALLC_N_PLANE_STATES * planes
+
+
+cdef inline int _states(const double[::1] params, int planes):
+    """The number of states of a run with ``params`` (``planes`` of them): the rolling
+    block only when its rolling or twisting resistance is not 0 (_system.c)."""
+    cdef int n = BALLC_N_BALL_STATES + BALLC_N_PLANE_STATES * planes
+    if (params[BALLC_PARAMETER_ROLLING_RESISTANCE] != 0
+            or params[BALLC_PARAMETER_TWISTING_RESISTANCE] != 0):
+        n += BALLC_N_ROLLING_BALL_STATES + BALLC_N_ROLLING_PLANE_STATES * planes
+    return n
 
 
 cdef inline int _latches(int planes):
@@ -191,8 +225,9 @@ cdef inline int _latches(int planes):
 
 def layout_of(params):
     """(planes, states, latched values) of a run with the parameter vector ``params``."""
-    cdef int n = _planes_of(np.ascontiguousarray(params, dtype=float))
-    return n, _states(n), _latches(n)
+    cdef const double[::1] p = np.ascontiguousarray(params, dtype=float)
+    cdef int n = _planes_of(p)
+    return n, _states(p, n), _latches(n)
 
 
 cdef void _copy_state(const double[:] y, double *ys, int n) except *:
@@ -222,7 +257,7 @@ cdef class System:
     def __init__(self, const double[::1] params, const double[::1] latch, long long flags):
         cdef int planes = _planes_of(params)
         _check("latch", latch.shape[0], _latches(planes))
-        self.n_states = _states(planes)
+        self.n_states = _states(params, planes)
         self._params_array = np.empty(params.shape[0])
         self._latch_array = np.empty(latch.shape[0])
         self._params = self._params_array
@@ -271,7 +306,7 @@ cdef class System:
 cdef int _check_call(const double[::1] params, Py_ssize_t states, Py_ssize_t latch) except -1:
     """The planes of ``params``, checked with a state's and a latch's length (-1: none)."""
     cdef int planes = _planes_of(params)
-    _check("y", states, _states(planes))
+    _check("y", states, _states(params, planes))
     if latch >= 0:
         _check("latch", latch, _latches(planes))
     return planes
@@ -353,9 +388,10 @@ cdef object _per_row_of_system(system_fn function, int per_plane, int fixed,
 
 
 def energies(const double[:, ::1] states, const double[::1] params):
-    """(n, 2 + 2 planes): kinetic, potential, each plane's Hertz spring, each plane's
-    tangential spring (J) per state row."""
-    return _per_row_of_system(ballc_energy, 2, 2, states, params)
+    """(n, 2 + 3 planes): kinetic, potential, each plane's Hertz spring, each plane's
+    tangential spring, each plane's rolling springs (0 without rolling resistance) (J)
+    per state row."""
+    return _per_row_of_system(ballc_energy, 3, 2, states, params)
 
 
 def contact_kinematics(const double[:, ::1] states, const double[::1] params):
@@ -411,7 +447,7 @@ def slip_map(const double[::1] params, int plane):
     state, u = slip_map . y."""
     cdef int planes = _planes_of(params)
     _plane_index(plane, planes)
-    cdef int n = _states(planes)
+    cdef int n = _states(params, planes)
     cdef double ys[BALLC_MAX_STATES]
     out = np.empty(BALLC_MAX_SLIP_NOUT)
     cdef double[::1] o = out
@@ -472,6 +508,62 @@ def remove_slip(const double[::1] y, const double[::1] params, long long flags, 
     cdef int status = ballc_remove_slip(&y[0], &params[0], flags, plane, &o[0])
     if status != BALLC_OK:
         raise FloatingPointError(f"remove_slip failed with C status {status}")
+    return out
+
+
+def rolling_state(const double[::1] y, const double[::1] params, const double[::1] latch,
+                  long long flags, int plane):
+    """Rolling resistance on ``plane`` (src/ballc/_rolling.h) under ``flags`` and the
+    modes in ``latch``: (lambda (3: the rolling force along t1, t2 and the twisting force
+    that hold the held parts, N), F_n (N), the rolling margin mu_r F_n - |lambda_r| (N),
+    the twisting margin mu_t F_n - |lambda_w| (N), the rolling velocity (2, m/s), the
+    twisting velocity (m/s)); raises if it cannot be evaluated (the plane must be in
+    contact under ``flags``)."""
+    _check_plane_call(y, params, latch, plane)
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
+    out = np.empty(BALLC_ROLLING_STATE_NOUT)
+    cdef double[::1] o = out
+    cdef int status = ballc_rolling_state(&y[0], &prepared, &latch[0], flags, plane, &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"rolling state failed with C status {status}")
+    return out
+
+
+def rolling_margins(const double[::1] y, const double[::1] params, const double[::1] latch,
+                    long long flags, int plane):
+    """The sds model's guards on ``plane`` (codegen contact.sds_margins), per part
+    (rolling, twisting): yield margin 1 - k |xi| / (mu F_n), re-stick margin (m/s, with
+    the penetration acceleration of the dynamics under ``flags`` and ``latch``) and the
+    deflection at the cap mu F_n / k (m)."""
+    _check_plane_call(y, params, latch, plane)
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
+    out = np.empty(BALLC_SDS_MARGINS)
+    cdef double[::1] o = out
+    cdef int status = ballc_rolling_margins(&y[0], &prepared, &latch[0], flags, plane, &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"rolling margins failed with C status {status}")
+    return out
+
+
+#: ballc_remove_velocities' mask bits (_rolling.h BALLC_HOLD_*)
+HOLD_SLIP, HOLD_ROLLING, HOLD_TWISTING = 1, 2, 4
+
+
+def remove_velocities(const double[::1] y, const double[::1] params, const double[::1] latch,
+                      long long flags, int plane, int mask):
+    """The state with ``plane``'s velocities in ``mask`` (HOLD_SLIP, HOLD_ROLLING,
+    HOLD_TWISTING) set to zero by one impulse of the constraint forces that hold them."""
+    _check_plane_call(y, params, latch, plane)
+    cdef ballc_parameters_t prepared
+    ballc_parameters_init(&prepared, &params[0])
+    out = np.empty(y.shape[0])
+    cdef double[::1] o = out
+    cdef int status = ballc_remove_velocities(&y[0], &prepared, &latch[0], flags, plane, mask,
+                                              &o[0])
+    if status != BALLC_OK:
+        raise FloatingPointError(f"remove_velocities failed with C status {status}")
     return out
 
 

@@ -13,12 +13,14 @@
 #include "_driver.h"
 #include "_integrator.h"
 #include "_system.h"
+#include "_rolling.h"
 
 #define N BALLC_MAX_STATES   /* room for a state; the run's are r->ns (params' planes) */
 #define NL BALLC_MAX_LATCH   /* room for a latch; the run's is r->nl */
 #define NLP BALLC_N_LATCH_PER_PLANE
 #define MAXP BALLC_MAX_PLANES
-#define EVENTS_PER_PLANE 6   /* the driver's own events of a segment per plane, at most */
+#define EVENTS_PER_PLANE 12  /* the driver's own events of a segment per plane, at most
+                              * (6, and the rolling part's: 3 per part) */
 #define SLIP_D BALLC_LATCH_SLIP_DIRECTION_X   /* within a plane's latch block */
 #define KIN_PER_PLANE BALLC_CONTACT_KINEMATICS_PER_PLANE
 
@@ -134,6 +136,7 @@ typedef struct {
     int interrupted;
     long seg_interpolant;
     ballc_segment_rec seg;      /* the segment under way's log record */
+    ballc_rolling_run rolling_run[MAXP];   /* rolling resistance's exact modes, per plane */
 } run_t;
 
 enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
@@ -145,7 +148,9 @@ enum { COMPLIANT_NONE = 0, COMPLIANT_ELASTIC, COMPLIANT_SLIDING };
 #define CAPACITY_SECOND (MARGIN_CODE + 5 * MAXP)
 
 enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RELEASE,
-       K_ARM, K_YIELD, K_RESTICK, K_CAPACITY, K_USER };   /* from K_APPROACH on: CARRY_STEP */
+       K_ARM, K_YIELD, K_RESTICK, K_CAPACITY,
+       K_ROLL_FIRST,   /* rolling resistance's events (_rolling.h BALLC_ROLLING_*) */
+       K_USER = K_ROLL_FIRST + BALLC_ROLLING_EVENTS };   /* from K_APPROACH on: CARRY_STEP */
 
 /* ---- the segment log (_driver.h: ballc_segment_rec) ---- */
 
@@ -153,6 +158,8 @@ enum { K_ENTER, K_LEAVE, K_THROUGH, K_DEEPEST, K_APPROACH, K_STOP, K_CLEAR, K_RE
 typedef char k_codes_are_segment_ends[((int)K_ENTER == (int)BALLC_SEG_ENTER
                                        && (int)K_DEEPEST == (int)BALLC_SEG_DEEPEST
                                        && (int)K_CAPACITY == (int)BALLC_SEG_CAPACITY
+                                       && (int)K_ROLL_FIRST == (int)BALLC_SEG_ROLL_APPROACH
+                                       && (int)K_USER == (int)BALLC_SEG_TWIST_RESTICK + 1
                                        && (int)K_USER == (int)BALLC_SEG_USER) ? 1 : -1];
 
 typedef char integrator_prof_fits[RADAU5_PROF_N == 7 ? 1 : -1];
@@ -163,7 +170,9 @@ const char *const ballc_plane_mode_names[BALLC_N_PLANE_MODES] = {
 
 const char *const ballc_segment_end_names[BALLC_N_SEGMENT_ENDS] = {
     "enter", "leave", "through", "deepest", "approach", "stop", "clear", "release", "arm",
-    "yield", "restick", "capacity", "user", "t_end", "rest check", "uniform check",
+    "yield", "restick", "capacity", "roll_approach", "roll_stop", "roll_clear",
+    "roll_release", "twist_stop", "twist_release", "roll_yield", "roll_restick",
+    "twist_yield", "twist_restick", "user", "t_end", "rest check", "uniform check",
     "orbit check", "step bound", "failed"};
 
 /* plane p's mode now (BALLC_PLANE_*, ballc.automaton.MODES) */
@@ -196,8 +205,13 @@ static void log_open(run_t *r)
     g->t_start = r->t;
     g->plane = -1;
     g->rearm_kind = g->rearm_plane = g->rearm_before = g->rearm_after = -1;
-    for (int p = 0; p < MAXP; p++)
+    for (int p = 0; p < MAXP; p++) {
         g->before[p] = p < r->np ? (signed char)plane_mode(r, p) : (signed char)-1;
+        g->rolling_before[p] = p < r->np ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 0)
+                                         : (signed char)-1;
+        g->twisting_before[p] = p < r->np ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 1)
+                                          : (signed char)-1;
+    }
 }
 
 /* An event of plane p re-armed inside the segment, leaving it in mode ``before``. */
@@ -222,8 +236,13 @@ static int log_close(run_t *r, int end, int plane, double t_end)
     g->end = end;
     g->plane = plane;
     g->t_end = t_end;
-    for (int p = 0; p < MAXP; p++)
+    for (int p = 0; p < MAXP; p++) {
         g->after[p] = p < r->np ? (signed char)plane_mode(r, p) : (signed char)-1;
+        g->rolling_after[p] = p < r->np ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 0)
+                                        : (signed char)-1;
+        g->twisting_after[p] = p < r->np ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 1)
+                                         : (signed char)-1;
+    }
     o->log[o->n_log++] = *g;
     return 0;
 }
@@ -427,6 +446,27 @@ static double force_scale(const run_t *r, double load)
     return (64 * DBL_EPSILON) * (r->c->weight + fabs(load));
 }
 
+/* Whether a plane in contact holds its rolling or twisting velocity (rolling
+ * resistance's exact holding mode). */
+static int rolling_holds(const run_t *r)
+{
+    for (int p = 0; p < r->np; p++)
+        if (r->in_contact[p] && ballc_rolling_held_mask(r->latch, p, 0)) return 1;
+    return 0;
+}
+
+/* The slip of plane p removed by an impulse (stickslip.remove_slip), the other planes'
+ * sticking slips held; while rolling resistance holds a velocity, that one is held too
+ * (and plane p's own held ones removed with its slip: _rolling.h). */
+static int remove_slip(run_t *r, int p, ballc_flags flags, double *y_out)
+{
+    if (rolling_holds(r))
+        return ballc_remove_velocities(r->y, &r->prepared, r->latch, flags, p,
+                                       ballc_rolling_held_mask(r->latch, p, 0) | BALLC_HOLD_SLIP,
+                                       y_out);
+    return ballc_remove_slip(r->y, r->c->params, flags, p, y_out);
+}
+
 /* at zero slip: the slip projected to exactly zero, then stick when the constraint
  * force lies in the friction cone, else slip from rest along -lambda */
 static int settle(run_t *r, int p)
@@ -436,7 +476,7 @@ static int settle(run_t *r, int p)
                                            | ballc_flag(BALLC_KIND_SLIP_FIXED, p)
                                            | ballc_flag(BALLC_KIND_STICK, p));
     double y0[N], out[4];
-    if (ballc_remove_slip(r->y, r->c->params, base, p, y0) != BALLC_OK) {
+    if (remove_slip(r, p, base, y0) != BALLC_OK) {
         r->failed_kernel = 1;
         return -1;
     }
@@ -631,6 +671,9 @@ static int checked_plane(const run_t *r)
     return found;
 }
 
+static int start_rolling(run_t *r, int p);
+static int recheck_modes(run_t *r, int p);
+
 /* the automaton's "enter": latch rhodot^- and the dig-in direction (ballc.modes), relax
  * the tangential spring, open the contact's record, pick its first mode */
 static int begin_contact(run_t *r, int p)
@@ -686,14 +729,16 @@ static int begin_contact(run_t *r, int p)
     r->rest_check[p] = p == c->resting_plane || is_incline(r, p) ? r->t + c->rest_period
                                                                   : INFINITY;
     if (c->exact && start_coulomb(r, p)) return -1;
-    if (c->compliant_modes) return start_compliant(r, p, rate);
-    return 0;
+    if (c->compliant_modes && start_compliant(r, p, rate)) return -1;
+    return start_rolling(r, p);
 }
 
 /* the automaton's "leave": close the contact's record */
 static void end_contact(run_t *r, int p)
 {
     ballc_drive_output *o = r->o;
+    if (r->c->rolling || r->c->twisting)   /* the rolling part rests with the contact */
+        ballc_rolling_end(&r->prepared, p, r->y, r->latch);
     r->rest_check[p] = INFINITY;
     r->in_contact[p] = 0;
     r->coulomb[p] = BALLC_MODE_NONE;
@@ -751,6 +796,30 @@ static int settles(run_t *r, int p)
     return 0;
 }
 
+/* A stick's release: slip from rest along -lambda (the slip removed). */
+static int coulomb_release(run_t *r, int p)
+{
+    double out[4], y1[N], dir[2];
+    if (ballc_stick_state(r->y, r->c->params, r->latch, run_flags(r, 1), p, out)
+            != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    double size = hypot(out[0], out[1]);
+    const double *d = NULL;
+    if (size > 0) {
+        dir[0] = -out[0] / size;
+        dir[1] = -out[1] / size;
+        d = dir;
+    }
+    if (remove_slip(r, p, run_flags(r, 1), y1) != BALLC_OK) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    memcpy(r->y, y1, r->ns * sizeof(double));
+    return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
+}
+
 /* the automaton's approach, stop, clear and release: the next exact-Coulomb mode */
 static int coulomb_event(run_t *r, int kind, int p)
 {
@@ -776,28 +845,120 @@ static int coulomb_event(run_t *r, int kind, int p)
                         py_min(clear, APPROACH_FRACTION * speed));
     case K_CLEAR:
         return set_mode(r, p, BALLC_MODE_SLIP, direction, 0, 0.0);
-    default: {   /* release */
-        double out[4], y1[N];
-        if (ballc_stick_state(r->y, r->c->params, r->latch, run_flags(r, 1), p, out)
-                != BALLC_OK) {
+    default:   /* release */
+        return coulomb_release(r, p);
+    }
+}
+
+/* ---- rolling resistance's exact and sds modes (_rolling.h) ---- */
+
+/* The scales of the rolling part's guards and resets at y (_rolling.h). */
+static ballc_rolling_scales rolling_scales(const run_t *r, int p, const double *y)
+{
+    double error = error_speed(r, y), speed = speed_scale(r, y);
+    /* the compliant guards' rounding, with rho at least the arming depth: below it the
+     * margins, of a cap ~ rho^(3/2), are not resolved (compliantmodes.arm_penetration) */
+    double position = plane_position(r, p, y);
+    double arm = py_max(BALLC_ARM_ULPS * ulp(position), r->c->arm_force_depth);
+    double rounding = py_max(64 * DBL_EPSILON,
+                             8 * ulp(position) / py_max(rho_of(r, p, y), arm));
+    ballc_rolling_scales s = {error, CLEAR_FACTOR * error, 4 * ulp(speed),
+                              r->c->weight, rounding, speed};
+    return s;
+}
+
+/* Whether a plane's sds slider acts: its segments take a Jacobian at every step, as the
+ * compliant law's sliding mode (its turn's stiffness (e . w) / |xi| follows |xi|). */
+static int rolling_slides(const run_t *r)
+{
+    for (int p = 0; p < r->np; p++)
+        for (int part = 0; part < 2; part++)
+            if (r->in_contact[p]
+                    && ballc_rolling_mode(r->latch + p * NLP, part) == BALLC_ROLLING_MODE_SLIDER)
+                return 1;
+    return 0;
+}
+
+/* A contact starts: the rolling and twisting parts' first modes. */
+static int start_rolling(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    if (!c->rolling && !c->twisting) return 0;
+    ballc_rolling_scales scales = rolling_scales(r, p, r->y);
+    if (ballc_rolling_start(&r->prepared, p, c->rolling, c->twisting, r->y,
+                            r->latch, run_flags(r, 1), r->coulomb[p] == BALLC_MODE_STICK,
+                            &r->rolling_run[p], &scales)) {
+        r->failed_kernel = 1;
+        return -1;
+    }
+    return recheck_modes(r, p);
+}
+
+/* After a reset of plane p that moved the state or changed what holds (a settle, a
+ * release), every exact mode must still be on its guard's side (_rolling.h,
+ * ballc_rolling_recheck): a Coulomb slip with u . d above its approach speed (free) or
+ * above -margin (fixed), a stick with its margin mu N - |lambda| above -scale (a hold
+ * that starts next to it shares the load: a ball held from rolling on an incline needs
+ * all of m g sin(theta) from friction), and so the rolling and twisting parts; one that
+ * is not starts afresh, or is released, which may move the state again (a few passes).
+ * Only with rolling resistance: without it, Coulomb's resets keep their own invariants. */
+static int recheck_modes(run_t *r, int p)
+{
+    const ballc_drive_config *c = r->c;
+    if (!c->rolling && !c->twisting) return 0;
+    for (int pass = 0; pass < 8; pass++) {
+        int restarted = 0;
+        int mode = r->coulomb[p];
+        if (c->exact && (mode == BALLC_MODE_SLIP || mode == BALLC_MODE_SLIP_FIXED)) {
+            double u[2], speed, error, clear;
+            slip(r, p, r->y, u, &speed, &error, &clear);
+            const double *d = r->latch + p * NLP + SLIP_D;
+            double along = u[0] * d[0] + u[1] * d[1];
+            double guard = mode == BALLC_MODE_SLIP
+                           ? (r->has_approach[p] ? r->approach[p] : clear)
+                           : -4 * ulp(speed_scale(r, r->y));
+            if (!(along > guard)) {
+                if (start_coulomb(r, p)) return -1;
+                restarted++;
+            }
+        } else if (c->exact && mode == BALLC_MODE_STICK) {
+            double out[4];
+            if (ballc_stick_state(r->y, c->params, r->latch, run_flags(r, 1), p, out)
+                    != BALLC_OK) {
+                r->failed_kernel = 1;
+                return -1;
+            }
+            if (out[3] < -force_scale(r, out[2])) {
+                if (coulomb_release(r, p)) return -1;
+                restarted++;
+            }
+        }
+        ballc_rolling_scales scales = rolling_scales(r, p, r->y);
+        int n = ballc_rolling_recheck(&r->prepared, p, r->y, r->latch, run_flags(r, 1),
+                                      r->coulomb[p] == BALLC_MODE_STICK,
+                                      &r->rolling_run[p], &scales);
+        if (n < 0) {
             r->failed_kernel = 1;
             return -1;
         }
-        double size = hypot(out[0], out[1]);
-        const double *d = NULL;
-        if (size > 0) {
-            dir[0] = -out[0] / size;
-            dir[1] = -out[1] / size;
-            d = dir;
-        }
-        if (ballc_remove_slip(r->y, r->c->params, run_flags(r, 1), p, y1) != BALLC_OK) {
-            r->failed_kernel = 1;
-            return -1;
-        }
-        memcpy(r->y, y1, r->ns * sizeof(double));
-        return set_mode(r, p, BALLC_MODE_SLIP_FIXED, d, 0, 0.0);
+        if (!restarted && !n) return 0;
     }
+    return 0;
+}
+
+/* An event of the rolling part: its reset (_rolling.c), counted as a mode change. */
+static int rolling_event(run_t *r, int kind, int p)
+{
+    if (!settles(r, p)) return 0;
+    ballc_rolling_scales scales = rolling_scales(r, p, r->y);
+    r->transitions[p] += 1;
+    if (ballc_rolling_transition(&r->prepared, p, kind - K_ROLL_FIRST, r->y, r->latch,
+                                 run_flags(r, 1), r->coulomb[p] == BALLC_MODE_STICK,
+                                 &r->rolling_run[p], &scales)) {
+        r->failed_kernel = 1;
+        return -1;
     }
+    return recheck_modes(r, p);
 }
 
 /* the automaton's arm, yield, capacity and restick: the compliant law's next mode */
@@ -861,6 +1022,10 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
     double out[6];
     (void)t;
     int code = r->ev_plane_code[e];
+    if (r->ev_kind[e] >= K_ROLL_FIRST && r->ev_kind[e] < K_USER)   /* the rolling part's */
+        return ballc_rolling_guard_value(&r->prepared, r->ev_plane[e],
+                                         r->ev_kind[e] - K_ROLL_FIRST, y, r->latch,
+                                         r->seg_flags, g);
     if (code <= -2) {   /* the user's callable (the bridge's _user_event) */
         int st = r->c->user_fun(r->c->user_ctx, -2 - code, t, y, g);
         if (st) r->user_failed = 1;
@@ -1043,6 +1208,22 @@ static int segment_events(run_t *r, ballc_flags flags)
             int k = add_event(r, K_RELEASE, p, NULL, -1, 0, force_scale(r, out[2]), 1, -1);
             r->ev_nonlinear[k] = 1;
             r->ev_plane_code[k] = p;
+        }
+        if (r->in_contact[p] && ballc_rolling_on(r->latch + p * NLP)) {   /* _rolling.h */
+            ballc_rolling_guard guards[4];
+            ballc_rolling_scales scales = rolling_scales(r, p, y0);
+            int n = ballc_rolling_guards(&r->prepared, p, y0, r->latch, flags,
+                                         &r->rolling_run[p], &scales, guards);
+            if (n < 0) {
+                r->failed_kernel = 1;
+                return -1;
+            }
+            for (int i = 0; i < n; i++) {
+                const ballc_rolling_guard *g = &guards[i];
+                int k = add_event(r, K_ROLL_FIRST + g->event, p, g->linear ? g->row : NULL,
+                                  -1, 0, g->offset, 1, g->direction);
+                r->ev_nonlinear[k] = !g->linear;
+            }
         }
         if (r->compliant[p] != COMPLIANT_NONE) {   /* the mode's guard */
             if (!r->armed[p]) {   /* the penetration rising through the arming depth */
@@ -1446,6 +1627,25 @@ static double tangential_springs(const run_t *r, const double *e)
     return spring;
 }
 
+/* the rolling part's sds springs' energy, every plane's (J; 0 without them) */
+static double rolling_springs(const run_t *r, const double *e)
+{
+    double spring = 0.0;
+    for (int q = 0; q < r->np; q++) spring += e[2 + 2 * r->np + q];
+    return spring;
+}
+
+/* Whether plane p holds its rolling (rolling resistance's exact holding mode) and sticks:
+ * the ball can then only spin about the normal, uniformly (the constraints keep omega
+ * along n and the centre still; no force has a moment about n), whatever its inertia
+ * and observer -- a uniform motion in closed form. */
+static int held_still(const run_t *r, int p)
+{
+    return p >= 0 && r->in_contact[p]
+           && ballc_rolling_mode(r->latch + p * NLP, 0) == BALLC_ROLLING_MODE_HOLDING
+           && r->coulomb[p] == BALLC_MODE_STICK;
+}
+
 /* The resting plane p's state: y with the centre at the static equilibrium's height
  * above the plane (r - rho_eq along its normal, which is opposite gravity) and no
  * velocity along the normal, every deflection 0 */
@@ -1479,7 +1679,11 @@ static int at_rest(const run_t *r, int p, const double *y, double t_start, doubl
     const ballc_drive_config *c = r->c;
     if (t - t_start < c->rest_period) return 0;
     double across = 0.0, up = 0.0;
-    if (c->observer_massive) {   /* the observer's offset from the centre, plane's frame */
+    /* a ball whose rolling is held (the exact model's holding, or the sds spring below
+     * its cap) rests wherever its observer is: it cannot roll the observer lower */
+    int roll_mode = ballc_rolling_mode(r->latch + p * NLP, 0);
+    int held = roll_mode == BALLC_ROLLING_MODE_HOLDING || roll_mode == BALLC_ROLLING_MODE_SPRING;
+    if (c->observer_massive && !held) {   /* the observer's offset from the centre, plane's frame */
         double where[BALLC_OBSERVER_POSITION_NOUT], d[3], local[3];
         ballc_observer_position(y, c->params, r->prepared.constants, NULL, where);
         for (int i = 0; i < 3; i++) d[i] = where[i] - y[BALLC_STATE_X + i];
@@ -1496,7 +1700,7 @@ static int at_rest(const run_t *r, int p, const double *y, double t_start, doubl
     double normal = INFINITY;
     if (x > -1) normal = normal_above(c, x);   /* deep: inf, not at rest */
     double observer = 0.0;
-    if (c->observer_massive) {
+    if (c->observer_massive && !held) {
         double reach = hypot(across, up);
         observer = reach > 0 ? c->observer_weight * across * across / (reach + fabs(up)) : 0.0;
     }
@@ -1515,13 +1719,66 @@ static double max_abs(const double *v, int n)
     return m;
 }
 
+/* rolls() of a ball held and sticking on plane p (held_still): roll = y with no velocity
+ * along the normal and the centre at the contact's own equilibrium along it (Newton's
+ * method on the normal acceleration: with the seed's dig-in law and a direction latched
+ * off the normal, the weight is not carried by the Hertz force alone), the rolling
+ * springs and deflections as they are; the end state when the small normal oscillation
+ * about it holds less than the rest threshold's energy and the state is steady there
+ * (its spin about the normal then goes on uniformly). */
+static int held_spin(const run_t *r, int p, const double *y, double slip_speed, double *roll)
+{
+    const ballc_drive_config *c = r->c;
+    const ballc_plane_t *pl = &r->prepared.planes[p];
+    const double *n = pl->frame[2];
+    ballc_flags flags = run_flags(r, 1);
+    double rate[N], moved[N], slope = 0.0;
+    memcpy(roll, y, r->ns * sizeof(double));
+    double height = 0.0, vn = 0.0;
+    for (int i = 0; i < 3; i++) {
+        height += n[i] * (y[BALLC_STATE_X + i] - pl->point[i]);
+        vn += n[i] * y[BALLC_STATE_VX + i];
+    }
+    for (int i = 0; i < 3; i++) {
+        roll[BALLC_STATE_X + i] += (c->z_eq - height) * n[i];
+        roll[BALLC_STATE_VX + i] -= vn * n[i];
+    }
+    double moved_by = c->z_eq - height;   /* roll's height - y's */
+    for (int it = 0; it < 40; it++) {
+        if (ballc_rhs(roll, c->params, r->latch, flags, rate) != BALLC_OK) return -1;
+        double h = 1e-6 * c->rho_eq, a = 0.0, b = 0.0;
+        for (int i = 0; i < 3; i++) a += n[i] * rate[BALLC_STATE_VX + i];
+        memcpy(moved, roll, r->ns * sizeof(double));
+        for (int i = 0; i < 3; i++) moved[BALLC_STATE_X + i] += h * n[i];
+        if (ballc_rhs(moved, c->params, r->latch, flags, rate) != BALLC_OK) return -1;
+        for (int i = 0; i < 3; i++) b += n[i] * rate[BALLC_STATE_VX + i];
+        slope = (b - a) / h;
+        if (!(slope < 0)) return 0;   /* no restoring force: not in contact */
+        double dz = -a / slope;
+        for (int i = 0; i < 3; i++) roll[BALLC_STATE_X + i] += dz * n[i];
+        moved_by += dz;
+        if (fabs(dz) <= 4 * DBL_EPSILON * fabs(c->z_eq)) break;
+    }
+    double above = c->half_mass * (vn * vn - slope * moved_by * moved_by);
+    if (!(above <= c->rest_threshold)) return 0;
+    booked(r, y, roll);
+    if (ballc_rhs(roll, c->params, r->latch, flags, rate) != BALLC_OK) return -1;
+    double level = c->rolls_level;
+    if (max_abs(rate + BALLC_STATE_VX, 3) > level
+            || c->radius * max_abs(rate + BALLC_STATE_OMEGA_X, 3) > level)
+        return 0;
+    return slip_speed <= c->rolls_dv ? BALLC_END_ROLLING : BALLC_END_SLIDING;
+}
+
 /* uniform rolling or sliding on plane p (ballc.resting): BALLC_END_ROLLING / SLIDING
  * with ``roll`` the uniform state, 0 none, -1 when a kernel failed */
 static int rolls(run_t *r, int p, const double *y, double t_start, double t,
                  double slip_speed, double *roll)
 {
     const ballc_drive_config *c = r->c;
-    if (t - t_start < c->rest_period || !c->rolls_allowed) return 0;
+    int held = held_still(r, p);
+    if (t - t_start < c->rest_period || !(c->rolls_allowed || held)) return 0;
+    if (held) return held_spin(r, p, y, slip_speed, roll);
     double e[BALLC_MAX_ENERGY_NOUT];
     energy_of(r, y, e);
     double x = (rho_of(r, p, y) - c->rho_eq) / c->rho_eq;
@@ -1530,6 +1787,7 @@ static int rolls(run_t *r, int p, const double *y, double t_start, double t,
     double rate_n = rho_rate(r, p, y);
     double above = c->half_mass * (rate_n * rate_n) + tangential_springs(r, e)
                    + py_max(normal, 0.0);
+    if (c->rolling || c->twisting) above += rolling_springs(r, e);
     if (!(above <= c->rest_threshold)) return 0;
     memcpy(roll, y, r->ns * sizeof(double));   /* the uniform state, energy booked */
     at_equilibrium(r, p, roll);
@@ -1687,6 +1945,25 @@ static int incline_state(run_t *r, int p)
     energy_of(r, y, e);
     double above = 0.5 * M * pow(rho_rate(r, p, y), 2.0) + tangential_springs(r, e)
                    + py_max(normal, 0.0);
+    if (c->rolling || c->twisting) {
+        /* rolling resistance: a ball held from rolling and sticking rests on the incline
+         * (tan theta <= mu_r and mu); one rolling down does so against the rolling
+         * torque, which the closed form below has not: it goes on integrating */
+        if (!held_still(r, p)) return 0;
+        if (!(above + e[0] + rolling_springs(r, e) <= c->rest_threshold)) return 0;
+        double rest[N], height = 0.0;
+        const ballc_plane_t *pl = &r->prepared.planes[p];
+        memcpy(rest, y, r->ns * sizeof(double));
+        for (int i = 0; i < 3; i++) height += n[i] * (y[BALLC_STATE_X + i] - pl->point[i]);
+        for (int i = 0; i < 3; i++) {
+            rest[BALLC_STATE_X + i] += (radius - rho_eq - height) * n[i];
+            rest[BALLC_STATE_VX + i] = rest[BALLC_STATE_OMEGA_X + i] = 0.0;
+        }
+        booked(r, y, rest);
+        memcpy(r->y, rest, r->ns * sizeof(double));
+        r->seg.end = BALLC_SEG_REST_CHECK;
+        return BALLC_END_REST;
+    }
     if (!(above <= c->rest_threshold)) return 0;
     /* rolling along g_t, no spin about n */
     double u[2], speed, error, clear;
@@ -2137,7 +2414,8 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         pr.rearm = drv_rearm;
         pr.method = c->method;
         pr.jacobian_ahead = any_plane(r, flags, BALLC_KIND_COMPLIANT);
-        pr.jacobian_every_step = any_plane(r, flags, BALLC_KIND_COMPLIANT_SLIDING);
+        pr.jacobian_every_step = any_plane(r, flags, BALLC_KIND_COMPLIANT_SLIDING)
+                                 || rolling_slides(r);
         r->margins_plane = -1;   /* a fresh bridge context per segment */
         pr.auto_implicit = c->method == RADAU5_METHOD_AUTO && implicit;
         pr.poll = drv_poll;
@@ -2333,7 +2611,17 @@ int ballc_drive(const ballc_drive_config *c, const double *y0, ballc_drive_outpu
         case K_ARM: case K_YIELD: case K_RESTICK: case K_CAPACITY:
             handled = compliant_event(r, kind, p);
             break;
-        default: handled = coulomb_event(r, kind, p); break;
+        case K_ROLL_FIRST + BALLC_ROLLING_APPROACH: case K_ROLL_FIRST + BALLC_ROLLING_STOP:
+        case K_ROLL_FIRST + BALLC_ROLLING_CLEAR: case K_ROLL_FIRST + BALLC_ROLLING_RELEASE:
+        case K_ROLL_FIRST + BALLC_TWISTING_STOP: case K_ROLL_FIRST + BALLC_TWISTING_RELEASE:
+        case K_ROLL_FIRST + BALLC_ROLLING_YIELD: case K_ROLL_FIRST + BALLC_ROLLING_RESTICK:
+        case K_ROLL_FIRST + BALLC_TWISTING_YIELD: case K_ROLL_FIRST + BALLC_TWISTING_RESTICK:
+            handled = rolling_event(r, kind, p);
+            break;
+        default:
+            handled = coulomb_event(r, kind, p);
+            if (!handled && r->status == 0) handled = recheck_modes(r, p);
+            break;
         }
         if (handled) { rc = handled == -2 ? -2 : -1; break; }
         if (log_close(r, kind, p, r->t)) { rc = -2; break; }

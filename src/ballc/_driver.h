@@ -201,6 +201,9 @@ typedef struct {                       /* constants of one run, filled by the br
     const int *user_rearm;
     int (*rearm_fun)(void *ctx, int k, double t, const double *y, double *coef,
                      double *offset, double *latch);
+    /* issue 31: rolling resistance (_rolling.h): the rolling and twisting parts' models
+     * (0 off, 1 exact, 2 sds; both 0: the run has no rolling states) */
+    int rolling, twisting;
 } ballc_drive_config;
 
 /* how a run ended at a rest check (ballc.resting): the state from end_t on is end_y */
@@ -251,7 +254,12 @@ enum {
 enum {
     BALLC_SEG_ENTER = 0, BALLC_SEG_LEAVE, BALLC_SEG_THROUGH, BALLC_SEG_DEEPEST,
     BALLC_SEG_APPROACH, BALLC_SEG_STOP, BALLC_SEG_CLEAR, BALLC_SEG_RELEASE, BALLC_SEG_ARM,
-    BALLC_SEG_YIELD, BALLC_SEG_RESTICK, BALLC_SEG_CAPACITY, BALLC_SEG_USER,
+    BALLC_SEG_YIELD, BALLC_SEG_RESTICK, BALLC_SEG_CAPACITY,
+    /* rolling resistance's exact modes (_rolling.h, BALLC_ROLLING_* in its order) */
+    BALLC_SEG_ROLL_APPROACH, BALLC_SEG_ROLL_STOP, BALLC_SEG_ROLL_CLEAR, BALLC_SEG_ROLL_RELEASE,
+    BALLC_SEG_TWIST_STOP, BALLC_SEG_TWIST_RELEASE, BALLC_SEG_ROLL_YIELD,
+    BALLC_SEG_ROLL_RESTICK, BALLC_SEG_TWIST_YIELD, BALLC_SEG_TWIST_RESTICK,
+    BALLC_SEG_USER,
     BALLC_SEG_T_END,            /* reached t_end */
     BALLC_SEG_REST_CHECK,       /* a rest check that found rest */
     BALLC_SEG_UNIFORM_CHECK,    /* ... no rest; uniform rolling / sliding, or nothing */
@@ -282,6 +290,10 @@ typedef struct {
     signed char rearm_kind, rearm_plane;    /* the last re-arm: BALLC_SEG_APPROACH or
                                              * _CAPACITY and its plane; -1 none */
     signed char rearm_before, rearm_after;  /* the plane's mode before / after it */
+    /* each plane's rolling and twisting modes (BALLC_ROLLING_MODE_*: the latch's codes)
+     * during the segment and after its end was handled */
+    signed char rolling_before[BALLC_MAX_PLANES], rolling_after[BALLC_MAX_PLANES];
+    signed char twisting_before[BALLC_MAX_PLANES], twisting_after[BALLC_MAX_PLANES];
 } ballc_segment_rec;
 
 typedef struct {

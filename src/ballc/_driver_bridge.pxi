@@ -78,6 +78,7 @@ cdef extern from "_driver.h":
         const int *user_rearm
         int (*rearm_fun)(void *, int, double, const double *, double *, double *,
                          double *) noexcept nogil
+        int rolling, twisting
     ctypedef struct ballc_contact_rec:
         int plane, ended, passed_through, rate_is_kernel_value
         double t_start, t_end
@@ -99,7 +100,7 @@ cdef extern from "_driver.h":
         long step0, n_steps, coef0
         int terms
         int flight
-        double y0[27]
+        double y0[46]
         int own
         long interpolant
     enum: BALLC_N_PLANE_MODES, BALLC_N_SEGMENT_ENDS
@@ -112,6 +113,10 @@ cdef extern from "_driver.h":
         signed char before[6]
         signed char after[6]
         signed char rearm_kind, rearm_plane, rearm_before, rearm_after
+        signed char rolling_before[6]
+        signed char rolling_after[6]
+        signed char twisting_before[6]
+        signed char twisting_after[6]
     ctypedef struct ballc_drive_output:
         int n_planes, n_states, n_latch
         long n
@@ -151,7 +156,7 @@ cdef extern from "_driver.h":
         long segments
         int end_kind, end_plane
         double end_t
-        double end_y[27]
+        double end_y[46]
         double end_acceleration[3]
         int profiled
         double integrator_ns, drive_ns
@@ -207,12 +212,19 @@ cdef object _segment_record():
                <char *>&g.plane - at, <char *>&g.rearms - at, <char *>&g.before[0] - at,
                <char *>&g.after[0] - at, <char *>&g.rearm_kind - at,
                <char *>&g.rearm_plane - at, <char *>&g.rearm_before - at,
-               <char *>&g.rearm_after - at]
+               <char *>&g.rearm_after - at, <char *>&g.rolling_before[0] - at,
+               <char *>&g.rolling_after[0] - at, <char *>&g.twisting_before[0] - at,
+               <char *>&g.twisting_after[0] - at]
     fields = [("t_start", "f8"), ("t_end", "f8"), ("nfev", "l"), ("njev", "l"), ("nlu", "l"),
               ("nstep", "l"), ("nreject", "l"), ("method", "intc"), ("method_end", "intc"), ("switches", "intc"),
               ("end", "intc"), ("plane", "intc"), ("rearms", "intc"),
-              ("before", ("i1", (2,))), ("after", ("i1", (2,))), ("rearm_kind", "i1"),
-              ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1")]
+              ("before", ("i1", (BALLC_MAX_PLANES,))), ("after", ("i1", (BALLC_MAX_PLANES,))),
+              ("rearm_kind", "i1"),
+              ("rearm_plane", "i1"), ("rearm_before", "i1"), ("rearm_after", "i1"),
+              ("rolling_before", ("i1", (BALLC_MAX_PLANES,))),
+              ("rolling_after", ("i1", (BALLC_MAX_PLANES,))),
+              ("twisting_before", ("i1", (BALLC_MAX_PLANES,))),
+              ("twisting_after", ("i1", (BALLC_MAX_PLANES,)))]
     return np.dtype(dict(names=[f[0] for f in fields], formats=[f[1] for f in fields],
                          offsets=offsets, itemsize=sizeof(ballc_segment_rec)))
 
@@ -314,12 +326,19 @@ cdef int _drive_user_event(void *ctx, int k, double t, const double *y,
 
 
 cdef int _state_width(const double[::1] y0) except -1:
-    """The length of a state (a scene's: the ball's states and 2 per plane), checked."""
+    """The length of a state (a scene's: the ball's states and 2 per plane, then with
+    rolling resistance its ball state and 3 per plane), checked."""
     cdef Py_ssize_t n = y0.shape[0]
-    if n < BALLC_N_BALL_STATES + 2 or n > BALLC_MAX_STATES or (n - BALLC_N_BALL_STATES) % 2:
-        raise ValueError(f"y0 must have {BALLC_N_BALL_STATES} + 2 per plane values (1 to "
-                         f"{BALLC_MAX_PLANES} planes), got {n}")
-    return <int>n
+    cdef int planes
+    for planes in range(1, BALLC_MAX_PLANES + 1):
+        if n == _ball_and_plane_states(planes) or n == (
+                _ball_and_plane_states(planes) + BALLC_N_ROLLING_BALL_STATES
+                + BALLC_N_ROLLING_PLANE_STATES * planes):
+            return <int>n
+    raise ValueError(f"y0 must have {BALLC_N_BALL_STATES} + {BALLC_N_PLANE_STATES} per plane "
+                     f"values, and with rolling resistance {BALLC_N_ROLLING_BALL_STATES} + "
+                     f"{BALLC_N_ROLLING_PLANE_STATES} per plane more (1 to "
+                     f"{BALLC_MAX_PLANES} planes), got {n}")
 
 
 def flight_states(double t0, const double[::1] y0, const double[::1] gravity, t):
@@ -398,7 +417,7 @@ cdef class DriveScene:
         self.python = {}
         pv = self.params
         self.n_planes = _planes_of(pv)   # checks the parameters' length and plane table
-        self.n_states, self.n_latch = _states(self.n_planes), _latches(self.n_planes)
+        self.n_states, self.n_latch = _states(pv, self.n_planes), _latches(self.n_planes)
         memset(&self.c, 0, sizeof(ballc_drive_config))
         self.c.params = &pv[0]
         self.c.observer_bits = k["observer_bits"]
@@ -409,6 +428,8 @@ cdef class DriveScene:
         self.c.total_mass = k["total_mass"]
         self.c.rest_period = k["rest_period"]
         self.c.resting_plane = k["resting_plane"]
+        self.c.rolling = k["rolling"]
+        self.c.twisting = k["twisting"]
         self.c.compliant_modes = k["compliant_modes"]
         self.c.starts_armed = k["starts_armed"]
         self.c.arm_force_depth = k["arm_force_depth"]

@@ -132,7 +132,7 @@ def motion_apply(const double[::1] motion, y, k=1, bint rate=False):
     added)."""
     cdef ballc_motion g, gk
     _motion_of(motion, &g)
-    cdef int width = _states(g.n_planes)
+    cdef int width = _ball_and_plane_states(g.n_planes)
     states = np.asarray(y, dtype=float)
     single = states.ndim == 1
     if states.shape[0] != width:
@@ -199,7 +199,7 @@ def orbit_measure(sol, double t0, double t1, const double[::1] axis, double gues
     [t0, t1]): (c0, period, G as MOTION_SIZE numbers, the mechanical energy's rate of
     change (W)), or None."""
     _check("axis", axis.shape[0], 3)
-    cdef int width = _states(_planes_of(params))
+    cdef int width = _ball_and_plane_states(_planes_of(params))
     _check("atol", atol.shape[0], width)
     cdef ballc_orbit_tolerances tol
     cdef ballc_orbit found
@@ -229,7 +229,7 @@ def orbit_states(const double[::1] t, double c0, double period, const double[::1
     orbit.period = period
     orbit.rate = 0.0
     _motion_of(motion, &orbit.g)
-    cdef int width = _states(orbit.g.n_planes)
+    cdef int width = _ball_and_plane_states(orbit.g.n_planes)
     cdef list ctx = [base, [], width]
     out = np.empty((t.shape[0], width))
     cdef double[:, ::1] o = out

@@ -9,7 +9,7 @@ static double dot3(const double *a, const double *b)
 }
 
 void ballc_plane_init(ballc_plane_t *plane, const double *point, const double *normal,
-                      const double *gravity, int deflection)
+                      const double *gravity, int deflection, int rolling)
 {
     double *t1 = plane->frame[0], *t2 = plane->frame[1], *n = plane->frame[2];
     double length = sqrt(dot3(normal, normal));
@@ -29,6 +29,7 @@ void ballc_plane_init(ballc_plane_t *plane, const double *point, const double *n
     t2[2] = n[0] * t1[1] - n[1] * t1[0];
     plane->gravity_into = -dot3(n, gravity);
     plane->deflection = deflection;
+    plane->rolling = rolling;
 }
 
 void ballc_plane_state_columns(const ballc_plane_t *plane, const double *local, int rows,
@@ -46,6 +47,11 @@ void ballc_plane_state_columns(const ballc_plane_t *plane, const double *local, 
         }
         jac[plane->deflection] = local[BALLC_CONTACT_STATE_DEFLECTION_X];
         jac[plane->deflection + 1] = local[BALLC_CONTACT_STATE_DEFLECTION_Y];
+        if (plane->rolling >= 0) {
+            jac[plane->rolling] = local[BALLC_CONTACT_STATE_ROLLING_X];
+            jac[plane->rolling + 1] = local[BALLC_CONTACT_STATE_ROLLING_Y];
+            jac[plane->rolling + 2] = local[BALLC_CONTACT_STATE_TWISTING];
+        }
     }
 }
 

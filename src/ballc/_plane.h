@@ -6,7 +6,7 @@
  *
  *   the contact state (BALLC_CONTACT_STATE_*): the centre's height z_l = n . (c - p), the
  *     angular velocity omega_l = R^T omega and velocity v_l = R^T v, and the plane's
- *     tangential deflection as it is (it lives in the plane's frame);
+ *     tangential deflection and rolling spring as they are (they live in its frame);
  *   the plane's inputs (BALLC_N_PLANE_INPUTS): its latch block with the dig-in direction
  *     (latched in inertial components) turned into the frame, and gravity into the
  *     plane, -n . g;
@@ -14,7 +14,8 @@
  *     torque and a force, tau = R tau_l and F = R F_l, the contact force F = R F_l; its
  *     scalars (dissipation rates) and the deflection rates (the plane's frame) as they are;
  *   its Jacobian d/d(contact state) as d/d(state): the centre's columns n dz_l, those of
- *     omega and v through R^T, the deflection's to the plane's own, the rest 0 (a sphere's
+ *     omega and v through R^T, the deflection's and the rolling spring's to the plane's
+ *     own, the rest 0 (a sphere's
  *     contact depends neither on its orientation nor on where along the plane it is).
  */
 #ifndef BALLC_PLANE_H
@@ -27,15 +28,18 @@ typedef struct {
     double frame[3][3];      /* rows t1, t2, n (inertial components): R^T */
     double gravity_into;     /* -n . g (m/s^2): gravity's component into the plane */
     int deflection;          /* the state index of the plane's deflection_x (y next) */
+    int rolling;             /* the state index of its rolling spring (rolling_x, _y,
+                              * twisting), -1 in a run without rolling resistance */
 } ballc_plane_t;
 
 /* The plane through ``point`` with the normal ``normal`` (towards the ball, any length
  * > 0: normalised here), its frame: t1 the coordinate axis the normal has least of (the
  * first such) made perpendicular to n and unit, t2 = n x t1 (the floor: x, y, z; the
  * ceiling, normal -z: x, -y, -z).  ``gravity`` (3) the gravity vector, ``deflection``
- * the state index of the plane's deflection_x. */
+ * the state index of the plane's deflection_x, ``rolling`` that of its rolling_x (-1:
+ * none, the rolling springs read as 0). */
 void ballc_plane_init(ballc_plane_t *plane, const double *point, const double *normal,
-                      const double *gravity, int deflection);
+                      const double *gravity, int deflection, int rolling);
 
 /* v_l = R^T v: the components along t1, t2, n. */
 static inline void ballc_plane_to_local(const ballc_plane_t *plane, const double *v,
@@ -59,6 +63,14 @@ static inline void ballc_plane_contact_state(const ballc_plane_t *plane, const d
     ballc_plane_to_local(plane, state + BALLC_STATE_VX, local + BALLC_CONTACT_STATE_VX);
     local[BALLC_CONTACT_STATE_DEFLECTION_X] = state[plane->deflection];
     local[BALLC_CONTACT_STATE_DEFLECTION_Y] = state[plane->deflection + 1];
+    if (plane->rolling >= 0) {
+        local[BALLC_CONTACT_STATE_ROLLING_X] = state[plane->rolling];
+        local[BALLC_CONTACT_STATE_ROLLING_Y] = state[plane->rolling + 1];
+        local[BALLC_CONTACT_STATE_TWISTING] = state[plane->rolling + 2];
+    } else {   /* a run without rolling resistance has no rolling springs */
+        local[BALLC_CONTACT_STATE_ROLLING_X] = local[BALLC_CONTACT_STATE_ROLLING_Y] = 0.0;
+        local[BALLC_CONTACT_STATE_TWISTING] = 0.0;
+    }
 }
 
 /* A plane kernel's extra (BALLC_N_PLANE_INPUTS) from the plane's latch block

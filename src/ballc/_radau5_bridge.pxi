@@ -734,7 +734,7 @@ def solve_system(params, latch, long long flags, t_span, y0, *, rtol, atol,
     ballc_parameters_init(&ctx.prepared, &pv[0])
     ctx.latch = &lv[0]
     ctx.flags = flags
-    ctx.n_states = _states(n_planes)
+    ctx.n_states = _states(pv, n_planes)
     ctx.n_latch = _latches(n_planes)
     ctx.event_plane = &planes[0]
     margins_state = np.empty(ctx.n_states)

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "_system.h"
+#include "_rolling.h"
 
 #define MAXS BALLC_MAX_STATES
 #define NB BALLC_N_BALL_STATES   /* the ball's states: the generated dynamics' columns */
@@ -34,7 +35,13 @@ int ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
         return BALLC_BAD_PLANES;
     }
     prepared->n_planes = n;
-    prepared->n_states = NB + BALLC_N_PLANE_STATES * n;
+    /* rolling resistance: its states, after every plane's (none without it) */
+    prepared->rolling = params[BALLC_PARAMETER_ROLLING_RESISTANCE] != 0
+                        || params[BALLC_PARAMETER_TWISTING_RESISTANCE] != 0;
+    prepared->rolling_state = prepared->rolling ? NB + BALLC_N_PLANE_STATES * n : -1;
+    prepared->n_states = NB + BALLC_N_PLANE_STATES * n
+                         + (prepared->rolling ? BALLC_N_ROLLING_BALL_STATES
+                                                + BALLC_N_ROLLING_PLANE_STATES * n : 0);
     prepared->n_latch = BALLC_N_LATCH_PER_PLANE * n;
     prepared->n_parameters = BALLC_PARAMETER_PLANES + BALLC_N_PLANE_FIELDS * n;
     ballc_parameter_constants(params, prepared->constants);
@@ -44,12 +51,22 @@ int ballc_parameters_init(ballc_parameters_t *prepared, const double *params)
     for (int p = 0; p < n; p++) {
         const double *entry = params + BALLC_PARAMETER_PLANES + p * BALLC_N_PLANE_FIELDS;
         ballc_plane_t *pl = &prepared->planes[p];
+        int rolling = prepared->rolling ? prepared->rolling_state + BALLC_N_ROLLING_BALL_STATES
+                                          + BALLC_N_ROLLING_PLANE_STATES * p : -1;
         ballc_plane_init(pl, entry + BALLC_PLANE_POINT_X, entry + BALLC_PLANE_NORMAL_X,
-                         params + BALLC_PARAMETER_GRAVITY_X, ballc_plane_state(p));
+                         params + BALLC_PARAMETER_GRAVITY_X, ballc_plane_state(p), rolling);
         /* the plane's slip map by the ball's state, its force map in inertial components */
         ballc_plane_state_columns(pl, maps, 2, prepared->n_states, prepared->slip_map[p]);
         memcpy(prepared->slip_force_map[p], maps + 2 * NC, sizeof prepared->slip_force_map[p]);
         ballc_plane_rows_to_inertial(pl, prepared->slip_force_map[p], 2, 0, 2);
+        if (!prepared->rolling) continue;
+        /* the same for its rolling and twisting velocities (_rolling.h) */
+        double roll[BALLC_PLANE_ROLLING_MAP_NOUT];
+        ballc_plane_rolling_map(anywhere, PARAMS(prepared), NULL, roll);
+        ballc_plane_state_columns(pl, roll, 3, prepared->n_states, prepared->rolling_map[p]);
+        memcpy(prepared->rolling_force_map[p], roll + 3 * NC,
+               sizeof prepared->rolling_force_map[p]);
+        ballc_plane_rows_to_inertial(pl, prepared->rolling_force_map[p], 3, 0, 2);
     }
     return BALLC_OK;
 }
@@ -196,6 +213,7 @@ typedef struct {
     double lambda[MAXP][2];           /* sticking: the constraint force */
     /* the coefficients of rho'' in the auxiliary rates, per plane (0 without) */
     double acceleration[MAXP][4];
+    ballc_rolling_eval rolling[MAXP];   /* rolling resistance (_rolling.h) */
 } evaluation_t;
 
 /* The exact penetration acceleration rho'' of ``plane`` from the solved udot: rho = r -
@@ -233,6 +251,8 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
         ev->mode[plane] = exact_mode(flags, plane);
         ev->load[plane] = 0.0;
         for (int i = 0; i < 4; i++) ev->acceleration[plane][i] = 0.0;
+        ev->rolling[plane].mode[0] = ev->rolling[plane].mode[1] = BALLC_ROLLING_MODE_NONE;
+        for (int i = 0; i < 4; i++) ev->rolling[plane].acceleration[i] = 0.0;
     }
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
     for (int plane = 0; plane < np; plane++) {
@@ -266,6 +286,9 @@ static void assemble(const double *state, const ballc_parameters_t *params, cons
             auxiliary_targets(pl, target);
             for (int i = 0; i < 4; i++) xdot[target[i]] += sum[BALLC_LAW_DISSIPATION + i];
         }
+        if (params->rolling && ballc_rolling_on(law_latch(latch, plane)))   /* the 4th part */
+            ballc_rolling_assemble(params, plane, contact.state, contact.inputs,
+                                   law_latch(latch, plane), &ev->rolling[plane], force, xdot);
         if (ev->mode[plane] == MODE_NONE) continue;
         slip_t *slip = &ev->slip[plane];
         slip_of(params, plane, contact.state, slip);
@@ -369,7 +392,7 @@ static int stick_response(const schur_t *factor, const slip_t *slip, int ns,
     return BALLC_OK;
 }
 
-/* Solve the dense m x m system A x = b (A row-major, m <= 2 MAXP) in place by Gaussian
+/* Solve the dense m x m system A x = b (A row-major, m <= MAX_HELD) in place by Gaussian
  * elimination with partial pivoting: b becomes x.  BALLC_SINGULAR when a pivot is 0. */
 static int dense_solve(int m, double *A, double *b)
 {
@@ -424,6 +447,122 @@ static int joint_constraint(const schur_t *factor, const slip_t *const *slips, i
     return BALLC_OK;
 }
 
+/* The velocities held by constraint forces, of every plane at once (_rolling.h): a
+ * sticking plane's slip (2), a holding rolling part's (2) and twisting part's (1).  Each
+ * row: its map (a row of n_states, dv/dx: the speeds' columns are used), the generalized
+ * force of its unit constraint force (6, inertial), the velocity now and where its
+ * multiplier goes. */
+#define MAX_HELD (5 * MAXP)
+typedef struct {
+    int k;
+    const double *row[MAX_HELD];
+    double G[MAX_HELD][NU];
+    double v[MAX_HELD];
+    double *lambda[MAX_HELD];
+} held_t;
+
+/* Add a plane's slip (its rows and force map) to ``h``. */
+static void hold_slip(held_t *h, const slip_t *slip, int ns, double *lambda)
+{
+    for (int r = 0; r < 2; r++, h->k++) {
+        h->row[h->k] = slip->du + r * ns;
+        for (int i = 0; i < NU; i++) h->G[h->k][i] = slip->G[2 * i + r];
+        h->v[h->k] = slip->u[r];
+        h->lambda[h->k] = lambda ? lambda + r : NULL;
+    }
+}
+
+/* Add a plane's rolling (part 0: 2 rows) or twisting (part 1: 1 row) velocity to ``h``. */
+static void hold_rolling(held_t *h, ballc_rolling_eval *roll, int part, int ns)
+{
+    for (int r = part ? 2 : 0; r < (part ? 3 : 2); r++, h->k++) {
+        h->row[h->k] = roll->dw + r * ns;
+        for (int i = 0; i < NU; i++) h->G[h->k][i] = roll->G[3 * i + r];
+        h->v[h->k] = roll->w[r];
+        h->lambda[h->k] = roll->lambda + r;
+    }
+}
+
+/* Solve A x = b (m x m, row-major) in place (b becomes x) for a set of held velocities
+ * that may be redundant: Gaussian elimination with complete pivoting, and where every
+ * pivot left is below 1e-12 of the largest entry the remaining unknowns are 0 (a held
+ * velocity the others already hold -- a ball sticking on two planes at once, both
+ * holding its rolling: their forces are then statically indeterminate, and this takes
+ * one split of them).  BALLC_SINGULAR when A is not finite or is 0. */
+static int held_dense_solve(int m, double *A, double *b)
+{
+    int column[MAX_HELD], rank = m;
+    double largest = 0.0;
+    for (int i = 0; i < m * m; i++) {
+        if (!isfinite(A[i])) return BALLC_SINGULAR;
+        largest = fmax(largest, fabs(A[i]));
+    }
+    if (!(largest > 0)) return BALLC_SINGULAR;
+    for (int c = 0; c < m; c++) column[c] = c;
+    for (int c = 0; c < m; c++) {
+        int pr = c, pc = c;
+        for (int r = c; r < m; r++)
+            for (int j = c; j < m; j++)
+                if (fabs(A[r * m + j]) > fabs(A[pr * m + pc])) { pr = r; pc = j; }
+        if (!(fabs(A[pr * m + pc]) > 1e-12 * largest)) { rank = c; break; }
+        if (pr != c) {
+            for (int j = 0; j < m; j++) {
+                double t = A[c * m + j]; A[c * m + j] = A[pr * m + j]; A[pr * m + j] = t;
+            }
+            double t = b[c]; b[c] = b[pr]; b[pr] = t;
+        }
+        if (pc != c) {
+            for (int r = 0; r < m; r++) {
+                double t = A[r * m + c]; A[r * m + c] = A[r * m + pc]; A[r * m + pc] = t;
+            }
+            int t = column[c]; column[c] = column[pc]; column[pc] = t;
+        }
+        for (int r = c + 1; r < m; r++) {
+            double f = A[r * m + c] / A[c * m + c];
+            for (int j = c; j < m; j++) A[r * m + j] -= f * A[c * m + j];
+            b[r] -= f * b[c];
+        }
+    }
+    double x[MAX_HELD];
+    for (int c = m - 1; c >= 0; c--) {
+        if (c >= rank) { x[c] = 0.0; continue; }
+        double s = b[c];
+        for (int j = c + 1; j < m; j++) s -= A[c * m + j] * x[j];
+        x[c] = s / A[c * m + c];
+    }
+    for (int c = 0; c < m; c++) b[column[c]] = x[c];
+    return BALLC_OK;
+}
+
+/* The constraint forces (or impulses) of the held velocities ``h``: lambda solves
+ * W lambda = target (W_ab = (dv_a/d speeds) M^-1 G_b, the Delassus matrix of all of
+ * them), and M^-1 G lambda is added to ``speeds`` (6); each multiplier stored where its
+ * row says (when ``store``). */
+static int hold_solve(const schur_t *factor, const held_t *h, const double *target,
+                      int store, double *speeds)
+{
+    const int k = h->k;
+    double z[MAX_HELD][NU], W[MAX_HELD * MAX_HELD], lambda[MAX_HELD];
+    for (int c = 0; c < k; c++) {
+        for (int i = 0; i < NU; i++) z[c][i] = h->G[c][i];
+        schur_solve(factor, z[c]);
+    }
+    for (int a = 0; a < k; a++)
+        for (int c = 0; c < k; c++) {
+            double s = 0;
+            for (int i = 0; i < NU; i++) s += h->row[a][NQ + i] * z[c][i];
+            W[a * k + c] = s;
+        }
+    for (int c = 0; c < k; c++) lambda[c] = target[c];
+    int status = held_dense_solve(k, W, lambda);
+    if (status != BALLC_OK) return status;
+    for (int c = 0; c < k; c++) {
+        for (int i = 0; i < NU; i++) speeds[i] += z[c][i] * lambda[c];
+        if (store && h->lambda[c]) *h->lambda[c] = lambda[c];
+    }
+    return BALLC_OK;
+}
+
 /* udot (6) and the auxiliary rates.  A sticking plane's constraint force lambda makes
  * du/dt = 0: lambda = -W^-1 (du/d speeds) udot_0, udot = udot_0 + z lambda; several
  * sticking planes at once (a ball resting in a wedge's corner) are solved jointly, with
@@ -437,10 +576,37 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
     int status = schur_factor(ev->mass, factor);
     if (status != BALLC_OK) return status;
     schur_solve(factor, udot);
-    int sticking[MAXP], k = 0;
-    for (int plane = 0; plane < np; plane++)
+    int sticking[MAXP], k = 0, held = 0;
+    for (int plane = 0; plane < np; plane++) {
         if (ev->mode[plane] == MODE_STICK) sticking[k++] = plane;
-    if (k == 1) {
+        held |= ballc_rolling_held(&ev->rolling[plane]);
+    }
+    if (held) {   /* rolling resistance holds: every held velocity of every plane at once */
+        held_t h = {0};
+        double target[MAX_HELD];
+        for (int plane = 0; plane < np; plane++) {
+            if (ev->mode[plane] == MODE_STICK)
+                hold_slip(&h, &ev->slip[plane], ns, ev->lambda[plane]);
+            ballc_rolling_eval *roll = &ev->rolling[plane];
+            int mask = ballc_rolling_held(roll);
+            if (mask & BALLC_HOLD_ROLLING) hold_rolling(&h, roll, 0, ns);
+            if (mask & BALLC_HOLD_TWISTING) hold_rolling(&h, roll, 1, ns);
+        }
+        for (int a = 0; a < h.k; a++) {   /* -(dv/d speeds) udot_0 */
+            double s = 0;
+            for (int i = 0; i < NU; i++) s += h.row[a][NQ + i] * udot[i];
+            target[a] = -s;
+        }
+        status = hold_solve(factor, &h, target, 1, udot);
+        if (status != BALLC_OK) return status;
+        if (xdot)
+            for (int plane = 0; plane < np; plane++) {
+                const ballc_rolling_eval *roll = &ev->rolling[plane];
+                if (!ballc_rolling_held(roll)) continue;
+                for (int i = 0; i < BALLC_ROLLING_W; i++)
+                    xdot[params->rolling_state] -= roll->lambda[i] * roll->w[i];
+            }
+    } else if (k == 1) {
         int plane = sticking[0];
         const slip_t *slip = &ev->slip[plane];
         const double *du = slip->du;
@@ -492,6 +658,14 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
             double rho_dd = penetration_acceleration(params, plane, udot);
             for (int i = 0; i < 4; i++) xdot[target[i]] += coefficients[i] * rho_dd;
         }
+    if (xdot && params->rolling)   /* the rolling part's sds sliders: their rho'' shares */
+        for (int plane = 0; plane < np; plane++) {
+            const double *c = ev->rolling[plane].acceleration;
+            if (!c[0] && !c[1] && !c[2] && !c[3]) continue;
+            double rho_dd = penetration_acceleration(params, plane, udot);
+            xdot[params->rolling_state] += c[0] * rho_dd;
+            for (int i = 0; i < 3; i++) xdot[params->planes[plane].rolling + i] += c[1 + i] * rho_dd;
+        }
     return all_finite(udot, NU) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
@@ -499,6 +673,19 @@ static int any_stick(ballc_flags flags, int n_planes)
 {
     for (int plane = 0; plane < n_planes; plane++)
         if (exact_mode(flags, plane) == MODE_STICK) return 1;
+    return 0;
+}
+
+/* Whether a plane in contact holds its rolling or twisting velocity (its latch). */
+static int any_held(const ballc_parameters_t *params, ballc_flags flags, const double *latch)
+{
+    if (!params->rolling) return 0;
+    for (int plane = 0; plane < params->n_planes; plane++) {
+        if (!in_contact(flags, plane)) continue;
+        const double *l = law_latch(latch, plane);
+        for (int part = 0; part < 2; part++)
+            if (ballc_rolling_mode(l, part) == BALLC_ROLLING_MODE_HOLDING) return 1;
+    }
     return 0;
 }
 
@@ -517,7 +704,11 @@ static int prepare(const double *params, const double *latch, ballc_parameters_t
 static int state_count(const double *params)
 {
     int n = ballc_plane_count(params);
-    return n < 0 ? 0 : NB + BALLC_N_PLANE_STATES * n;
+    if (n < 0) return 0;
+    int rolling = params[BALLC_PARAMETER_ROLLING_RESISTANCE] != 0
+                  || params[BALLC_PARAMETER_TWISTING_RESISTANCE] != 0;
+    return NB + BALLC_N_PLANE_STATES * n
+           + (rolling ? BALLC_N_ROLLING_BALL_STATES + BALLC_N_ROLLING_PLANE_STATES * n : 0);
 }
 
 int ballc_rhs(const double *state, const double *params, const double *latch,
@@ -779,7 +970,8 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
     double udot[NU];
     const int ns = params->n_states, np = params->n_planes;
     if (!all_finite(state, ns)) return BALLC_NOT_FINITE;
-    if (any_stick(flags, np)) return difference_jacobian(state, params, latch, flags, jac);
+    if (any_stick(flags, np) || any_held(params, flags, latch))
+        return difference_jacobian(state, params, latch, flags, jac);
     int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
 
@@ -817,6 +1009,9 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
                 for (int j = 0; j < ns; j++)
                     jac[target[i] * ns + j] += buf[(BALLC_LAW_DISSIPATION + i) * ns + j];
         }
+        if (params->rolling && ballc_rolling_on(law_latch(latch, plane)))   /* the 4th part */
+            ballc_rolling_jacobian(params, plane, contact.state, contact.inputs,
+                                   law_latch(latch, plane), &ev.rolling[plane], dF, jac);
     }
     /* d udot / dx_j = M^-1 (dF/dx_j - d(M udot)/dx_j); M depends on q only. */
     for (int j = 0; j < ns; j++) {
@@ -839,7 +1034,123 @@ void ballc_energy(const double *state, const ballc_parameters_t *params, double 
         ballc_plane_energy(local, PARAMS(params), NULL, e);
         out[2 + p] = e[0];
         out[2 + np + p] = e[1];
+        out[2 + 2 * np + p] = 0.0;   /* no rolling springs without rolling resistance */
+        if (params->rolling)
+            ballc_plane_rolling_energy(local, PARAMS(params), NULL, out + 2 + 2 * np + p);
     }
+}
+
+int ballc_rolling_state(const double *state, const ballc_parameters_t *params,
+                        const double *latch, ballc_flags flags, int plane, double *out)
+{
+    schur_t factor;
+    evaluation_t ev;
+    double udot[NU];
+    for (int i = 0; i < BALLC_ROLLING_STATE_NOUT; i++) out[i] = NAN;
+    if (plane < 0 || plane >= params->n_planes || !in_contact(flags, plane)) return BALLC_SINGULAR;
+    if (!all_finite(state, params->n_states) || !all_finite(latch, params->n_latch))
+        return BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+    if (status != BALLC_OK) return status;
+    const ballc_rolling_eval *roll = &ev.rolling[plane];
+    if (roll->mode[0] == BALLC_ROLLING_MODE_NONE && roll->mode[1] == BALLC_ROLLING_MODE_NONE) {
+        /* rolling resistance off: its velocities and load all the same */
+        plane_contact_t contact;
+        double w[BALLC_PLANE_ROLLING_NOUT];
+        plane_contact(params, plane, state, latch, &contact);
+        ballc_plane_rolling(contact.state, PARAMS(params), contact.inputs, w);
+        for (int i = 0; i < 3; i++) out[i] = 0.0;
+        out[3] = w[3];
+        out[4] = params->values[BALLC_PARAMETER_ROLLING_RESISTANCE] * w[3];
+        out[5] = params->values[BALLC_PARAMETER_TWISTING_RESISTANCE] * w[3];
+        for (int i = 0; i < 3; i++) out[6 + i] = w[i];
+        return all_finite(out, BALLC_ROLLING_STATE_NOUT) ? BALLC_OK : BALLC_NOT_FINITE;
+    }
+    for (int i = 0; i < 3; i++) out[i] = roll->lambda[i];
+    out[3] = roll->load;
+    out[4] = params->values[BALLC_PARAMETER_ROLLING_RESISTANCE] * roll->load
+             - hypot(roll->lambda[0], roll->lambda[1]);
+    out[5] = params->values[BALLC_PARAMETER_TWISTING_RESISTANCE] * roll->load
+             - fabs(roll->lambda[2]);
+    for (int i = 0; i < 3; i++) out[6 + i] = roll->w[i];
+    return all_finite(out, BALLC_ROLLING_STATE_NOUT) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+int ballc_rolling_margins(const double *state, const ballc_parameters_t *params,
+                          const double *latch, ballc_flags flags, int plane, double *out)
+{
+    static void (*const MARGINS[2])(const double *restrict, const double *restrict,
+                                    const double *restrict, const double *restrict,
+                                    double *restrict) = {ballc_plane_rolling_margins,
+                                                         ballc_plane_twisting_margins};
+    for (int i = 0; i < BALLC_SDS_MARGINS; i++) out[i] = NAN;
+    if (plane < 0 || plane >= params->n_planes) return BALLC_SINGULAR;
+    if (!all_finite(state, params->n_states) || !all_finite(latch, params->n_latch))
+        return BALLC_NOT_FINITE;
+    schur_t factor;
+    evaluation_t ev;
+    double udot[NU], m[BALLC_PLANE_ROLLING_MARGINS_NOUT];
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
+    if (status != BALLC_OK) return status;
+    double rho_dd = penetration_acceleration(params, plane, udot);
+    plane_contact_t contact;
+    plane_contact(params, plane, state, latch, &contact);
+    for (int part = 0; part < 2; part++) {
+        MARGINS[part](contact.state, PARAMS(params), contact.inputs, m);
+        out[3 * part] = m[0];
+        out[3 * part + 1] = m[1] + m[3] * rho_dd;
+        out[3 * part + 2] = m[2];
+    }
+    return all_finite(out, BALLC_SDS_MARGINS) ? BALLC_OK : BALLC_NOT_FINITE;
+}
+
+int ballc_remove_velocities(const double *state, const ballc_parameters_t *params,
+                            const double *latch, ballc_flags flags, int plane, int mask,
+                            double *state_out)
+{
+    schur_t factor;
+    evaluation_t ev;
+    double force[NU], scratch[NU];
+    const int ns = params->n_states, np = params->n_planes;
+    memcpy(state_out, state, ns * sizeof(double));
+    if (plane < 0 || plane >= np || !params->rolling) return BALLC_SINGULAR;
+    if (!all_finite(state, ns) || !all_finite(latch, params->n_latch)) return BALLC_NOT_FINITE;
+    /* the mass matrix, the slips and the rolling parts' velocities and maps at the state */
+    assemble(state, params, latch, flags, &ev, force, NULL);
+    int status = schur_factor(ev.mass, &factor);
+    if (status != BALLC_OK) return status;
+    /* the velocities of ``mask`` on ``plane`` go to 0, every other held one stays */
+    held_t h = {0};
+    double target[MAX_HELD];
+    slip_t slips[MAXP];
+    for (int p = 0; p < np; p++) {
+        if (!in_contact(flags, p)) continue;
+        plane_contact_t contact;
+        plane_contact(params, p, state, latch, &contact);
+        int own = p == plane ? mask : 0;
+        int first = h.k;
+        if ((own & BALLC_HOLD_SLIP) || exact_mode(flags, p) == MODE_STICK) {
+            slip_of(params, p, contact.state, &slips[p]);
+            hold_slip(&h, &slips[p], ns, NULL);
+            for (int c = first; c < h.k; c++) target[c] = own & BALLC_HOLD_SLIP ? -h.v[c] : 0.0;
+        }
+        ballc_rolling_eval *roll = &ev.rolling[p];
+        if (own & (BALLC_HOLD_ROLLING | BALLC_HOLD_TWISTING))   /* its velocities and maps */
+            ballc_rolling_assemble(params, p, contact.state, contact.inputs, law_latch(latch, p),
+                                   roll, scratch, NULL);
+        int held = ballc_rolling_held(roll);
+        for (int part = 0; part < 2; part++) {
+            int bit = part ? BALLC_HOLD_TWISTING : BALLC_HOLD_ROLLING;
+            if (!((own | held) & bit)) continue;
+            first = h.k;
+            hold_rolling(&h, roll, part, ns);
+            for (int c = first; c < h.k; c++) target[c] = own & bit ? -h.v[c] : 0.0;
+        }
+    }
+    if (!h.k) return BALLC_OK;
+    status = hold_solve(&factor, &h, target, 0, state_out + NQ);
+    if (status != BALLC_OK) return status;
+    return all_finite(state_out, ns) ? BALLC_OK : BALLC_NOT_FINITE;
 }
 
 void ballc_contact_kinematics(const double *state, const ballc_parameters_t *params,

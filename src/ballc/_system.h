@@ -103,25 +103,35 @@ int ballc_jacobian(const double *state, const double *params, const double *latc
  * ballc_parameters_init: once per segment by the integrator's adapter, once per call by
  * the entry points that take a plain parameter vector.  The constants and planes are
  * never taken from a caller, so they cannot belong to other parameters. */
-typedef struct {
+typedef struct ballc_parameters {
     const double *values;                               /* n_parameters, borrowed */
     int n_planes;                                       /* 1 .. BALLC_MAX_PLANES */
     int n_states, n_latch, n_parameters;                /* the run's sizes */
+    /* rolling resistance (rolling or twisting resistance > 0): the run's rolling block,
+     * dissipated_rolling at rolling_state (each plane's rolling spring: its
+     * planes[p].rolling); 0 and -1 without (no such states) */
+    int rolling, rolling_state;
     double constants[BALLC_N_PARAMETER_CONSTANTS];
     ballc_plane_t planes[BALLC_MAX_PLANES];
     /* each plane's slip map du/dx (2 x n_states, row-major) and the generalized-force
      * map of a unit tangential force along its t1, t2 (6 x 2, inertial): constants */
     double slip_map[BALLC_MAX_PLANES][2 * BALLC_MAX_STATES];
     double slip_force_map[BALLC_MAX_PLANES][12];
+    /* each plane's rolling and twisting velocities' map dw/dx (3 x n_states) and the
+     * generalized-force map of a unit rolling force along t1, t2 and a unit twisting
+     * force (6 x 3, inertial): constants (_rolling.h) */
+    double rolling_map[BALLC_MAX_PLANES][3 * BALLC_MAX_STATES];
+    double rolling_force_map[BALLC_MAX_PLANES][18];
 } ballc_parameters_t;
 
 /* BALLC_OK, or BALLC_BAD_PLANES (the plane count is not 1 .. BALLC_MAX_PLANES: then
  * nothing else is set but n_planes = 0). */
 int ballc_parameters_init(ballc_parameters_t *prepared, const double *params);
 
-/* Energies (J): kinetic, potential, then per plane the Hertz spring's and per plane the
- * compliant law's tangential spring's: 2 + 2 n_planes. */
-#define BALLC_ENERGY_NOUT(n_planes) (2 + 2 * (n_planes))
+/* Energies (J): kinetic, potential, then per plane the Hertz spring's, per plane the
+ * compliant law's tangential spring's and per plane the rolling part's sds springs' (0
+ * without rolling resistance): 2 + 3 n_planes. */
+#define BALLC_ENERGY_NOUT(n_planes) (2 + 3 * (n_planes))
 #define BALLC_MAX_ENERGY_NOUT BALLC_ENERGY_NOUT(BALLC_MAX_PLANES)
 void ballc_energy(const double *state, const ballc_parameters_t *params, double *out);
 
@@ -178,6 +188,31 @@ int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t 
  * stick-to-slip event); lambda along the plane's tangents t1, t2. */
 int ballc_stick_state(const double *state, const double *params, const double *latch,
                       ballc_flags flags, int plane, double *out);
+
+/* Rolling resistance (_rolling.h) of ``plane`` under ``flags`` and ``latch`` (its modes):
+ * out = [lambda (3: the rolling force along t1, t2 and the twisting force that hold its
+ * held parts, 0 for the others), F_n, the rolling margin mu_r F_n - |lambda_r|, the
+ * twisting margin mu_t F_n - |lambda_w|, the rolling velocity (2), the twisting
+ * velocity].  The margins end a holding part (its release event). */
+#define BALLC_ROLLING_STATE_NOUT 9
+int ballc_rolling_state(const double *state, const ballc_parameters_t *params,
+                        const double *latch, ballc_flags flags, int plane, double *out);
+
+/* The sds model's mode guards of ``plane``'s rolling and twisting parts (_rolling.h,
+ * codegen contact.sds_margins), 3 per part: the yield margin 1 - k |xi| / (mu F_n), the
+ * re-stick margin (m/s, with the exact penetration acceleration of the dynamics under
+ * ``flags`` and ``latch``: one solve) and the deflection at the cap mu F_n / k (m). */
+#define BALLC_SDS_MARGINS 6
+int ballc_rolling_margins(const double *state, const ballc_parameters_t *params,
+                          const double *latch, ballc_flags flags, int plane, double *out);
+
+/* state_out = state with the velocities of ``plane`` in ``mask`` (_rolling.h
+ * BALLC_HOLD_*: its slip, rolling and twisting velocities) set to zero by one impulse
+ * of the constraint forces that hold them (P = -W^-1 v, W their Delassus matrix); used
+ * where a velocity starts being held and what is left of it is at rounding level. */
+int ballc_remove_velocities(const double *state, const ballc_parameters_t *params,
+                            const double *latch, ballc_flags flags, int plane, int mask,
+                            double *state_out);
 
 /* state_out = state with the slip velocity of ``plane`` set to zero by a tangential
  * impulse at the contact point (the impulse P = -W^-1 u, W the 2x2 Delassus matrix);

@@ -11,6 +11,14 @@ in one *mode* at a time:
 * with the compliant law's exact modes (ballc.compliantmodes): ``elastic``, ``sliding``;
 * ``contact``: in contact with neither (the dig-in model; the "max" and "smooth"
   regularisations; mu = 0);
+* with rolling resistance (docs/contact_laws.md, "Rolling resistance"), each contact's
+  *rolling part* has modes of its own, a second factor of the plane's mode
+  (:data:`ROLLING_PART_MODES`; the C loop's segment log reports them as
+  ``rolling_before``/``_after`` and ``twisting_before``/``_after``): with the exact model
+  ``rolling`` (the torque mu_r r F_n against the rolling velocity, its direction free),
+  ``rolling_fixed`` (its direction held), ``holding`` (the rolling velocity held at 0 by
+  a constraint torque); its twisting part ``twisting`` and ``holding``; with the sds
+  model ``spring`` (below the cap) and ``slider`` (at it);
 * end states of a run (floor only), each continued in closed form to t_end:
   ``resting`` (ballc.resting), ``rolling`` and ``free_sliding`` (uniform: ballc.resting;
   with the wobble of an eccentric observer: ballc.orbit); ``passed_through`` (the ball
@@ -39,6 +47,18 @@ COMPLIANT_MODES = ("elastic", "sliding")
 CONTACT_MODES = ("contact",) + COULOMB_MODES + COMPLIANT_MODES
 END_MODES = ("resting", "rolling", "free_sliding", "passed_through")
 MODES = ("flight",) + CONTACT_MODES + END_MODES
+#: The modes of a contact's rolling part, by the code its plane's latch holds them in
+#: (codegen model.ROLLING_MODE_CODES: none, free, fixed, holding, spring, slider), for
+#: its rolling and its twisting part ("none": no rolling resistance, or no contact).
+#: The rolling part's "rolling" is a mode of that part (the ball rolls against its
+#: resistance), not the plane's end state "rolling" (uniform rolling, in END_MODES).
+ROLLING_PART_MODES = {
+    "rolling": ("none", "rolling", "rolling_fixed", "holding", "spring", "slider"),
+    "twisting": ("none", "twisting", "twisting", "holding", "spring", "slider"),
+}
+EXACT_ROLLING_MODES = ("rolling", "rolling_fixed", "holding")
+EXACT_TWISTING_MODES = ("twisting", "holding")
+SDS_MODES = ("spring", "slider")
 
 
 @dataclass(frozen=True)
@@ -51,6 +71,9 @@ class Transition:
     guard: str           # the event function g and its direction (terminal events)
     reset: str           # what is latched or reset, and how the next mode is chosen
     handler: str         # the function of _driver.c that applies it
+    #: whose mode it changes: the plane's ("contact"), or its rolling part's ("rolling",
+    #: "twisting": sources and targets are ROLLING_PART_MODES)
+    part: str = "contact"
 
 
 TRANSITIONS = (
@@ -116,6 +139,54 @@ TRANSITIONS = (
                "the relative periodic orbit of an eccentric observer's wobble "
                "(ballc.orbit), in closed form to t_end; else a new trial",
                "check_orbit"),
+    # rolling resistance's exact model (src/ballc/_rolling.c): the modes of exact
+    # Coulomb friction, for the rolling velocity v_roll = r (omega x n) and the twisting
+    # velocity r omega . n; a contact's start sets them as Coulomb's (free, fixed, or
+    # settled), its end to none
+    Transition("roll_approach", ("rolling",), ("rolling", "rolling_fixed"),
+               "v_roll . d - approach falls through 0 (d the rolling velocity's latched "
+               "direction)", "re-latch d and stay free (a rolling velocity passing by "
+               "zero), else hold d", "rolling_event", "rolling"),
+    Transition("roll_stop", ("rolling_fixed",), ("holding", "rolling_fixed", "rolling"),
+               "v_roll . d + margin falls through 0",
+               "a rolling velocity left within 10 tolerances is removed by an angular "
+               "impulse (with the slip, when the contact sticks: one impulse for both) and "
+               "the part settles: holding when the force that holds it is within "
+               "mu_r F_n, else rolling from rest along -lambda_r; a larger one rolls on",
+               "rolling_event", "rolling"),
+    Transition("roll_clear", ("rolling_fixed",), ("rolling",),
+               "v_roll . d - 2 clear rises through 0", "the direction goes free",
+               "rolling_event", "rolling"),
+    Transition("roll_release", ("holding",), ("rolling_fixed",),
+               "mu_r F_n - |lambda_r| + scale falls through 0 (lambda_r the rolling force "
+               "that holds v_roll, solved with the equations of motion and Coulomb's "
+               "stick constraint)", "rolls from rest along -lambda_r (what is left of "
+               "v_roll removed)", "rolling_event", "rolling"),
+    Transition("twist_stop", ("twisting",), ("holding", "twisting"),
+               "v_twist d + margin falls through 0 (d its latched sign)",
+               "settles as roll_stop (holding, or twisting from rest along -lambda_w); "
+               "a larger twisting velocity twists on the other way",
+               "rolling_event", "twisting"),
+    Transition("twist_release", ("holding",), ("twisting",),
+               "mu_t F_n - |lambda_w| + scale falls through 0",
+               "twists from rest along -lambda_w", "rolling_event", "twisting"),
+    # the sds model (LAMMPS' rolling sds / twisting sds, ballc's passive form): a spring
+    # below the cap, a slider at it, for each part; a contact starts with the spring
+    # relaxed, and its end relaxes it (the energy booked as dissipated)
+    Transition("roll_yield", ("spring",), SDS_MODES,
+               "1 - k_r |xi| / (mu_r F_n) + rounding falls through 0",
+               "decide at the cap: slider when the re-stick margin there is >= 0, else the "
+               "spring brought back to the cap; without load the spring relaxed",
+               "rolling_event", "rolling"),
+    Transition("roll_restick", ("slider",), ("spring",),
+               "(e . v_roll) - mu_r F_n' / k_r + offset falls through 0 (the spring would "
+               "stretch slower than the cap grows)", "the spring, at (or brought back to) "
+               "the cap", "rolling_event", "rolling"),
+    Transition("twist_yield", ("spring",), SDS_MODES, "as roll_yield, for the twisting part",
+               "as roll_yield", "rolling_event", "twisting"),
+    Transition("twist_restick", ("slider",), ("spring",),
+               "as roll_restick, for the twisting part", "as roll_restick", "rolling_event",
+               "twisting"),
 )
 
 #: How simultaneous events are handled: the earliest terminal event that fired ends the
@@ -126,7 +197,9 @@ TRANSITIONS = (
 #: after the loop's own.  A mode change at the
 #: time of the last one counts as stalled, and 100 in a row stop the run (status -1).
 SIMULTANEOUS = ("leave", "enter", "through", "deepest", "approach", "stop", "clear",
-                "release", "arm", "yield", "capacity", "restick", "user")
+                "release", "roll_approach", "roll_stop", "roll_clear", "roll_release",
+                "twist_stop", "twist_release", "roll_yield", "roll_restick", "twist_yield",
+                "twist_restick", "arm", "yield", "capacity", "restick", "user")
 
 _HANDLERS = {transition.event: transition.handler for transition in TRANSITIONS}
 

@@ -51,6 +51,7 @@ def _scene_dict(scene) -> dict:
     rho_eq = resting.equilibrium_penetration(scene) if checks else 1.0
     orbits = orbit.applies(scene)
     return dict(
+        **rolling_constants(scene),
         observer_bits=observer,
         contact_bits=[modes.contact_flags(scene, k) for k in range(len(scene.planes))],
         exact=int(stickslip.uses_exact_coulomb(scene)), compliant_modes=int(modes_on),
@@ -74,6 +75,19 @@ def _scene_dict(scene) -> dict:
         rolls_allowed=int(flight_scene_allows(params)), orbit_applies=int(orbits),
         orbit_axis=orbit.body_axis(scene).tolist() if orbits else [0.0, 0.0, 1.0],
         rest_factor=resting.REST_FACTOR)
+
+
+def rolling_constants(scene) -> dict:
+    """The rolling part's constants of the C loop (_driver.h): each part's model (0 off, 1
+    exact, 2 sds); both 0 without rolling resistance (the run has no rolling states)."""
+    model = ROLLING_MODEL_CODES[scene.rolling_model]
+    rolling = model if scene.rolling_resistance > 0 else 0
+    twisting = model if scene.twisting_resistance > 0 else 0
+    return dict(rolling=rolling, twisting=twisting)
+
+
+#: Scene.rolling_model -> the C loop's code (_driver.h ballc_drive_config.rolling)
+ROLLING_MODEL_CODES = {"exact": 1, "sds": 2}
 
 
 def run_constants(scene, options, rest) -> dict:

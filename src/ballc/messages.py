@@ -79,6 +79,10 @@ def motion_message(scene, plane, t, y, kind):
         v = float(np.linalg.norm(velocity - (velocity @ n) * n))
     what = "rolls uniformly" if kind == "rolling" else (
         "slides uniformly (no force opposes its slip)")
+    if kind == "rolling" and scene.rolling_resistance > 0:   # held: it can only spin
+        spin = float(y[layout.ANGULAR_VELOCITY] @ n)
+        what = (f"is held by its rolling resistance and sticks, spinning about the normal "
+                f"at {spin:.6g} rad/s (no twisting resistance stops it),")
     return (f"{SUCCESS} The ball {what} on the {plane} from t = "
             f"{t:.9g} s at {v:.6g} m/s (ballc.resting: static Hertz "
             f"equilibrium, penetration "

@@ -78,10 +78,12 @@ TILT_SAMPLES = _core.ORBIT_TILT_SAMPLES
 def applies(scene) -> bool:
     """Routh's sphere on the floor: g > 0 along -z, every plane horizontal (the scene
     symmetric about the vertical: the motion G turns it into itself), isotropic inertia,
-    a massive observer."""
+    a massive observer; no rolling resistance (it dissipates the rolling, and the motion
+    does not turn its states)."""
     p = scene._parameters   # (read only)
     g = scene.gravity_vector
     return bool(g[2] < 0 and g[0] == 0 and g[1] == 0 and scene.observer_mass > 0
+                and not scene.rolling_on
                 and all(plane.normal[0] == 0 and plane.normal[1] == 0
                         for plane in scene.planes)
                 and p[_PARAMETER["inertia_xx"]] == p[_PARAMETER["inertia_yy"]]

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from . import _core, layout
+from . import _core, automaton, layout
 from .orientation import angles_123_from_quaternion
 
 _STATE = layout.INDEX
@@ -353,30 +353,43 @@ class Result:
         """name -> (n,) array (J).
 
         ``kinetic``, ``potential`` (gravity), ``spring`` (Hertz, 2/5 k0 rho^(5/2), every
-        plane's),
-        ``tangential_spring`` (the compliant law's, ``1/2 k_t |s|^2``; 0 for the others) and
-        their sum ``total`` (the seed's total energy, plus the tangential spring's); ``dissipated_normal`` and
-        ``dissipated_tangential``: work dissipated by the contact forces since t = 0
-        (integrated with the motion; negative where a model injects energy, as dig-in
-        does), ``dissipated`` their sum, and ``balance`` = total + dissipated, which
-        stays at the initial energy to integration tolerance for every model.
+        plane's), ``tangential_spring`` (the compliant law's, ``1/2 k_t |s|^2``; 0 for the
+        others), ``rolling_spring`` (the sds rolling and twisting springs', ``1/2 k_r
+        |xi_r|^2 + 1/2 k_w xi_w^2``; 0 without them) and their sum ``total`` (the seed's
+        total energy, plus the tangential and rolling springs'); ``dissipated_normal``,
+        ``dissipated_tangential`` and ``dissipated_rolling`` (the rolling and twisting
+        torques'; 0 without rolling resistance): work dissipated by the contact forces
+        since t = 0 (integrated with the motion; negative where a model injects energy,
+        as dig-in does), ``dissipated`` their sum, and ``balance`` = total + dissipated,
+        which stays at the initial energy to integration tolerance for every model.
         """
         if self._energy is None:
             e = _core.energies(np.ascontiguousarray(self.y.T), self.scene.parameter_vector())
-            planes = (e.shape[1] - 2) // 2
+            planes = (e.shape[1] - 2) // 3
             spring, tangential_spring = e[:, 2], e[:, 2 + planes]
+            rolling_spring = e[:, 2 + 2 * planes]
             for k in range(1, planes):
                 spring = spring + e[:, 2 + k]
                 tangential_spring = tangential_spring + e[:, 2 + planes + k]
+                rolling_spring = rolling_spring + e[:, 2 + 2 * planes + k]
             total = e[:, 0] + e[:, 1] + spring + tangential_spring
             normal = self.y[_STATE["dissipated_normal"]]
             tangential = self.y[_STATE["dissipated_tangential"]]
+            dissipated = normal + tangential
+            if "dissipated_rolling" in self.state_names:   # rolling resistance's states
+                rolling = self.y[self.state_names.index("dissipated_rolling")]
+                total = total + rolling_spring
+                dissipated = dissipated + rolling
+            else:   # without it: none (every sum as without its terms, bit for bit)
+                rolling = np.zeros_like(normal)
             self._energy = {"kinetic": e[:, 0], "potential": e[:, 1], "spring": spring,
                             "tangential_spring": tangential_spring,
+                            "rolling_spring": rolling_spring,
                             "total": total, "dissipated_normal": normal,
                             "dissipated_tangential": tangential,
-                            "dissipated": normal + tangential,
-                            "balance": total + normal + tangential}
+                            "dissipated_rolling": rolling,
+                            "dissipated": dissipated,
+                            "balance": total + dissipated}
         return self._energy
 
     def contacts_dataframe(self):
@@ -609,6 +622,13 @@ SEGMENT_FIELDS = {
     "rearm_plane": ("", "... its plane, or ''"),
     "rearm_before": ("", "... that plane's mode before it, or ''"),
     "rearm_after": ("", "... and after it, or ''"),
+    "rolling_before": ("", "each plane's rolling part's mode during the segment (floor, "
+                       "ceiling; ballc.automaton.ROLLING_PART_MODES: none, rolling, "
+                       "rolling_fixed, holding, spring, slider)"),
+    "rolling_after": ("", "... once its end was handled"),
+    "twisting_before": ("", "each plane's twisting part's mode during the segment (none, "
+                        "twisting, holding, spring, slider)"),
+    "twisting_after": ("", "... once its end was handled"),
 }
 
 
@@ -626,6 +646,8 @@ def segment_table(raw: bytes, plane_names=layout.PLANES) -> np.ndarray:
     low = min(methods)
     method_names = np.array([methods.get(k, str(k)) for k in range(low, max(methods) + 1)])
     ends = np.array(_core.SEGMENT_ENDS + ("",))
+    rolling = np.array(automaton.ROLLING_PART_MODES["rolling"])
+    twisting = np.array(automaton.ROLLING_PART_MODES["twisting"])
     table = np.empty(log.size, dtype=[
         ("t_start", "f8"), ("t_end", "f8"), ("method", "U6"), ("method_end", "U6"),
         ("switches", "i4"), ("nfev", "i8"), ("njev", "i8"), ("nlu", "i8"), ("nstep", "i8"),
@@ -633,7 +655,9 @@ def segment_table(raw: bytes, plane_names=layout.PLANES) -> np.ndarray:
         ("plane", f"U{width}"), ("before", "U14", (count,)), ("after", "U14", (count,)),
         ("rearms", "i4"), ("rearm_kind", "U8"), ("rearm_plane", f"U{width}"),
         ("rearm_before", "U14"),
-        ("rearm_after", "U14")])
+        ("rearm_after", "U14"), ("rolling_before", "U13", (count,)),
+        ("rolling_after", "U13", (count,)), ("twisting_before", "U13", (count,)),
+        ("twisting_after", "U13", (count,))])
     for name in ("t_start", "t_end", "switches", "nfev", "njev", "nlu", "nstep", "nreject",
                  "rearms"):
         table[name] = log[name]
@@ -648,6 +672,9 @@ def segment_table(raw: bytes, plane_names=layout.PLANES) -> np.ndarray:
     table["rearm_plane"] = planes[log["rearm_plane"]]
     table["rearm_before"] = modes[log["rearm_before"]]
     table["rearm_after"] = modes[log["rearm_after"]]
+    for part, names in (("rolling", rolling), ("twisting", twisting)):
+        for when in ("before", "after"):
+            table[f"{part}_{when}"] = names[log[f"{part}_{when}"][:, :count]]
     table.flags.writeable = False
     return table
 

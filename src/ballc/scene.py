@@ -23,6 +23,11 @@ from .planes import MAX_PLANES, Plane, PlaneError, check_room, names_of, seed_pl
 #: The values of ``Scene.tangential_model``.
 TANGENTIAL_MODELS = ("mixture", "friction", "dig-in", "compliant")
 FRICTION_REGULARIZATIONS = ("exact", "max", "smooth")
+#: The values of ``Scene.rolling_model`` (docs/contact_laws.md, "Rolling resistance").
+ROLLING_MODELS = ("exact", "sds")
+#: The sds model's default dashpot as a fraction of its critical damping (Ai et al. 2011
+#: recommend eta_r = 0.3): gamma = ROLLING_DAMPING_FRACTION * 2 sqrt(I_r k) / r.
+ROLLING_DAMPING_FRACTION = 0.3
 #: The values of ``Scene.normal_damping`` (docs/contact_laws.md).
 NORMAL_DAMPINGS = ("hunt_crossley", "viscoelastic")
 #: c_tau when a scene gives neither c_tau nor restitution (the seed's value).
@@ -154,6 +159,33 @@ class Scene:
     tangential_stiffness_ratio : float, optional
         Tangential / normal contact stiffness ratio kappa of the compliant model (1).
         Default (None): Mindlin's 4 G* / E*, from the Poisson ratios and the moduli.
+    rolling_resistance : float
+        Rolling resistance coefficient mu_r (1), >= 0: the contact resists the ball's
+        rolling relative to the plane with a torque of at most mu_r radius F_n (F_n the
+        normal force), a fourth part of every contact law (docs/contact_laws.md,
+        "Rolling resistance").  Default 0: none (every result as without it).
+    rolling_model : str
+        "exact" (default; Ai et al.'s type A with holding): while the ball rolls a torque
+        mu_r r F_n opposes the rolling; where the rolling velocity reaches 0 and the
+        torque that holds it is within the cap, the ball holds -- exact events, as
+        Coulomb's stick and slip.  "sds" (LAMMPS' ``rolling sds``): a rolling spring
+        ``rolling_stiffness`` with a dashpot ``rolling_damping`` and a slider at the cap,
+        in ballc's passive form.  The same model serves the twisting part.
+    rolling_stiffness : float, optional
+        k_r of the sds model's rolling spring (N/m; its torque r k_r xi for a rolling
+        displacement xi of the contact, LAMMPS' k_roll).  Default (None): Ai et al.'s
+        2.25 mu_r^2 k_n at the ball's static load (k_n = 3/2 k0 rho_eq^(1/2)).
+    rolling_damping : float, optional
+        gamma_r of the sds model's rolling dashpot (N s/m; LAMMPS' gamma_roll), >= 0.
+        Default (None): 0.3 of its critical value 2 sqrt((I + m r^2) k_r) / r.
+    twisting_resistance : float
+        Twisting resistance coefficient mu_t (1), >= 0: the contact resists the ball's
+        spin about the plane's normal with a torque of at most mu_t radius F_n, in the
+        model ``rolling_model``.  Default 0: none.
+    twisting_stiffness, twisting_damping : float, optional
+        The sds model's twisting spring k_w (N/m; torque r k_w xi_w) and dashpot (N s/m).
+        Defaults (None): k_w = the rolling spring's default, gamma_w = 0.3 of
+        2 sqrt(I k_w) / r.
     position : tuple of 3 float
         Initial position of the centre (m), on the ball's side of every plane, less than
         one radius deep in it (0 < z < ceiling_height with the shorthand).  Default
@@ -198,6 +230,13 @@ class Scene:
     friction_regularization            (none)          (none)       "exact" (or "max",
                                                                     "smooth")
     tangential_stiffness_ratio         (none)          1            Mindlin (compliant)
+    rolling_resistance                 (none)          1            0.0
+    rolling_model                      (none)          (none)       "exact" (or "sds")
+    rolling_stiffness                  (none)          N/m          sds: Ai et al.
+    rolling_damping                    (none)          N s/m        sds: 0.3 critical
+    twisting_resistance                (none)          1            0.0
+    twisting_stiffness                 (none)          N/m          sds: as rolling
+    twisting_damping                   (none)          N s/m        sds: 0.3 critical
     planes                             (none)          (none)       None: the floor and
                                                                     ceiling_height's
                                                                     ceiling
@@ -234,6 +273,13 @@ class Scene:
     friction_regularization_speed: float = 1e-10
     friction_regularization: str = "exact"
     tangential_stiffness_ratio: float | None = None
+    rolling_resistance: float = 0.0
+    rolling_model: str = "exact"
+    rolling_stiffness: float | None = None
+    rolling_damping: float | None = None
+    twisting_resistance: float = 0.0
+    twisting_stiffness: float | None = None
+    twisting_damping: float | None = None
     position: tuple = (0.0, 0.0, 5.0)
     velocity: tuple = (-5.0, 5.0, -25.0)
     angles: tuple = (0.0, 0.0, 0.0)
@@ -284,6 +330,7 @@ class Scene:
             object.__setattr__(self, "inertia", (i, i, i))
         _validate(self)
         _resolve_damping(self)   # after _validate: c_tau, if given, is a valid number
+        _resolve_rolling(self)
 
     @classmethod
     def from_dict(cls, values: dict) -> "Scene":
@@ -398,8 +445,16 @@ class Scene:
     @functools.cached_property
     def state_names(self) -> tuple:
         """The names of the state vector's rows: the ball's 15, then each plane's
-        ``<name>_deflection_x``, ``_y`` (the seed's: ``ballc.STATE_NAMES``)."""
-        return _core.state_names(self.plane_names)
+        ``<name>_deflection_x``, ``_y`` (the seed's: ``ballc.STATE_NAMES``); with rolling
+        resistance (:attr:`rolling_on`) then ``dissipated_rolling`` and each plane's
+        rolling springs ``<name>_rolling_x``, ``_rolling_y``, ``_twisting``."""
+        return _core.state_names(self.plane_names, self.rolling_on)
+
+    @property
+    def rolling_on(self) -> bool:
+        """Whether the scene has rolling or twisting resistance (its runs then have its
+        states; without it every run is as before, bit for bit)."""
+        return self.rolling_resistance > 0 or self.twisting_resistance > 0
 
     @functools.cached_property
     def parameter_names(self) -> tuple:
@@ -449,6 +504,12 @@ class Scene:
             "normal_damping_model": float(self.normal_damping == "viscoelastic"),
             "damping_ratio": self.damping_ratio or 0.0,
             "tangential_damping_ratio": self.tangential_damping_ratio or 0.0,
+            "rolling_resistance": self.rolling_resistance,
+            "rolling_stiffness": self.rolling_stiffness or 0.0,
+            "rolling_damping": self.rolling_damping or 0.0,
+            "twisting_resistance": self.twisting_resistance,
+            "twisting_stiffness": self.twisting_stiffness or 0.0,
+            "twisting_damping": self.twisting_damping or 0.0,
             # the plane table: its count, then a point and a normal (towards the ball) per
             # plane
             "plane_count": len(self.planes),
@@ -597,6 +658,61 @@ def _resolve_damping(s: Scene) -> None:
     elif s.tangential_damping_ratio is not None:
         _non_negative("tangential_damping_ratio", s.tangential_damping_ratio)
     object.__setattr__(s, "_derived", tuple(derived))
+
+
+_ROLLING_SPRING_FIELDS = ("rolling_stiffness", "rolling_damping", "twisting_stiffness",
+                          "twisting_damping")
+
+
+def _resolve_rolling(s: Scene) -> None:
+    """Check the rolling part's fields and fill in the sds model's defaults (after
+    _resolve_damping: it appends to the derived fields)."""
+    for name in ("rolling_resistance", "twisting_resistance"):
+        _non_negative(name, getattr(s, name))
+        object.__setattr__(s, name, float(getattr(s, name)))
+    if s.rolling_model not in ROLLING_MODELS:
+        close = difflib.get_close_matches(str(s.rolling_model), ROLLING_MODELS, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        _fail("rolling_model", s.rolling_model, f"must be one of {ROLLING_MODELS}{hint}")
+    given = [name for name in _ROLLING_SPRING_FIELDS if getattr(s, name) is not None]
+    if s.rolling_model != "sds" and given:
+        _fail(given[0], getattr(s, given[0]), "it is a parameter of the sds model: give "
+              "rolling_model = 'sds' with it (the exact model has no spring)")
+    for name in given:
+        if name.endswith("stiffness"):
+            if not _finite(name, getattr(s, name)) > 0:
+                _fail(name, getattr(s, name), "must be a finite number > 0")
+        else:
+            _non_negative(name, getattr(s, name))
+        object.__setattr__(s, name, float(getattr(s, name)))
+    if s.rolling_model != "sds" or not (s.rolling_resistance > 0 or s.twisting_resistance > 0):
+        return
+    derived = list(s._derived)
+    missing = [f"{part}_stiffness" for part in ("rolling", "twisting")
+               if getattr(s, f"{part}_resistance") > 0
+               and getattr(s, f"{part}_stiffness") is None]
+    if missing and not s.gravity_magnitude > 0:
+        _fail(missing[0], None, "needs a value without gravity: its default is Ai et al.'s "
+              "2.25 mu_r^2 k_n at the ball's static load, which gravity = 0 does not have")
+    if missing:   # Ai et al. (2011): k_r = 2.25 mu_r^2 k_n (force per displacement)
+        k0 = s.hertz_stiffness
+        load = (s.mass + s.observer_mass) * s.gravity_magnitude
+        k_n = 1.5 * k0 * (load / k0) ** (1.0 / 3.0)
+        mu = max(s.rolling_resistance, s.twisting_resistance)
+        default = 2.25 * mu ** 2 * k_n
+        for name in missing:
+            object.__setattr__(s, name, float(default))
+            derived.append(name)
+    radius, mass = float(s.radius), float(s.mass)
+    inertia = {"rolling_damping": (sum(s.inertia) / 3 + mass * radius ** 2, "rolling_stiffness"),
+               "twisting_damping": (sum(s.inertia) / 3, "twisting_stiffness")}
+    for name, (moment, spring) in inertia.items():
+        if getattr(s, name) is None and getattr(s, spring) is not None:
+            gamma = ROLLING_DAMPING_FRACTION * 2 * math.sqrt(moment * getattr(s, spring)) / radius
+            object.__setattr__(s, name, float(gamma))
+            derived.append(name)
+    object.__setattr__(s, "_derived", tuple(derived))
+    s.__dict__.pop("_parameters", None)   # cached by hertz_stiffness, before the defaults
 
 
 def _non_negative(name, value):
