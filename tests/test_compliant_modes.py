@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import ballc
-from ballc import _core, layout
+from ballc import _core, _radau5, layout
 from validation.dem_reference import hertz_contact_time
 
 PLANE_FLAGS = {"sliding": _core.FLAGS["floor_compliant_sliding"],
@@ -223,3 +223,41 @@ def test_a_sliding_start_puts_the_spring_along_the_slip(vy):
     s = result.y[[names.index("floor_deflection_x"), names.index("floor_deflection_y")], after]
     u = result.y[[names.index("vx"), names.index("vy")], after]
     assert np.dot(s, u) / (np.linalg.norm(s) * np.linalg.norm(u)) > 1 - 1e-6
+
+
+@pytest.mark.parametrize("mode", ["sliding", "elastic"])
+def test_a_step_ending_exactly_at_a_leaving_contacts_end_converges(mode):
+    """A compliant contact leaves with a deflection (the spring stops moving below the
+    kernels' 1e-12 N force floor, so |s| ~ 5e-13 m is left when rho reaches 0), and
+    a step of radau5 can end exactly on rho = 0.  There the law carries nothing: with
+    no adhesion its force and rates are 0 at rho <= 0 (checked below: the right-hand
+    side is the flight's), so its Jacobian from that side is the flight's too.  Its
+    kernels' derivatives at rho = 0 were half the loaded side's, through the floors of
+    rho and sqrt(rho) (1e-30 m): 7e27 W/m in the tangential dissipation's row, with
+    which Newton failed and the run ended in 'step size less than spacing' (found as
+    1 to 3 in 60 perturbed throws of Hefner's channel).  The stiff rough superball of
+    that scene, on the floor: exactly at rho = 0, leaving at 2 m/s, slipping, spinning."""
+    scene = ballc.Scene(radius=0.025, mass=0.05, observer_mass=0.0, ball_youngs_modulus=1e9,
+                        plane_youngs_modulus=2e11, ball_poisson_ratio=0.49,
+                        tangential_model="compliant", friction_coefficient=10.0,
+                        restitution=1.0, tangential_stiffness_ratio=0.27,
+                        tangential_damping_ratio=0.0)
+    y = scene.initial_state()
+    y[layout.INDEX["z"]] = scene.radius
+    assert scene.radius - y[layout.INDEX["z"]] == 0.0          # rho = 0 exactly
+    y[layout.VELOCITY] = (1.0, 0.0, 2.0)
+    y[layout.ANGULAR_VELOCITY] = (0.0, 30.0, 0.0)
+    y[layout.DEFLECTION["floor"]] = (5e-13, 0.0)
+    latch = np.zeros(_core.N_LATCH)
+    latch[0], latch[1:4] = 2.0, (0.0, 0.0, -1.0)
+    params, flags = scene.parameter_vector(), PLANE_FLAGS[mode]
+    for below in (0.0, -1e-15):   # at the end, and just past it (before the leave event)
+        z = y.copy()
+        z[layout.INDEX["z"]] = scene.radius - below
+        np.testing.assert_array_equal(_core.rhs(z, params, latch, flags),
+                                      _core.rhs(z, params, latch, 0))
+        np.testing.assert_array_equal(_core.jacobian(z, params, latch, flags),
+                                      _core.jacobian(z, params, latch, 0))
+    sol = _radau5.solve_system(params, latch, flags, (1.0, 1.0 + 1e-6), y, rtol=1e-9,
+                               atol=1e-11, max_nfev=20000)
+    assert sol.status == 0, sol.message

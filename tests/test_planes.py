@@ -393,14 +393,20 @@ def test_hefner_channel_compliant_ball_follows_the_map():
     e_t ~ 0.83 (the passive law's unloading loses the rest), and contact by contact its
     height, vertical speed and spin follow ballc's rigid map with that e_t (the contacts
     last 0.35 ms, in which the map's instantaneous impacts fall behind by a contact's
-    time each) -- the 'damped oscillator and falling body' of Hefner's e_t < 1."""
+    time each) -- the 'damped oscillator and falling body' of Hefner's e_t < 1.
+
+    atol 1e-10, not 1e-11 (the error message's advice for contacts): at 1e-11 the end
+    of a sliding contact (rho -> 0, where the spring's rate follows the shrinking cap,
+    ~rho'/rho, and rho carries the rounding of the wall's position) is approached in
+    steps of ~10 ulp(t) with Newton's increments at that rounding, and 4 in 1000
+    throws perturbed by k 1e-13 m/s fail (docs/limits.md); at 1e-10 none does."""
     scene = ballc.Scene(planes=WALLS, radius=R_BALL, mass=M_BALL, observer_mass=0.0,
                         ball_youngs_modulus=1e9, plane_youngs_modulus=2e11,
                         ball_poisson_ratio=0.49, tangential_model="compliant",
                         friction_coefficient=10.0, restitution=1.0,
                         tangential_stiffness_ratio=0.27, tangential_damping_ratio=0.0,
                         position=(0.0, 0.0, 0.0), velocity=(2.0, 0.0, -1.0))
-    result = ballc.simulate(scene, 1.0, rtol=1e-9, atol=1e-11)
+    result = ballc.simulate(scene, 1.0, rtol=1e-9, atol=1e-10)
     assert result.status == 0 and len(result.contacts) == 28
     ratios = []
     for c in result.contacts:

@@ -984,6 +984,7 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
     }
 
     const double mu = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT];
+    const double radius = params->values[BALLC_PARAMETER_RADIUS];
     double dF[NU * MAXS] = {0}, dMa[NU * 4] = {0}, buf[LAW_NOUT * MAXS], local[LAW_NOUT * NC];
     add_dynamics_jac(ballc_ball_jac, state, params, udot, dF, dMa);
     if (flags & BALLC_WITH_OBSERVER)
@@ -995,6 +996,15 @@ int ballc_jacobian_checked_inputs(const double *state, const ballc_parameters_t 
         int target[4];
         auxiliary_targets(pl, target);
         plane_contact(params, plane, state, latch, &contact);
+        /* At rho <= 0 no law carries a load (no adhesion): each law's force and rates are
+         * 0 there, and so is their derivative on that side -- the side of a contact at
+         * rho = 0, which (armed at rho > 0) is leaving.  The kernels' derivatives at
+         * rho = 0 exactly are half the loaded side's (d max(rho, 0)/drho = 1/2 there),
+         * which for the compliant law run through its floors of rho and sqrt(rho)
+         * (1e-30 m): ~1e28 W/m in the tangential dissipation with the deflection a
+         * contact leaves, and radau5's Newton failed on a step that ended on rho = 0
+         * (docs/contact_laws.md, "The Jacobian at rho <= 0"). */
+        if (radius - contact.state[BALLC_CONTACT_STATE_Z] <= 0) continue;
         for (size_t k = 0; k < N_CONTACT_LAWS; k++) {
             if (!law_acts(flags, k, plane)) continue;
             int exact = is_sliding(ev.mode[plane]) && CONTACT_LAWS[k].normal_jac;
