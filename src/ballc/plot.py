@@ -324,24 +324,34 @@ def contact_points(result) -> np.ndarray:
     return points
 
 
-def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5), t_window=None):
-    """Top view (x, y): the centre's path and the contact points coloured by time,
-    numbered, with arrows from each to the next (floor o, ceiling ^; plane_style).
-    ``t_window``: as :func:`plot_coordinates`'s (the path in it, and the contacts that
-    start in it)."""
+def _path_view(result, ax, figsize, t_window, axes):
+    """What a view of the centre's path on two of its coordinates (``axes``: 0 x, 1 y,
+    2 z) starts with: pyplot, the figure and axes (new ones of ``figsize`` if ``ax`` is
+    None), the time window (t0, t1, tail) of :func:`_window`, the path's two coordinates
+    in it (decimated for drawing), the indices of the contacts that start in it and their
+    contact points."""
     plt = _pyplot()
     t0, t1, tail = _window(result, t_window)
     fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
                else (ax.figure, ax))
     drawn = _in_window(result, t0, t1, tail)
     inside = (drawn.t >= t0) & (drawn.t <= t1)
-    _, x, y = _for_drawing(drawn.t[inside], drawn.position[0, inside],
-                           drawn.position[1, inside])
+    _, a, b = _for_drawing(drawn.t[inside], drawn.position[axes[0], inside],
+                           drawn.position[axes[1], inside])
+    shown = [i for i, c in enumerate(result.contacts) if t0 <= c.t_start <= t1]
+    return plt, fig, ax, (t0, t1, tail), a, b, shown, contact_points(result)[shown]
+
+
+def plot_contacts_top_view(result, ax=None, figsize=(7, 6.5), t_window=None):
+    """Top view (x, y): the centre's path and the contact points coloured by time,
+    numbered, with arrows from each to the next (floor o, ceiling ^; plane_style).
+    ``t_window``: as :func:`plot_coordinates`'s (the path in it, and the contacts that
+    start in it)."""
+    plt, fig, ax, (t0, t1, tail), x, y, shown, points = _path_view(
+        result, ax, figsize, t_window, (0, 1))
     ax.plot(x, y, color="0.6", lw=0.8, label="centre path")
     if t0 <= result.t[0]:
         ax.plot(*result.position[:2, 0], "kx", ms=8, label="start")
-    shown = [i for i, c in enumerate(result.contacts) if t0 <= c.t_start <= t1]
-    points = contact_points(result)[shown]
     times = np.array([result.contacts[i].t_start for i in shown])
     if len(points):
         norm = plt.Normalize(t0, max(t1, t0 + 1e-12))
@@ -479,20 +489,12 @@ def plot_side_view(result, ax=None, figsize=(8, 6.5), t_window=None):
     colour, seen along y: a plane containing the y axis as its line) and the contact
     points numbered -- the picture of a tilted pair of plates, a wedge or a channel.
     ``t_window``: as :func:`plot_coordinates`'s."""
-    plt = _pyplot()
-    t0, t1, tail = _window(result, t_window)
-    fig, ax = (plt.subplots(figsize=figsize, constrained_layout=True) if ax is None
-               else (ax.figure, ax))
-    drawn = _in_window(result, t0, t1, tail)
-    inside = (drawn.t >= t0) & (drawn.t <= t1)
-    _, x, z = _for_drawing(drawn.t[inside], drawn.position[0, inside],
-                           drawn.position[2, inside])
+    plt, fig, ax, (t0, t1, tail), x, z, shown, points = _path_view(
+        result, ax, figsize, t_window, (0, 2))
     draw_planes(ax, result, (0, 2))
     ax.plot(x, z, color="0.35", lw=0.8, label="centre path")
     if t0 <= result.t[0]:
         ax.plot(result.position[0, 0], result.position[2, 0], "kx", ms=8, label="start")
-    shown = [i for i, c in enumerate(result.contacts) if t0 <= c.t_start <= t1]
-    points = contact_points(result)[shown]
     for k, i in enumerate(shown):
         colour, marker = plane_style(result.scene, result.contacts[i].plane)
         ax.plot(points[k, 0], points[k, 2], marker=marker, color=colour, mec="k", ms=8,
