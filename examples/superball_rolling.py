@@ -22,10 +22,10 @@ passive compliant law, mu = 0.9 and e = ``restitution`` = 0.97:
 
 Run it on its own::
 
-    python examples/superball_rolling.py [--figure PATH]
+    python examples/superball_rolling.py [--out DIR] [--figure PATH]
 
 It prints both tables and writes the figure (default
-``ballc-output/superball_rolling.png``; the docs' copy is ``docs/superball_rolling.png``).
+``ballc-output/superball_rolling/superball_rolling.png``; the docs' copy is ``docs/superball_rolling.png``).
 """
 
 # %%
@@ -44,9 +44,13 @@ from ballc.scene import mindlin_stiffness_ratio
 matplotlib.use("Agg")   # write files, never open a window
 
 parser = argparse.ArgumentParser(description="The superball with rolling resistance.")
-parser.add_argument("--figure", type=Path, default=Path("ballc-output/superball_rolling.png"),
-                    metavar="PATH", help="figure path, default %(default)s")
+parser.add_argument("--out", type=Path, default=Path("ballc-output/superball_rolling"),
+                    metavar="DIR", help="output folder, default %(default)s")
+parser.add_argument("--figure", type=Path, default=None, metavar="PATH",
+                    help="figure path, default DIR/superball_rolling.png")
 args = parser.parse_args()
+args.out.mkdir(parents=True, exist_ok=True)
+figure = args.figure or args.out / "superball_rolling.png"
 
 RUBBER = mindlin_stiffness_ratio(0.49, 0.25, 2e6, 5e10)   # 4 G*/E*, ~0.68
 KAPPAS = {"2/7": 2 / 7, "0.5": 0.5, "2/3": 2 / 3, f"rubber {RUBBER:.2f}": RUBBER}
@@ -115,6 +119,6 @@ right.set_yticks(range(len(MU_RS)), [f"{m:g}" for m in MU_RS])
 right.set(xlabel="tangential stiffness ratio kappa", ylabel="rolling resistance mu_r",
           title="seed's throw under the table: came back?")
 fig.suptitle("Rolling resistance (exact model) and the superball")
-args.figure.parent.mkdir(parents=True, exist_ok=True)
-fig.savefig(args.figure, dpi=100)
-print("wrote", args.figure)
+figure.parent.mkdir(parents=True, exist_ok=True)
+fig.savefig(figure, dpi=100)
+print("wrote", figure)

@@ -22,23 +22,11 @@ import numpy as np
 import pytest
 
 import ballc
-from ballc import _core, resting
+from ballc import _core
+from validation.rolling_cases import stiff_scene   # the scene the validation scores
 
 S = _core.STATE_INDEX
 G = 9.81
-
-
-def stiff_scene(**changes):
-    """A stiff ball (steel-like moduli), radius 0.1 m, 1 kg, no observer, at its static
-    Hertz equilibrium on the floor: the normal force is m g from the start."""
-    fields = dict(tangential_model="friction", observer_mass=0.0, radius=0.1, mass=1.0,
-                  ball_youngs_modulus=2e11, plane_youngs_modulus=2e11, c_tau=0.5,
-                  friction_coefficient=0.5, rolling_resistance=0.01, position=(0, 0, 0.1),
-                  velocity=(0.0, 0.0, 0.0))
-    fields.update(changes)
-    scene = ballc.Scene(**fields)
-    return scene.replace(position=(0.0, 0.0, scene.radius
-                                   - resting.equilibrium_penetration(scene)))
 
 
 def tilted(scene, theta):

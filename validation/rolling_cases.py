@@ -30,7 +30,10 @@ LAMMPS_BAR = (1.0, "issue 31: 1 % of the impact speed")
 CLOSED_FORM = (1e-4, "closed form, rtol 1e-9 run: 1e-4 %")
 
 
-def _stiff(**changes):
+def stiff_scene(**changes):
+    """A stiff ball (steel-like moduli), radius 0.1 m, 1 kg, no observer, rolling
+    resistance 0.01, at its static Hertz equilibrium on the floor: the normal force is
+    m g from the start (``changes``: Scene fields)."""
     fields = dict(tangential_model="friction", observer_mass=0.0, radius=0.1, mass=1.0,
                   ball_youngs_modulus=2e11, plane_youngs_modulus=2e11, c_tau=0.5,
                   friction_coefficient=0.5, rolling_resistance=0.01, position=(0, 0, 0.1),
@@ -55,7 +58,7 @@ def test7_rolling_resistance():
     # exact model on a floor: the stop
     for name, ratio in (("solid", 0.4), ("hollow", 2 / 3)):
         v0, mu_r, r = 1.0, 0.01, 0.1
-        scene = _stiff(inertia=(ratio * r * r,) * 3, velocity=(v0, 0, 0),
+        scene = stiff_scene(inertia=(ratio * r * r,) * 3, velocity=(v0, 0, 0),
                        angular_velocity=(0, v0 / r, 0))
         a = mu_r * G / (1 + ratio)
         result = ballc.simulate(scene, 1.5 * v0 / a, rtol=1e-9, atol=1e-10)
@@ -74,7 +77,7 @@ def test7_rolling_resistance():
     # exact model on an incline (gravity turned by theta)
     mu_r = 0.02
     theta = math.atan(3 * mu_r)
-    scene = _stiff(rolling_resistance=mu_r)
+    scene = stiff_scene(rolling_resistance=mu_r)
     params = scene.parameter_vector()
     names = ballc._core.PARAMETER_NAMES
     params[[names.index(f"gravity_{k}") for k in "xyz"]] = \
@@ -89,7 +92,7 @@ def test7_rolling_resistance():
                                       / 1.4), *CLOSED_FORM))
     # sds: the small oscillation
     k = 100.0
-    scene = _stiff(rolling_model="sds", rolling_resistance=0.1, rolling_stiffness=k,
+    scene = stiff_scene(rolling_model="sds", rolling_resistance=0.1, rolling_stiffness=k,
                    rolling_damping=0.0, velocity=(1e-3, 0, 0), angular_velocity=(0, 1e-2, 0))
     result = ballc.simulate(scene, 3.0, rtol=1e-10, atol=1e-12, rest=False)
     vx = result.y[S["vx"]]
