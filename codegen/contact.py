@@ -874,10 +874,17 @@ def sds_spring(model: Model, plane: str, part: str):
 def slider_grows(model: Model, plane: str):
     """1 while the cap grows (dF_n/dt >= 0 with the contact's own rho''), else 0: which
     radial form the sds slider takes (sds_slider)."""
+    return sm.Heaviside(_load_and_rate(model, plane)[1], 0)
+
+
+def _load_and_rate(model: Model, plane: str, accel=None):
+    """(F_n, dF_n/dt) of the plane's contact as its rolling part sees them: the normal
+    force (rolling_load) and its rate with the penetration acceleration ``accel``
+    (normal_force_rate; None: the contact's own rho'')."""
     _, _, rho, rhodot = contact_kinematics(model, plane)
     rate_at_impact = latch_symbols(model, plane)[0]
     f_n = rolling_load(model, plane)
-    return sm.Heaviside(normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n), 0)
+    return f_n, normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n, accel)
 
 
 def sds_slider(model: Model, plane: str, part: str, accel=None, grows=None):
@@ -898,10 +905,7 @@ def sds_slider(model: Model, plane: str, part: str, accel=None, grows=None):
     ``grows``: a symbol for slider_grows, held constant by the Jacobian (its derivative
     is a Dirac delta).  Returns (force, xi', dissipation rate)."""
     xi, w, k, gamma, mu = rolling_part(model, plane, part)
-    _, _, rho, rhodot = contact_kinematics(model, plane)
-    rate_at_impact = latch_symbols(model, plane)[0]
-    f_n = rolling_load(model, plane)
-    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n, accel)
+    f_n, f_rate = _load_and_rate(model, plane, accel)
     cap = mu * f_n
     size = sm.sqrt(sm.Max(sum(x**2 for x in xi), _DIRECTION_FLOOR2))
     e = [x / size for x in xi]
@@ -927,10 +931,7 @@ def sds_margins(model: Model, plane: str, part: str, accel):
     grows; the slider ends where it falls below 0; +1 without load), affine in the
     penetration acceleration ``accel``, and the deflection at the cap mu F_n / k (m)."""
     xi, w, k, gamma, mu = rolling_part(model, plane, part)
-    _, _, rho, rhodot = contact_kinematics(model, plane)
-    rate_at_impact = latch_symbols(model, plane)[0]
-    f_n = rolling_load(model, plane)
-    f_rate = normal_force_rate(model, plane, rho, rhodot, rate_at_impact, f_n, accel)
+    f_n, f_rate = _load_and_rate(model, plane, accel)
     cap = mu * f_n
     stiffness = sm.Max(k, _STIFFNESS_FLOOR)
     size = sm.sqrt(sm.Max(sum(x**2 for x in xi), _DIRECTION_FLOOR2))

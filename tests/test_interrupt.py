@@ -195,6 +195,13 @@ def _assert_partial_sweep(out_folder, out, err, total=4):
     assert "sweep.csv" in out
 
 
+def _pool_sweep(tmp_path):
+    """``ballc sweep`` started on the slow sweep file with 2 workers, in ``tmp_path``."""
+    text = SWEEP_FILE.replace("t_end = 1e6\n", "t_end = 1e6\nworkers = 2\n")
+    (tmp_path / "slow.toml").write_text(text)
+    return _Command("sweep", "slow.toml", "--out", "out", cwd=tmp_path)
+
+
 @pytest.mark.parametrize("to_group", [True, False], ids=["to the group", "to the parent"])
 def test_ctrl_c_stops_a_pool_sweep_and_its_workers(tmp_path, to_group):
     """Issue 28, item 2: a Ctrl-C sent to the process group (a terminal's) kept a pool
@@ -202,9 +209,7 @@ def test_ctrl_c_stops_a_pool_sweep_and_its_workers(tmp_path, to_group):
     run's result and went on; the parent waited for them); sent to the parent alone it
     left the workers orphaned, running.  Now both end the sweep: the workers are
     stopped, the finished rows are written, one line says so, exit code 130."""
-    text = SWEEP_FILE.replace("t_end = 1e6\n", "t_end = 1e6\nworkers = 2\n")
-    (tmp_path / "slow.toml").write_text(text)
-    command = _Command("sweep", "slow.toml", "--out", "out", cwd=tmp_path)
+    command = _pool_sweep(tmp_path)
     try:
         command.wait_for_finished_runs(len(FAST))
         assert len(command.workers) >= 2, command.workers
@@ -220,9 +225,7 @@ def test_ctrl_c_stops_a_pool_sweep_and_its_workers(tmp_path, to_group):
 def test_a_pool_sweeps_workers_end_with_their_parent(tmp_path):
     """A parent killed outright (SIGKILL: no chance to stop its workers) must not leave
     them running: each worker watches its parent and ends when it is gone."""
-    text = SWEEP_FILE.replace("t_end = 1e6\n", "t_end = 1e6\nworkers = 2\n")
-    (tmp_path / "slow.toml").write_text(text)
-    command = _Command("sweep", "slow.toml", "--out", "out", cwd=tmp_path)
+    command = _pool_sweep(tmp_path)
     try:
         command.wait_for_finished_runs(len(FAST))
         assert len(command.workers) >= 2, command.workers

@@ -93,31 +93,29 @@ cdef extern from "_system.h":
     int ballc_remove_velocities(const double *, const ballc_parameters_t *, const double *,
                                 ballc_flags, int, int, double *) nogil
 
+cdef tuple _decoded(const char *const *names, int n):
+    """The first ``n`` of a generated C table of names, as Python strings."""
+    cdef int i
+    return tuple([names[i].decode() for i in range(n)])
+
+
 #: The most planes a scene may have, and the layout of a run with n planes: the ball's
 #: states (BALL_STATE_NAMES), then PLANE_STATE_FIELDS per plane (``<plane>_<field>``);
 #: the scene's parameters (BASE_PARAMETER_NAMES, the last the plane table's count), then
 #: PLANE_FIELD_NAMES per plane; LATCH_FIELD_NAMES per plane.  (ballc.layout names them.)
 MAX_PLANES = BALLC_MAX_PLANES
-BALL_STATE_NAMES = tuple(BALLC_STATE_NAMES[i].decode() for i in range(BALLC_N_BALL_STATES))
-PLANE_STATE_FIELDS = tuple(BALLC_PLANE_STATE_NAMES[i].decode()
-                           for i in range(BALLC_N_PLANE_STATES))
+BALL_STATE_NAMES = _decoded(BALLC_STATE_NAMES, BALLC_N_BALL_STATES)
+PLANE_STATE_FIELDS = _decoded(BALLC_PLANE_STATE_NAMES, BALLC_N_PLANE_STATES)
 #: The states of rolling resistance (a run with rolling or twisting resistance only):
 #: after every plane's, ROLLING_BALL_STATE_NAMES, then ROLLING_PLANE_STATE_FIELDS per
 #: plane (its rolling springs, ``<plane>_<field>``).
-ROLLING_BALL_STATE_NAMES = tuple(BALLC_ROLLING_BALL_STATE_NAMES[i].decode()
-                                 for i in range(BALLC_N_ROLLING_BALL_STATES))
-ROLLING_PLANE_STATE_FIELDS = tuple(BALLC_ROLLING_PLANE_STATE_NAMES[i].decode()
-                                   for i in range(BALLC_N_ROLLING_PLANE_STATES))
-BASE_PARAMETER_NAMES = tuple(BALLC_PARAMETER_NAMES[i].decode()
-                             for i in range(BALLC_PARAMETER_PLANES))
-BASE_PARAMETER_UNITS = tuple(BALLC_PARAMETER_UNITS[i].decode()
-                             for i in range(BALLC_PARAMETER_PLANES))
-PLANE_FIELD_NAMES = tuple(BALLC_PLANE_FIELD_NAMES[i].decode()
-                          for i in range(BALLC_N_PLANE_FIELDS))
-PLANE_FIELD_UNITS = tuple(BALLC_PLANE_FIELD_UNITS[i].decode()
-                          for i in range(BALLC_N_PLANE_FIELDS))
-LATCH_FIELD_NAMES = tuple(BALLC_LATCH_FIELD_NAMES[i].decode()
-                          for i in range(BALLC_N_LATCH_PER_PLANE))
+ROLLING_BALL_STATE_NAMES = _decoded(BALLC_ROLLING_BALL_STATE_NAMES, BALLC_N_ROLLING_BALL_STATES)
+ROLLING_PLANE_STATE_FIELDS = _decoded(BALLC_ROLLING_PLANE_STATE_NAMES, BALLC_N_ROLLING_PLANE_STATES)
+BASE_PARAMETER_NAMES = _decoded(BALLC_PARAMETER_NAMES, BALLC_PARAMETER_PLANES)
+BASE_PARAMETER_UNITS = _decoded(BALLC_PARAMETER_UNITS, BALLC_PARAMETER_PLANES)
+PLANE_FIELD_NAMES = _decoded(BALLC_PLANE_FIELD_NAMES, BALLC_N_PLANE_FIELDS)
+PLANE_FIELD_UNITS = _decoded(BALLC_PLANE_FIELD_UNITS, BALLC_N_PLANE_FIELDS)
+LATCH_FIELD_NAMES = _decoded(BALLC_LATCH_FIELD_NAMES, BALLC_N_LATCH_PER_PLANE)
 N_LATCH_PER_PLANE = BALLC_N_LATCH_PER_PLANE
 CONTACT_KINEMATICS_PER_PLANE = BALLC_CONTACT_KINEMATICS_PER_PLANE
 

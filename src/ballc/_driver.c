@@ -197,6 +197,21 @@ static int plane_mode(const run_t *r, int p)
     return BALLC_PLANE_CONTACT;
 }
 
+/* Each plane's mode, rolling part's and twisting part's mode now, for the log (-1 for
+ * the slots beyond the scene's planes). */
+static void log_modes(const run_t *r, signed char *mode, signed char *rolling,
+                      signed char *twisting)
+{
+    for (int p = 0; p < MAXP; p++) {
+        int here = p < r->np;
+        mode[p] = here ? (signed char)plane_mode(r, p) : (signed char)-1;
+        rolling[p] = here ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 0)
+                          : (signed char)-1;
+        twisting[p] = here ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 1)
+                           : (signed char)-1;
+    }
+}
+
 /* A segment starts at r->t in the present modes. */
 static void log_open(run_t *r)
 {
@@ -205,13 +220,7 @@ static void log_open(run_t *r)
     g->t_start = r->t;
     g->plane = -1;
     g->rearm_kind = g->rearm_plane = g->rearm_before = g->rearm_after = -1;
-    for (int p = 0; p < MAXP; p++) {
-        g->before[p] = p < r->np ? (signed char)plane_mode(r, p) : (signed char)-1;
-        g->rolling_before[p] = p < r->np ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 0)
-                                         : (signed char)-1;
-        g->twisting_before[p] = p < r->np ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 1)
-                                          : (signed char)-1;
-    }
+    log_modes(r, g->before, g->rolling_before, g->twisting_before);
 }
 
 /* An event of plane p re-armed inside the segment, leaving it in mode ``before``. */
@@ -236,13 +245,7 @@ static int log_close(run_t *r, int end, int plane, double t_end)
     g->end = end;
     g->plane = plane;
     g->t_end = t_end;
-    for (int p = 0; p < MAXP; p++) {
-        g->after[p] = p < r->np ? (signed char)plane_mode(r, p) : (signed char)-1;
-        g->rolling_after[p] = p < r->np ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 0)
-                                        : (signed char)-1;
-        g->twisting_after[p] = p < r->np ? (signed char)ballc_rolling_mode(r->latch + p * NLP, 1)
-                                         : (signed char)-1;
-    }
+    log_modes(r, g->after, g->rolling_after, g->twisting_after);
     o->log[o->n_log++] = *g;
     return 0;
 }
