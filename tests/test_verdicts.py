@@ -99,3 +99,34 @@ def test_the_drift_is_written_as_a_percentage_or_a_multiple(short):
     drifted.y[ballc.STATE_NAMES.index("dissipated_normal"), -1] += 0.02 * initial
     drifted._energy = None
     assert "2 % of the initial energy" in outcome.balance_warning(drifted, 1.0)
+
+
+@pytest.mark.parametrize("scene", [ballc.Scene(),                       # comes back
+                                   ballc.Scene(tangential_model="friction"),
+                                   ballc.Scene(mixture=0.3, friction_coefficient=0.2)])
+def test_summary_from_the_run_is_the_summary_from_its_contacts(scene, tmp_path):
+    """A run's summary (sweep rows) reads the C loop's contact records; a Result read
+    from a file has only its Contact objects: the two must give the same row, including
+    the first reversal and the verdict (and the Contact of the first reversal is the one
+    at that time)."""
+    run = ballc.simulate(scene, 1.2, rtol=1e-6, atol=1e-6)
+    path = tmp_path / "run.npz"
+    run.save(path)
+    loaded = ballc.load(path)
+    assert "_contact_records" not in loaded.__dict__
+    from_run, from_file = outcome.summary(run), outcome.summary(loaded)
+    assert from_run.keys() == from_file.keys()
+    for key, value in from_run.items():
+        other = from_file[key]
+        if isinstance(value, float) and np.isnan(value):
+            assert np.isnan(other), key
+        else:
+            assert value == other, key
+    reversal = outcome.first_reversal(run)
+    if reversal is None:
+        assert np.isnan(from_run["first_reversal_time"])
+    else:
+        assert reversal.t_start == from_run["first_reversal_time"]
+        assert reversal.velocity_before[0] * reversal.velocity_after[0] < 0
+        earlier = [c for c in run.contacts if c.t_start < reversal.t_start]
+        assert all(c.velocity_before[0] * c.velocity_after[0] >= 0 for c in earlier)

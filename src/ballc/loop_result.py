@@ -31,7 +31,9 @@ def result_of(scene, options, run, checks_rest=False) -> Result:
         njev=run.njev, nlu=run.nlu, state_names=scene.state_names, _energy=None,
         method_switches=run.switches() if options.method == "auto" else None,
         _pending={
-            "contacts": lambda r: _contacts(scene, run, _ForceSummary(run.t, y, blocks, scene)),
+            "_contact_records": lambda r: run.contacts(),
+            "contacts": lambda r: _contacts(scene, r._contact_records, run,
+                                            _ForceSummary(run.t, y, blocks, scene)),
             "flags": lambda r: blocks.flags(),
             "latch": lambda r: blocks.latch(),
             "t_events": lambda r: _user_events(r, run, options)[0],
@@ -117,12 +119,11 @@ def _user_events(result, run, options):
     return found
 
 
-def _contacts(scene, run, summary) -> list:
-    """The run's contacts, their phases and end states; their force summaries are
-    computed on first access to one (``summary``, ballc.outcome.summarize_contacts).
-    Their vectors are rows of one array per field (a contact that did not end: NaN
-    after)."""
-    found = run.contacts()
+def _contacts(scene, found, run, summary) -> list:
+    """The run's contacts (``found``: its contact records, run.contacts()), their phases
+    and end states; their force summaries are computed on first access to one
+    (``summary``, ballc.outcome.summarize_contacts).  Their vectors are rows of one
+    array per field (a contact that did not end: NaN after)."""
     t_end, lost, rates = found["t_end"].tolist(), found["lost"].tolist(), found["rate"]
     v_before, w_before, v_after, w_after, digin, point = (found[name] for name in (
         "v_before", "w_before", "v_after", "w_after", "digin", "contact_point"))

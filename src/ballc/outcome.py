@@ -26,10 +26,11 @@ def came_back(result, after_contacts: int = CAME_BACK_AFTER_CONTACTS):
     is opposite to the initial x-velocity, False when it is not, None (undetermined)
     with fewer completed contacts or no initial x-velocity (see the module docstring)."""
     thrown = result.velocity[0, 0]
-    done = [c for c in result.contacts if np.isfinite(c.t_end)][:after_contacts]
+    _, completed, _, after = _x_velocities(result)
+    done = np.flatnonzero(completed)[:after_contacts]
     if len(done) < after_contacts or thrown == 0:
         return None
-    return bool(np.sign(done[-1].velocity_after[0]) == -np.sign(thrown))
+    return bool(np.sign(after[done[-1]]) == -np.sign(thrown))
 
 
 def verdict(came, after_contacts: int = CAME_BACK_AFTER_CONTACTS) -> str:
@@ -43,22 +44,42 @@ def verdict(came, after_contacts: int = CAME_BACK_AFTER_CONTACTS) -> str:
 
 def first_reversal(result):
     """The first contact at which the x-velocity changed sign, or None."""
-    for contact in result.contacts:
-        before, after = contact.velocity_before[0], contact.velocity_after[0]
-        if np.isfinite(after) and before * after < 0:
-            return contact
-    return None
+    k = _first_reversal_index(result)
+    return None if k is None else result.contacts[k]
+
+
+def _first_reversal_index(result):
+    _, _, before, after = _x_velocities(result)
+    reversed_ = np.flatnonzero(np.isfinite(after) & (before * after < 0))
+    return int(reversed_[0]) if len(reversed_) else None
+
+
+def _x_velocities(result):
+    """(t_start, completed, x-velocity before, x-velocity after) of the run's contacts,
+    one array each: from the C loop's contact records when the result has them (a run:
+    no Contact object is built), else from its contacts (a Result read from a file)."""
+    records = getattr(result, "_contact_records", None)
+    if records is not None:
+        return (records["t_start"], np.isfinite(records["t_end"]),
+                records["v_before"][:, 0], records["v_after"][:, 0])
+    contacts = result.contacts
+    return (np.array([c.t_start for c in contacts], dtype=float),
+            np.array([np.isfinite(c.t_end) for c in contacts], dtype=bool),
+            np.array([c.velocity_before[0] for c in contacts], dtype=float),
+            np.array([c.velocity_after[0] for c in contacts], dtype=float))
 
 
 def summary(result) -> dict:
     """Plain numbers of one run: contacts, came_back (True, False or None:
     undetermined), energies (J), solver status."""
     total = result.energy["total"]
-    reversal = first_reversal(result)
+    t_start = _x_velocities(result)[0]
+    reversal = _first_reversal_index(result)
     return {
-        "contacts": len(result.contacts),
+        "contacts": len(t_start),
         "came_back": came_back(result),
-        "first_reversal_time": reversal.t_start if reversal else float("nan"),   # s
+        "first_reversal_time": (float(t_start[reversal]) if reversal is not None
+                                else float("nan")),                              # s
         "energy_initial": float(total[0]),                                       # J
         "energy_final": float(total[-1]),                                        # J
         "energy_lost": float(total[0] - total[-1]),                              # J

@@ -157,8 +157,10 @@ class Plane:
                          "normal[, name])")
 
 
+@functools.lru_cache(maxsize=64)
 def seed_planes(ceiling_height: float) -> tuple:
-    """The seed's planes: the floor z = 0 (normal +z) and the ceiling z = H (normal -z)."""
+    """The seed's planes: the floor z = 0 (normal +z) and the ceiling z = H (normal -z).
+    Planes are frozen: the scenes of one height share them (a sweep makes thousands)."""
     return (Plane((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), "floor"),
             Plane((0.0, 0.0, float(ceiling_height)), (0.0, 0.0, -1.0), "ceiling"))
 

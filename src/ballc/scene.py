@@ -448,7 +448,7 @@ class Scene:
         ``<name>_deflection_x``, ``_y`` (the seed's: ``ballc.STATE_NAMES``); with rolling
         resistance (:attr:`rolling_on`) then ``dissipated_rolling`` and each plane's
         rolling springs ``<name>_rolling_x``, ``_rolling_y``, ``_twisting``."""
-        return _core.state_names(self.plane_names, self.rolling_on)
+        return _state_names(self.plane_names, self.rolling_on)
 
     @property
     def rolling_on(self) -> bool:
@@ -459,12 +459,12 @@ class Scene:
     @functools.cached_property
     def parameter_names(self) -> tuple:
         """The names of :meth:`parameter_vector`'s entries."""
-        return _core.parameter_names(self.plane_names)
+        return _parameter_names(self.plane_names)
 
     @functools.cached_property
     def latch_names(self) -> tuple:
         """The names of the latched values (per plane, LATCH fields)."""
-        return _core.latch_names(self.plane_names)
+        return _latch_names(self.plane_names)
 
     @property
     def gravity_vector(self) -> np.ndarray:
@@ -535,6 +535,12 @@ class Scene:
         state.flags.writeable = False
         return state
 
+
+# The layouts' names, each built once per set of planes (a sweep makes thousands of
+# scenes with the same planes; names are tuples of str: immutable).
+_state_names = functools.lru_cache(maxsize=256)(_core.state_names)
+_parameter_names = functools.lru_cache(maxsize=256)(_core.parameter_names)
+_latch_names = functools.lru_cache(maxsize=256)(_core.latch_names)
 
 #: The Scene fields' names, in order (dataclasses.fields is slow to ask every time).
 _FIELD_NAMES = tuple(f.name for f in fields(Scene))
@@ -788,6 +794,10 @@ def _fail(name, value, allowed):
 
 def _finite(name, value) -> float:
     """``value`` as a finite float, or SceneError naming ``name``."""
+    if type(value) is float:   # most fields, a replace()'s all: no conversion to check
+        if not math.isfinite(value):
+            _fail(name, value, "must be finite")
+        return value
     # Strings and bools would pass float() but are not numbers (a str field
     # would break arithmetic later, e.g. in hertz_stiffness).
     if isinstance(value, (str, bytes, bool, np.bool_)):

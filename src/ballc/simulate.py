@@ -168,6 +168,14 @@ def simulate(scene: Scene, t_end: float, *, method: str = "radau5", rtol: float 
     options = check_options(scene, t_end, method, rtol, atol, max_step, first_step, t_eval,
                             max_nfev, events, dense_output, exact_flight)
     y = scene._initial if y0 is None else check_initial_state(scene, y0)
+    return run_checked(scene, options, y, progress, rest)
+
+
+def run_checked(scene: Scene, options, y, progress=None, rest: bool = True) -> Result:
+    """:func:`simulate`'s run from its checked arguments: ``options``
+    (ballc.options.check_options of this scene, or of one with the same state names) and
+    ``y`` (the full initial state, checked).  A sweep checks its options once, not
+    once per cell."""
     constants = scene_constants(scene)
     run_given = run_constants(scene, options, rest)
     bar = progress_bar(progress, options.t_end)   # advanced from C, throttled in wall time

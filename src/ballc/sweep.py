@@ -51,13 +51,21 @@ class SweepInterrupted(KeyboardInterrupt):
         self.table, self.finished, self.total = table, finished, total
 
 
-def _run_one(changes: dict, scene: Scene, t_end: float, options: dict, outputs: dict) -> dict:
+def _run_one(changes: dict, scene: Scene, t_end: float, options: dict, outputs: dict,
+             checked: dict | None = None) -> dict:
     """One simulation -> one row (runs in a worker; module-level so it pickles).  The
-    scene is the one validated before any run: a worker does not validate it again."""
-    from .simulate import simulate
+    scene is the one validated before any run: a worker does not validate it again, and
+    ``checked`` (a dict kept over a batch) holds simulate's options checked once per
+    batch and state layout."""
+    from .simulate import run_checked, simulate
     row = dict(changes)
     try:
-        result = simulate(scene, t_end, progress=False, **options)
+        if checked is None or options.get("y0") is not None:
+            result = simulate(scene, t_end, progress=False, **options)
+        else:
+            result = run_checked(scene, _checked_options(checked, scene, t_end, options),
+                                 scene._initial, progress=False,
+                                 rest=options.get("rest", True))
     except Exception as error:    # one failed scene must not lose the sweep
         row.update({name: float("nan") for name in SUMMARY_COLUMNS})
         row.update(status=-1, message=f"{type(error).__name__}: {error}",
@@ -66,6 +74,18 @@ def _run_one(changes: dict, scene: Scene, t_end: float, options: dict, outputs: 
     row.update(summary(result))
     row.update({name: function(result) for name, function in outputs.items()})
     return row
+
+
+def _checked_options(checked: dict, scene: Scene, t_end: float, options: dict):
+    """simulate's options (but progress, y0, rest) checked for ``scene`` as simulate
+    checks them, once per state layout (they depend on the scene only through its
+    state names: a per-state atol, a LinearEvent's coefficients)."""
+    from .options import check_options
+    found = checked.get(scene.state_names)
+    if found is None:
+        given = {k: v for k, v in options.items() if k not in ("y0", "rest")}
+        found = checked[scene.state_names] = check_options(scene, t_end, **given)
+    return found
 
 
 def _named_outputs(outputs) -> dict:
@@ -282,9 +302,10 @@ def _bar(iterable, progress, total):
 def _in_this_process(tasks, rows, progress):
     """The runs one after the other in this process (workers = 1)."""
     bar = _bar(None, progress, len(tasks)) if progress else None
+    checked = {}
     try:
         for i, task in enumerate(tasks):
-            rows[i] = _run_one(*task)
+            rows[i] = _run_one(*task, checked)
             if bar is not None:
                 bar.update(1)
     finally:
@@ -294,7 +315,8 @@ def _in_this_process(tasks, rows, progress):
 
 def _run_batch(batch):
     """Several runs in one worker call: one round trip per batch, not per run."""
-    return [_run_one(*task) for task in batch]
+    checked = {}
+    return [_run_one(*task, checked) for task in batch]
 
 
 #: A pool worker checks this often (s) whether the process that started it is still
