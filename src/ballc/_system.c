@@ -1,5 +1,6 @@
 /* See _system.h.  Hand-written glue: calls generated kernels (the contact laws in each
  * plane's frame, _plane.h), solves M udot = F. */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -12,6 +13,12 @@
 #define NU 6  /* speeds: angular velocity (3) and centre velocity (3) */
 #define NC BALLC_N_CONTACT_STATES
 #define MAXP BALLC_MAX_PLANES
+
+#if defined(__GNUC__)
+#define BALLC_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define BALLC_ALWAYS_INLINE inline
+#endif
 
 typedef void (*kernel_fn)(const double *restrict, const double *restrict,
                           const double *restrict, const double *restrict, double *restrict);
@@ -141,12 +148,20 @@ typedef struct {
     double D, inverse_D;
 } schur_t;
 
-/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one. */
+/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one (four sums:
+ * one chain of additions would wait on each, and this runs twice per right-hand side). */
 static int all_finite(const double *v, int n)
 {
-    double s = 0.0;
-    for (int i = 0; i < n; i++) s += v[i] - v[i];
-    return s == 0.0;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        s0 += v[i] - v[i];
+        s1 += v[i + 1] - v[i + 1];
+        s2 += v[i + 2] - v[i + 2];
+        s3 += v[i + 3] - v[i + 3];
+    }
+    for (; i < n; i++) s0 += v[i] - v[i];
+    return (s0 + s1) + (s2 + s3) == 0.0;
 }
 
 /* The number of parameters of ``params`` (its plane table's count), or -1. */
@@ -489,22 +504,26 @@ static void hold_rolling(held_t *h, ballc_rolling_eval *roll, int part, int ns)
  * velocity the others already hold -- a ball sticking on two planes at once, both
  * holding its rolling: their forces are then statically indeterminate, and this takes
  * one split of them).  BALLC_SINGULAR when A is not finite or is 0. */
-static int held_dense_solve(int m, double *A, double *b)
+static BALLC_ALWAYS_INLINE int held_dense_solve(int m, double *A, double *b)
 {
     int column[MAX_HELD], rank = m;
     double largest = 0.0;
     for (int i = 0; i < m * m; i++) {
-        if (!isfinite(A[i])) return BALLC_SINGULAR;
-        largest = fmax(largest, fabs(A[i]));
+        double a = fabs(A[i]);
+        if (!(a <= DBL_MAX)) return BALLC_SINGULAR;   /* not finite */
+        if (a > largest) largest = a;
     }
     if (!(largest > 0)) return BALLC_SINGULAR;
     for (int c = 0; c < m; c++) column[c] = c;
     for (int c = 0; c < m; c++) {
         int pr = c, pc = c;
+        double best = fabs(A[c * m + c]);
         for (int r = c; r < m; r++)
-            for (int j = c; j < m; j++)
-                if (fabs(A[r * m + j]) > fabs(A[pr * m + pc])) { pr = r; pc = j; }
-        if (!(fabs(A[pr * m + pc]) > 1e-12 * largest)) { rank = c; break; }
+            for (int j = c; j < m; j++) {
+                double a = fabs(A[r * m + j]);
+                if (a > best) { best = a; pr = r; pc = j; }
+            }
+        if (!(best > 1e-12 * largest)) { rank = c; break; }
         if (pr != c) {
             for (int j = 0; j < m; j++) {
                 double t = A[c * m + j]; A[c * m + j] = A[pr * m + j]; A[pr * m + j] = t;
@@ -534,14 +553,12 @@ static int held_dense_solve(int m, double *A, double *b)
     return BALLC_OK;
 }
 
-/* The constraint forces (or impulses) of the held velocities ``h``: lambda solves
- * W lambda = target (W_ab = (dv_a/d speeds) M^-1 G_b, the Delassus matrix of all of
- * them), and M^-1 G lambda is added to ``speeds`` (6); each multiplier stored where its
- * row says (when ``store``). */
-static int hold_solve(const schur_t *factor, const held_t *h, const double *target,
-                      int store, double *speeds)
+/* hold_solve's body for k held velocities (inlined with k a constant below: the loops of
+ * the common sizes unrolled, the same operations in the same order). */
+static BALLC_ALWAYS_INLINE int hold_solve_k(const schur_t *factor, const held_t *h,
+                                            const double *target, int store, double *speeds,
+                                            const int k)
 {
-    const int k = h->k;
     double z[MAX_HELD][NU], W[MAX_HELD * MAX_HELD], lambda[MAX_HELD];
     for (int c = 0; c < k; c++) {
         for (int i = 0; i < NU; i++) z[c][i] = h->G[c][i];
@@ -563,6 +580,22 @@ static int hold_solve(const schur_t *factor, const held_t *h, const double *targ
     return BALLC_OK;
 }
 
+/* The constraint forces (or impulses) of the held velocities ``h``: lambda solves
+ * W lambda = target (W_ab = (dv_a/d speeds) M^-1 G_b, the Delassus matrix of all of
+ * them), and M^-1 G lambda is added to ``speeds`` (6); each multiplier stored where its
+ * row says (when ``store``). */
+static int hold_solve(const schur_t *factor, const held_t *h, const double *target,
+                      int store, double *speeds)
+{
+    switch (h->k) {   /* a sticking plane holding its rolling: 4 (and its twisting: 5) */
+    case 2: return hold_solve_k(factor, h, target, store, speeds, 2);
+    case 3: return hold_solve_k(factor, h, target, store, speeds, 3);
+    case 4: return hold_solve_k(factor, h, target, store, speeds, 4);
+    case 5: return hold_solve_k(factor, h, target, store, speeds, 5);
+    default: return hold_solve_k(factor, h, target, store, speeds, h->k);
+    }
+}
+
 /* udot (6) and the auxiliary rates.  A sticking plane's constraint force lambda makes
  * du/dt = 0: lambda = -W^-1 (du/d speeds) udot_0, udot = udot_0 + z lambda; several
  * sticking planes at once (a ball resting in a wedge's corner) are solved jointly, with
@@ -582,8 +615,9 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
         held |= ballc_rolling_held(&ev->rolling[plane]);
     }
     if (held) {   /* rolling resistance holds: every held velocity of every plane at once */
-        held_t h = {0};
+        held_t h;   /* rows 0 .. h.k - 1 written as they are added: ~2 KB not zeroed */
         double target[MAX_HELD];
+        h.k = 0;
         for (int plane = 0; plane < np; plane++) {
             if (ev->mode[plane] == MODE_STICK)
                 hold_slip(&h, &ev->slip[plane], ns, ev->lambda[plane]);
