@@ -2,6 +2,7 @@
  * plane's frame, _plane.h), solves M udot = F. */
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "_system.h"
@@ -148,12 +149,14 @@ typedef struct {
     double D, inverse_D;
 } schur_t;
 
-/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one (four sums:
- * one chain of additions would wait on each, and this runs twice per right-hand side). */
+/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one.  Two
+ * pairs of sums (one chain of additions would wait on each; this runs twice per
+ * right-hand side and on every Jacobian), with a pointer-sized index: under Python's
+ * -fwrapv an int index keeps the compiler from pairing them into vector adds. */
 static int all_finite(const double *v, int n)
 {
     double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    int i = 0;
+    ptrdiff_t i = 0;
     for (; i + 4 <= n; i += 4) {
         s0 += v[i] - v[i];
         s1 += v[i + 1] - v[i + 1];
@@ -360,8 +363,9 @@ static int schur_factor(const double *mass, schur_t *f)
     return BALLC_OK;
 }
 
-/* Solve M z = b in place (b: 6 = [b_omega; b_v]). */
-static void schur_solve(const schur_t *f, double *b)
+/* Solve M z = b in place (b: 6 = [b_omega; b_v]).  Inlined where its columns come in a
+ * batch (hold_solve): the columns' operations interleave. */
+static BALLC_ALWAYS_INLINE void schur_solve_inline(const schur_t *f, double *b)
 {
     const double *B = f->B, *L = f->L, *Li = f->Linv;
     double *bw = b, *bv = b + 3;
@@ -379,6 +383,11 @@ static void schur_solve(const schur_t *f, double *b)
     bw[0] = w0; bw[1] = w1; bw[2] = w2;
     for (int j = 0; j < 3; j++)
         bv[j] = (bv[j] - (B[j]*w0 + B[3+j]*w1 + B[6+j]*w2)) * f->inverse_D;
+}
+
+static void schur_solve(const schur_t *f, double *b)
+{
+    schur_solve_inline(f, b);
 }
 
 /* Responses of a sticking plane: z_k = M^-1 G_t e_k (6 x 2, column k at z[k]) and the
@@ -562,7 +571,7 @@ static BALLC_ALWAYS_INLINE int hold_solve_k(const schur_t *factor, const held_t 
     double z[MAX_HELD][NU], W[MAX_HELD * MAX_HELD], lambda[MAX_HELD];
     for (int c = 0; c < k; c++) {
         for (int i = 0; i < NU; i++) z[c][i] = h->G[c][i];
-        schur_solve(factor, z[c]);
+        schur_solve_inline(factor, z[c]);
     }
     for (int a = 0; a < k; a++)
         for (int c = 0; c < k; c++) {
