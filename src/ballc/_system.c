@@ -814,21 +814,29 @@ int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t 
 int ballc_stick_state(const double *state, const double *params, const double *latch,
                       ballc_flags flags, int plane, double *out)
 {
+    for (int i = 0; i < 4; i++) out[i] = NAN;
+    ballc_parameters_t prepared;
+    if (!prepare(params, latch, &prepared)) return BALLC_NOT_FINITE;
+    return ballc_stick_state_prepared(state, &prepared, latch, flags, plane, out);
+}
+
+int ballc_stick_state_prepared(const double *state, const ballc_parameters_t *params,
+                               const double *latch, ballc_flags flags, int plane, double *out)
+{
     schur_t factor;
     evaluation_t ev;
     double udot[NU];
     for (int i = 0; i < 4; i++) out[i] = NAN;
-    ballc_parameters_t prepared;
-    if (!prepare(params, latch, &prepared)) return BALLC_NOT_FINITE;
-    if (plane < 0 || plane >= prepared.n_planes || exact_mode(flags, plane) != MODE_STICK)
+    if (plane < 0 || plane >= params->n_planes || exact_mode(flags, plane) != MODE_STICK)
         return BALLC_SINGULAR;
-    if (!all_finite(state, prepared.n_states)) return BALLC_NOT_FINITE;
-    int status = accelerations(state, &prepared, latch, flags, &factor, &ev, udot, NULL);
+    if (!all_finite(state, params->n_states) || !all_finite(latch, params->n_latch))
+        return BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
     out[0] = ev.lambda[plane][0];
     out[1] = ev.lambda[plane][1];
     out[2] = ev.load[plane];
-    out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]
+    out[3] = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]
              - hypot(out[0], out[1]);
     return all_finite(out, 4) ? BALLC_OK : BALLC_NOT_FINITE;
 }
