@@ -177,8 +177,8 @@ DEFECTS = [
            tests=("tests/test_sweep.py::"
                   "test_rows_follow_the_grid_whatever_order_the_runs_complete_in",)),
     Defect("Coulomb cone off by 2 (stick holds until |lambda| = 2 mu N)", "src/ballc/_system.c",
-           "    out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
-           "    out[3] = 2 * params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
+           "    out[3] = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
+           "    out[3] = 2 * params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]\n",
            tests=("tests/test_stickslip.py::test_stick_releases_where_the_coulomb_cone_says",)),
     Defect("compliant sliding: the rho'' share of ds_cap/dt left out (the contact's own "
            "acceleration only)", "src/ballc/_system.c",

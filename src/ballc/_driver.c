@@ -1049,7 +1049,8 @@ static int drv_event(void *ctx, int e, double t, const double *y, double *g)
         g[0] = r->margins_out[row];
         return st;
     }
-    int status = ballc_stick_state(y, r->c->params, r->latch, r->seg_flags, code, out);
+    int status = ballc_stick_state_prepared(y, &r->prepared, r->latch, r->seg_flags, code,
+                                            out);
     g[0] = out[3];
     return status;
 }

@@ -1,6 +1,8 @@
 /* See _system.h.  Hand-written glue: calls generated kernels (the contact laws in each
  * plane's frame, _plane.h), solves M udot = F. */
+#include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "_system.h"
@@ -12,6 +14,12 @@
 #define NU 6  /* speeds: angular velocity (3) and centre velocity (3) */
 #define NC BALLC_N_CONTACT_STATES
 #define MAXP BALLC_MAX_PLANES
+
+#if defined(__GNUC__)
+#define BALLC_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define BALLC_ALWAYS_INLINE inline
+#endif
 
 typedef void (*kernel_fn)(const double *restrict, const double *restrict,
                           const double *restrict, const double *restrict, double *restrict);
@@ -141,12 +149,22 @@ typedef struct {
     double D, inverse_D;
 } schur_t;
 
-/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one. */
+/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one.  Two
+ * pairs of sums (one chain of additions would wait on each; this runs twice per
+ * right-hand side and on every Jacobian), with a pointer-sized index: under Python's
+ * -fwrapv an int index keeps the compiler from pairing them into vector adds. */
 static int all_finite(const double *v, int n)
 {
-    double s = 0.0;
-    for (int i = 0; i < n; i++) s += v[i] - v[i];
-    return s == 0.0;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    ptrdiff_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        s0 += v[i] - v[i];
+        s1 += v[i + 1] - v[i + 1];
+        s2 += v[i + 2] - v[i + 2];
+        s3 += v[i + 3] - v[i + 3];
+    }
+    for (; i < n; i++) s0 += v[i] - v[i];
+    return (s0 + s1) + (s2 + s3) == 0.0;
 }
 
 /* The number of parameters of ``params`` (its plane table's count), or -1. */
@@ -345,8 +363,9 @@ static int schur_factor(const double *mass, schur_t *f)
     return BALLC_OK;
 }
 
-/* Solve M z = b in place (b: 6 = [b_omega; b_v]). */
-static void schur_solve(const schur_t *f, double *b)
+/* Solve M z = b in place (b: 6 = [b_omega; b_v]).  Inlined where its columns come in a
+ * batch (hold_solve): the columns' operations interleave. */
+static BALLC_ALWAYS_INLINE void schur_solve_inline(const schur_t *f, double *b)
 {
     const double *B = f->B, *L = f->L, *Li = f->Linv;
     double *bw = b, *bv = b + 3;
@@ -364,6 +383,11 @@ static void schur_solve(const schur_t *f, double *b)
     bw[0] = w0; bw[1] = w1; bw[2] = w2;
     for (int j = 0; j < 3; j++)
         bv[j] = (bv[j] - (B[j]*w0 + B[3+j]*w1 + B[6+j]*w2)) * f->inverse_D;
+}
+
+static void schur_solve(const schur_t *f, double *b)
+{
+    schur_solve_inline(f, b);
 }
 
 /* Responses of a sticking plane: z_k = M^-1 G_t e_k (6 x 2, column k at z[k]) and the
@@ -489,22 +513,26 @@ static void hold_rolling(held_t *h, ballc_rolling_eval *roll, int part, int ns)
  * velocity the others already hold -- a ball sticking on two planes at once, both
  * holding its rolling: their forces are then statically indeterminate, and this takes
  * one split of them).  BALLC_SINGULAR when A is not finite or is 0. */
-static int held_dense_solve(int m, double *A, double *b)
+static BALLC_ALWAYS_INLINE int held_dense_solve(int m, double *A, double *b)
 {
     int column[MAX_HELD], rank = m;
     double largest = 0.0;
     for (int i = 0; i < m * m; i++) {
-        if (!isfinite(A[i])) return BALLC_SINGULAR;
-        largest = fmax(largest, fabs(A[i]));
+        double a = fabs(A[i]);
+        if (!(a <= DBL_MAX)) return BALLC_SINGULAR;   /* not finite */
+        if (a > largest) largest = a;
     }
     if (!(largest > 0)) return BALLC_SINGULAR;
     for (int c = 0; c < m; c++) column[c] = c;
     for (int c = 0; c < m; c++) {
         int pr = c, pc = c;
+        double best = fabs(A[c * m + c]);
         for (int r = c; r < m; r++)
-            for (int j = c; j < m; j++)
-                if (fabs(A[r * m + j]) > fabs(A[pr * m + pc])) { pr = r; pc = j; }
-        if (!(fabs(A[pr * m + pc]) > 1e-12 * largest)) { rank = c; break; }
+            for (int j = c; j < m; j++) {
+                double a = fabs(A[r * m + j]);
+                if (a > best) { best = a; pr = r; pc = j; }
+            }
+        if (!(best > 1e-12 * largest)) { rank = c; break; }
         if (pr != c) {
             for (int j = 0; j < m; j++) {
                 double t = A[c * m + j]; A[c * m + j] = A[pr * m + j]; A[pr * m + j] = t;
@@ -534,18 +562,16 @@ static int held_dense_solve(int m, double *A, double *b)
     return BALLC_OK;
 }
 
-/* The constraint forces (or impulses) of the held velocities ``h``: lambda solves
- * W lambda = target (W_ab = (dv_a/d speeds) M^-1 G_b, the Delassus matrix of all of
- * them), and M^-1 G lambda is added to ``speeds`` (6); each multiplier stored where its
- * row says (when ``store``). */
-static int hold_solve(const schur_t *factor, const held_t *h, const double *target,
-                      int store, double *speeds)
+/* hold_solve's body for k held velocities (inlined with k a constant below: the loops of
+ * the common sizes unrolled, the same operations in the same order). */
+static BALLC_ALWAYS_INLINE int hold_solve_k(const schur_t *factor, const held_t *h,
+                                            const double *target, int store, double *speeds,
+                                            const int k)
 {
-    const int k = h->k;
     double z[MAX_HELD][NU], W[MAX_HELD * MAX_HELD], lambda[MAX_HELD];
     for (int c = 0; c < k; c++) {
         for (int i = 0; i < NU; i++) z[c][i] = h->G[c][i];
-        schur_solve(factor, z[c]);
+        schur_solve_inline(factor, z[c]);
     }
     for (int a = 0; a < k; a++)
         for (int c = 0; c < k; c++) {
@@ -561,6 +587,22 @@ static int hold_solve(const schur_t *factor, const held_t *h, const double *targ
         if (store && h->lambda[c]) *h->lambda[c] = lambda[c];
     }
     return BALLC_OK;
+}
+
+/* The constraint forces (or impulses) of the held velocities ``h``: lambda solves
+ * W lambda = target (W_ab = (dv_a/d speeds) M^-1 G_b, the Delassus matrix of all of
+ * them), and M^-1 G lambda is added to ``speeds`` (6); each multiplier stored where its
+ * row says (when ``store``). */
+static int hold_solve(const schur_t *factor, const held_t *h, const double *target,
+                      int store, double *speeds)
+{
+    switch (h->k) {   /* a sticking plane holding its rolling: 4 (and its twisting: 5) */
+    case 2: return hold_solve_k(factor, h, target, store, speeds, 2);
+    case 3: return hold_solve_k(factor, h, target, store, speeds, 3);
+    case 4: return hold_solve_k(factor, h, target, store, speeds, 4);
+    case 5: return hold_solve_k(factor, h, target, store, speeds, 5);
+    default: return hold_solve_k(factor, h, target, store, speeds, h->k);
+    }
 }
 
 /* udot (6) and the auxiliary rates.  A sticking plane's constraint force lambda makes
@@ -582,8 +624,9 @@ static int accelerations(const double *state, const ballc_parameters_t *params, 
         held |= ballc_rolling_held(&ev->rolling[plane]);
     }
     if (held) {   /* rolling resistance holds: every held velocity of every plane at once */
-        held_t h = {0};
+        held_t h;   /* rows 0 .. h.k - 1 written as they are added: ~2 KB not zeroed */
         double target[MAX_HELD];
+        h.k = 0;
         for (int plane = 0; plane < np; plane++) {
             if (ev->mode[plane] == MODE_STICK)
                 hold_slip(&h, &ev->slip[plane], ns, ev->lambda[plane]);
@@ -771,21 +814,29 @@ int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t 
 int ballc_stick_state(const double *state, const double *params, const double *latch,
                       ballc_flags flags, int plane, double *out)
 {
+    for (int i = 0; i < 4; i++) out[i] = NAN;
+    ballc_parameters_t prepared;
+    if (!prepare(params, latch, &prepared)) return BALLC_NOT_FINITE;
+    return ballc_stick_state_prepared(state, &prepared, latch, flags, plane, out);
+}
+
+int ballc_stick_state_prepared(const double *state, const ballc_parameters_t *params,
+                               const double *latch, ballc_flags flags, int plane, double *out)
+{
     schur_t factor;
     evaluation_t ev;
     double udot[NU];
     for (int i = 0; i < 4; i++) out[i] = NAN;
-    ballc_parameters_t prepared;
-    if (!prepare(params, latch, &prepared)) return BALLC_NOT_FINITE;
-    if (plane < 0 || plane >= prepared.n_planes || exact_mode(flags, plane) != MODE_STICK)
+    if (plane < 0 || plane >= params->n_planes || exact_mode(flags, plane) != MODE_STICK)
         return BALLC_SINGULAR;
-    if (!all_finite(state, prepared.n_states)) return BALLC_NOT_FINITE;
-    int status = accelerations(state, &prepared, latch, flags, &factor, &ev, udot, NULL);
+    if (!all_finite(state, params->n_states) || !all_finite(latch, params->n_latch))
+        return BALLC_NOT_FINITE;
+    int status = accelerations(state, params, latch, flags, &factor, &ev, udot, NULL);
     if (status != BALLC_OK) return status;
     out[0] = ev.lambda[plane][0];
     out[1] = ev.lambda[plane][1];
     out[2] = ev.load[plane];
-    out[3] = params[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]
+    out[3] = params->values[BALLC_PARAMETER_FRICTION_COEFFICIENT] * ev.load[plane]
              - hypot(out[0], out[1]);
     return all_finite(out, 4) ? BALLC_OK : BALLC_NOT_FINITE;
 }

@@ -188,6 +188,10 @@ int ballc_contact_forces_prepared(const double *state, const ballc_parameters_t 
  * stick-to-slip event); lambda along the plane's tangents t1, t2. */
 int ballc_stick_state(const double *state, const double *params, const double *latch,
                       ballc_flags flags, int plane, double *out);
+/* The same with the parameters prepared (the segment loop's stick-to-slip guard, at every
+ * step: the parameters are not prepared again per call); state and latch are checked. */
+int ballc_stick_state_prepared(const double *state, const ballc_parameters_t *params,
+                               const double *latch, ballc_flags flags, int plane, double *out);
 
 /* Rolling resistance (_rolling.h) of ``plane`` under ``flags`` and ``latch`` (its modes):
  * out = [lambda (3: the rolling force along t1, t2 and the twisting force that hold its
