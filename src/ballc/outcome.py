@@ -26,8 +26,8 @@ def came_back(result, after_contacts: int = CAME_BACK_AFTER_CONTACTS):
     is opposite to the initial x-velocity, False when it is not, None (undetermined)
     with fewer completed contacts or no initial x-velocity (see the module docstring)."""
     thrown = result.velocity[0, 0]
-    _, completed, _, after = _x_velocities(result)
-    done = np.flatnonzero(completed)[:after_contacts]
+    t_end, after = contact_columns(result, "t_end", "vx_after")
+    done = np.flatnonzero(np.isfinite(t_end))[:after_contacts]
     if len(done) < after_contacts or thrown == 0:
         return None
     return bool(np.sign(after[done[-1]]) == -np.sign(thrown))
@@ -49,31 +49,37 @@ def first_reversal(result):
 
 
 def _first_reversal_index(result):
-    _, _, before, after = _x_velocities(result)
+    before, after = contact_columns(result, "vx_before", "vx_after")
     reversed_ = np.flatnonzero(np.isfinite(after) & (before * after < 0))
     return int(reversed_[0]) if len(reversed_) else None
 
 
-def _x_velocities(result):
-    """(t_start, completed, x-velocity before, x-velocity after) of the run's contacts,
+#: contact_columns' names -> (the C loop's contact record, the Contact attribute, and
+#: the component of a vector: None for a number)
+_CONTACT_COLUMNS = {"t_start": ("t_start", "t_start", None),
+                    "t_end": ("t_end", "t_end", None),
+                    "vx_before": ("v_before", "velocity_before", 0),
+                    "vx_after": ("v_after", "velocity_after", 0)}
+
+
+def contact_columns(result, *names) -> list:
+    """The run's contacts' ``names`` (t_start, t_end (s), vx_before, vx_after (m/s)),
     one array each: from the C loop's contact records when the result has them (a run:
     no Contact object is built), else from its contacts (a Result read from a file)."""
+    columns = [_CONTACT_COLUMNS[name] for name in names]
     records = getattr(result, "_contact_records", None)
     if records is not None:
-        return (records["t_start"], np.isfinite(records["t_end"]),
-                records["v_before"][:, 0], records["v_after"][:, 0])
+        return [records[key] if i is None else records[key][:, i] for key, _, i in columns]
     contacts = result.contacts
-    return (np.array([c.t_start for c in contacts], dtype=float),
-            np.array([np.isfinite(c.t_end) for c in contacts], dtype=bool),
-            np.array([c.velocity_before[0] for c in contacts], dtype=float),
-            np.array([c.velocity_after[0] for c in contacts], dtype=float))
+    return [np.array([getattr(c, attribute) if i is None else getattr(c, attribute)[i]
+                      for c in contacts], dtype=float) for _, attribute, i in columns]
 
 
 def summary(result) -> dict:
     """Plain numbers of one run: contacts, came_back (True, False or None:
     undetermined), energies (J), solver status."""
     total = result.energy["total"]
-    t_start = _x_velocities(result)[0]
+    (t_start,) = contact_columns(result, "t_start")
     reversal = _first_reversal_index(result)
     return {
         "contacts": len(t_start),
