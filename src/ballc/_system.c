@@ -141,12 +141,21 @@ typedef struct {
     double D, inverse_D;
 } schur_t;
 
-/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one. */
+/* Branch-free: x - x is 0 for a finite x and NaN for an infinite or NaN one; the sum
+ * of them is 0 exactly when every entry is finite, in whatever order it is added: four
+ * partial sums, not one chain of dependent additions. */
 static int all_finite(const double *v, int n)
 {
-    double s = 0.0;
-    for (int i = 0; i < n; i++) s += v[i] - v[i];
-    return s == 0.0;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        s0 += v[i] - v[i];
+        s1 += v[i + 1] - v[i + 1];
+        s2 += v[i + 2] - v[i + 2];
+        s3 += v[i + 3] - v[i + 3];
+    }
+    for (; i < n; i++) s0 += v[i] - v[i];
+    return (s0 + s1) + (s2 + s3) == 0.0;
 }
 
 /* The number of parameters of ``params`` (its plane table's count), or -1. */
