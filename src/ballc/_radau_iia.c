@@ -441,9 +441,18 @@ int radau_iia_step(solver_t *s)
     s->dense_end = t_new;
     /* _compute_dense_output: Q = Z^T P (n x 3), stored transposed: row j holds the x^(j+1)
      * coefficients of the n states (the layout of the stored dense output) */
-    for (int c = 0; c < n; c++)
-        for (int j = 0; j < 3; j++)
-            s->Q[j * n + c] = Z[c] * k->P[0][j] + Z[n + c] * k->P[1][j] + Z[2 * n + c] * k->P[2][j];
+    {   /* P as locals: through k the compiler reloads it after every store to Q */
+        double *restrict Q = s->Q;
+        const double P00 = k->P[0][0], P01 = k->P[0][1], P02 = k->P[0][2],
+                     P10 = k->P[1][0], P11 = k->P[1][1], P12 = k->P[1][2],
+                     P20 = k->P[2][0], P21 = k->P[2][1], P22 = k->P[2][2];
+        for (int c = 0; c < n; c++) {
+            double z0 = Z[c], z1 = Z[n + c], z2 = Z[2 * n + c];
+            Q[c] = z0 * P00 + z1 * P10 + z2 * P20;
+            Q[n + c] = z0 * P01 + z1 * P11 + z2 * P21;
+            Q[2 * n + c] = z0 * P02 + z1 * P12 + z2 * P22;
+        }
+    }
     s->have_sol = 1;
     s->dense_dop853 = 0;
     s->r->nstep++;
