@@ -156,8 +156,9 @@ def balance_warning(result, rtol):
     """
     balance = result.energy["balance"]
     scale = max(abs(balance[0]), 1.0)
-    drift = float(np.max(np.abs(balance - balance[0])))
-    allowed = max(1e-6, min(1e3 * float(np.max(rtol)), MAX_BALANCE_DRIFT)) * scale
+    drift = float(np.abs(balance - balance[0]).max())
+    largest_rtol = rtol if type(rtol) is float else float(np.max(rtol))
+    allowed = max(1e-6, min(1e3 * largest_rtol, MAX_BALANCE_DRIFT)) * scale
     if not drift > allowed:
         return ""
     of = "the initial energy" if abs(balance[0]) >= 1.0 else "1 J"

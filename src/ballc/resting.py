@@ -96,7 +96,8 @@ def resting_plane_index(scene) -> int | None:
         return None
     down = scene.gravity_vector / g
     for i, plane in enumerate(scene.planes):
-        if float(np.linalg.norm(plane.unit_normal + down)) <= OPPOSITE_GRAVITY:
+        gap = plane.unit_normal + down
+        if math.sqrt(float(gap @ gap)) <= OPPOSITE_GRAVITY:
             return i
     return None
 

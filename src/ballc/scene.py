@@ -511,12 +511,11 @@ class Scene:
             "twisting_stiffness": self.twisting_stiffness or 0.0,
             "twisting_damping": self.twisting_damping or 0.0,
             # the plane table: its count, then a point and a normal (towards the ball) per
-            # plane
+            # plane, in PLANE_FIELD_NAMES' order (point x, y, z, normal x, y, z)
             "plane_count": len(self.planes),
-            **{name: value for plane, label in zip(self.planes, self.plane_names)
-               for name, value in _plane_entries(label, plane.point, plane.normal).items()},
         }
-        return np.array([float(values[name]) for name in self.parameter_names])
+        return np.array([float(values[name]) for name in _core.BASE_PARAMETER_NAMES]
+                        + [v for plane in self.planes for v in (*plane.point, *plane.normal)])
 
     def initial_state(self) -> np.ndarray:
         """State vector in the generated layout order (:attr:`state_names`); a fresh copy
@@ -542,15 +541,15 @@ _state_names = functools.lru_cache(maxsize=256)(_core.state_names)
 _parameter_names = functools.lru_cache(maxsize=256)(_core.parameter_names)
 _latch_names = functools.lru_cache(maxsize=256)(_core.latch_names)
 
+# Scene._parameters writes each plane's point, then its normal: the generated order.
+if _core.PLANE_FIELD_NAMES != tuple(f"{what}_{axis}" for what in ("point", "normal")
+                                    for axis in "xyz"):
+    raise ImportError(f"the generated plane fields {_core.PLANE_FIELD_NAMES} are not point "
+                      "x, y, z then normal x, y, z, the order Scene._parameters writes")
+
 #: The Scene fields' names, in order (dataclasses.fields is slow to ask every time).
 _FIELD_NAMES = tuple(f.name for f in fields(Scene))
 _FIELD_SET = frozenset(_FIELD_NAMES)
-
-
-def _plane_entries(plane: str, point, normal) -> dict:
-    """A plane's entries of the parameter vector (its point and normal)."""
-    names = _core.PLANE_FIELD_NAMES
-    return {f"{plane}_{name}": value for name, value in zip(names, (*point, *normal))}
 
 
 def _seed_form(planes) -> bool:
