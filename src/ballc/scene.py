@@ -343,7 +343,8 @@ class Scene:
         # every field is a number, a string, None or a tuple of floats (__post_init__):
         # immutable, so a shallow copy is asdict's (whose deep copy cost a sweep of the
         # 100 x 100 map ~1 s in its parent process)
-        values = {name: getattr(self, name) for name in _FIELD_NAMES}
+        mine = self.__dict__   # (a frozen dataclass keeps its fields there)
+        values = {name: mine[name] for name in _FIELD_NAMES}
         for name in getattr(self, "_derived", ()):
             values[name] = None     # computed from another field: not an input
         # the seed's planes are the shorthand's (ceiling_height); given planes as tables
