@@ -32,7 +32,26 @@ void radau_iia_init_constants(constants_t *k)
     memcpy(k->T, T, sizeof T);
     memcpy(k->TI, TI, sizeof TI);
     memcpy(k->P, P, sizeof P);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) k->PT[i][j] = P[j][i];
     for (int j = 0; j < 3; j++) k->ti_complex[j] = TI[1][j] + I * TI[2][j];
+}
+
+/* out = M x for three stage vectors of n states each (x and out: 3 x n, row by stage):
+ * out[i n + c] = M[i][0] x[c] + M[i][1] x[n + c] + M[i][2] x[2 n + c], in that order.
+ * M's entries as locals: through a pointer the compiler reloads them after every store. */
+static inline void stage_combination(int n, const double M[3][3], const double *restrict x,
+                                     double *restrict out)
+{
+    const double m00 = M[0][0], m01 = M[0][1], m02 = M[0][2],
+                 m10 = M[1][0], m11 = M[1][1], m12 = M[1][2],
+                 m20 = M[2][0], m21 = M[2][1], m22 = M[2][2];
+    for (int c = 0; c < n; c++) {
+        double x0 = x[c], x1 = x[n + c], x2 = x[2 * n + c];
+        out[c] = m00 * x0 + m01 * x1 + m02 * x2;
+        out[n + c] = m10 * x0 + m11 * x1 + m12 * x2;
+        out[2 * n + c] = m20 * x0 + m21 * x1 + m22 * x2;
+    }
 }
 
 /* Split the states into coupled ones (a nonzero entry in their column of J) and
@@ -158,20 +177,10 @@ static int solve_collocation(solver_t *s, double t, double h, double *restrict Z
     double *restrict W = s->W, *restrict F = s->F, *restrict dW = s->dW, *restrict yi = s->tmp;
     const double *restrict inv_scale = s->inv_scale;
     cplx *restrict fc = s->ctmp;
-    /* the transformation matrices as locals: the stage loops below then keep them in
-     * registers (through k the compiler reloads them for every element) */
-    const double T00 = k->T[0][0], T01 = k->T[0][1], T02 = k->T[0][2],
-                 T10 = k->T[1][0], T11 = k->T[1][1], T12 = k->T[1][2],
-                 T20 = k->T[2][0], T21 = k->T[2][1], T22 = k->T[2][2];
-    const double Ti00 = k->TI[0][0], Ti01 = k->TI[0][1], Ti02 = k->TI[0][2],
-                 Ti10 = k->TI[1][0], Ti11 = k->TI[1][1], Ti12 = k->TI[1][2],
-                 Ti20 = k->TI[2][0], Ti21 = k->TI[2][1], Ti22 = k->TI[2][2];
-    for (int c = 0; c < n; c++) {
-        double z0 = Z[c], z1 = Z[n + c], z2 = Z[2 * n + c];
-        W[c] = Ti00 * z0 + Ti01 * z1 + Ti02 * z2;
-        W[n + c] = Ti10 * z0 + Ti11 * z1 + Ti12 * z2;
-        W[2 * n + c] = Ti20 * z0 + Ti21 * z1 + Ti22 * z2;
-    }
+    /* TI's first row as locals: the stage loop below keeps them in registers (through k
+     * the compiler reloads them for every element) */
+    const double Ti00 = k->TI[0][0], Ti01 = k->TI[0][1], Ti02 = k->TI[0][2];
+    stage_combination(n, k->TI, Z, W);
     const cplx tc0 = k->ti_complex[0], tc1 = k->ti_complex[1], tc2 = k->ti_complex[2];
     double dW_norm_old = 0, rate = 0, theta = 0, rate_prev = 0;
     int have_old = 0, have_rate = 0, converged = 0, it;
@@ -214,12 +223,7 @@ static int solve_collocation(solver_t *s, double t, double h, double *restrict Z
                           pow(rate, maxiter - it) / (1 - rate) * dW_norm > s->newton_tol))
             break;
         for (int i = 0; i < 3 * n; i++) W[i] += dW[i];
-        for (int c = 0; c < n; c++) {
-            double w0 = W[c], w1 = W[n + c], w2 = W[2 * n + c];
-            Z[c] = T00 * w0 + T01 * w1 + T02 * w2;
-            Z[n + c] = T10 * w0 + T11 * w1 + T12 * w2;
-            Z[2 * n + c] = T20 * w0 + T21 * w1 + T22 * w2;
-        }
+        stage_combination(n, k->T, W, Z);
         if (dW_norm == 0 || (have_rate && rate / (1 - rate) * dW_norm < s->newton_tol)) {
             converged = 1;
             break;
@@ -441,18 +445,7 @@ int radau_iia_step(solver_t *s)
     s->dense_end = t_new;
     /* _compute_dense_output: Q = Z^T P (n x 3), stored transposed: row j holds the x^(j+1)
      * coefficients of the n states (the layout of the stored dense output) */
-    {   /* P as locals: through k the compiler reloads it after every store to Q */
-        double *restrict Q = s->Q;
-        const double P00 = k->P[0][0], P01 = k->P[0][1], P02 = k->P[0][2],
-                     P10 = k->P[1][0], P11 = k->P[1][1], P12 = k->P[1][2],
-                     P20 = k->P[2][0], P21 = k->P[2][1], P22 = k->P[2][2];
-        for (int c = 0; c < n; c++) {
-            double z0 = Z[c], z1 = Z[n + c], z2 = Z[2 * n + c];
-            Q[c] = z0 * P00 + z1 * P10 + z2 * P20;
-            Q[n + c] = z0 * P01 + z1 * P11 + z2 * P21;
-            Q[2 * n + c] = z0 * P02 + z1 * P12 + z2 * P22;
-        }
-    }
+    stage_combination(n, k->PT, Z, s->Q);
     s->have_sol = 1;
     s->dense_dop853 = 0;
     s->r->nstep++;

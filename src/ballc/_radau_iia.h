@@ -14,6 +14,7 @@
 /* radau.py module constants (computed as scipy computes them). */
 typedef struct {
     double C[3], E[3], T[3][3], TI[3][3], P[3][3];
+    double PT[3][3];   /* P transposed: the dense output's coefficients per stage */
     double mu_real;
     double _Complex mu_complex, ti_complex[3];
 } radau_iia_constants;
