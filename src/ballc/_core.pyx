@@ -517,15 +517,8 @@ def rolling_state(const double[::1] y, const double[::1] params, const double[::
     the twisting margin mu_t F_n - |lambda_w| (N), the rolling velocity (2, m/s), the
     twisting velocity (m/s)); raises if it cannot be evaluated (the plane must be in
     contact under ``flags``)."""
-    _check_plane_call(y, params, latch, plane)
-    cdef ballc_parameters_t prepared
-    ballc_parameters_init(&prepared, &params[0])
-    out = np.empty(BALLC_ROLLING_STATE_NOUT)
-    cdef double[::1] o = out
-    cdef int status = ballc_rolling_state(&y[0], &prepared, &latch[0], flags, plane, &o[0])
-    if status != BALLC_OK:
-        raise FloatingPointError(f"rolling state failed with C status {status}")
-    return out
+    return _rolling_call(ballc_rolling_state, BALLC_ROLLING_STATE_NOUT, "rolling state",
+                         y, params, latch, flags, plane)
 
 
 def rolling_margins(const double[::1] y, const double[::1] params, const double[::1] latch,
@@ -534,14 +527,28 @@ def rolling_margins(const double[::1] y, const double[::1] params, const double[
     (rolling, twisting): yield margin 1 - k |xi| / (mu F_n), re-stick margin (m/s, with
     the penetration acceleration of the dynamics under ``flags`` and ``latch``) and the
     deflection at the cap mu F_n / k (m)."""
+    return _rolling_call(ballc_rolling_margins, BALLC_SDS_MARGINS, "rolling margins",
+                         y, params, latch, flags, plane)
+
+
+ctypedef int (*_rolling_entry)(const double *, const ballc_parameters_t *, const double *,
+                               ballc_flags, int, double *) nogil
+
+
+cdef object _rolling_call(_rolling_entry entry, int n_out, str what, const double[::1] y,
+                          const double[::1] params, const double[::1] latch, long long flags,
+                          int plane):
+    """rolling_state's and rolling_margins' bridge: the inputs checked, the parameters
+    prepared, ``entry`` called on ``plane``; its ``n_out`` outputs, or raises naming
+    ``what``."""
     _check_plane_call(y, params, latch, plane)
     cdef ballc_parameters_t prepared
     ballc_parameters_init(&prepared, &params[0])
-    out = np.empty(BALLC_SDS_MARGINS)
+    out = np.empty(n_out)
     cdef double[::1] o = out
-    cdef int status = ballc_rolling_margins(&y[0], &prepared, &latch[0], flags, plane, &o[0])
+    cdef int status = entry(&y[0], &prepared, &latch[0], flags, plane, &o[0])
     if status != BALLC_OK:
-        raise FloatingPointError(f"rolling margins failed with C status {status}")
+        raise FloatingPointError(f"{what} failed with C status {status}")
     return out
 
 

@@ -416,6 +416,26 @@ static int stick_response(const schur_t *factor, const slip_t *slip, int ns,
     return BALLC_OK;
 }
 
+/* The two eliminations below (dense_solve, held_dense_solve) differ in their pivoting;
+ * these are their common steps.  Swap rows c and p of A (m x m, row-major) and of b. */
+static inline void swap_rows(int m, double *A, double *b, int c, int p)
+{
+    for (int j = 0; j < m; j++) {
+        double t = A[c * m + j]; A[c * m + j] = A[p * m + j]; A[p * m + j] = t;
+    }
+    double t = b[c]; b[c] = b[p]; b[p] = t;
+}
+
+/* Eliminate column c below the pivot A(c, c): rows c + 1 .. m - 1 of A and b. */
+static inline void eliminate_below(int m, double *A, double *b, int c)
+{
+    for (int r = c + 1; r < m; r++) {
+        double f = A[r * m + c] / A[c * m + c];
+        for (int j = c; j < m; j++) A[r * m + j] -= f * A[c * m + j];
+        b[r] -= f * b[c];
+    }
+}
+
 /* Solve the dense m x m system A x = b (A row-major, m <= MAX_HELD) in place by Gaussian
  * elimination with partial pivoting: b becomes x.  BALLC_SINGULAR when a pivot is 0. */
 static int dense_solve(int m, double *A, double *b)
@@ -425,17 +445,8 @@ static int dense_solve(int m, double *A, double *b)
         for (int r = c + 1; r < m; r++)
             if (fabs(A[r * m + c]) > fabs(A[pivot * m + c])) pivot = r;
         if (!(fabs(A[pivot * m + c]) > 0) || !isfinite(A[pivot * m + c])) return BALLC_SINGULAR;
-        if (pivot != c) {
-            for (int j = 0; j < m; j++) {
-                double t = A[c * m + j]; A[c * m + j] = A[pivot * m + j]; A[pivot * m + j] = t;
-            }
-            double t = b[c]; b[c] = b[pivot]; b[pivot] = t;
-        }
-        for (int r = c + 1; r < m; r++) {
-            double f = A[r * m + c] / A[c * m + c];
-            for (int j = c; j < m; j++) A[r * m + j] -= f * A[c * m + j];
-            b[r] -= f * b[c];
-        }
+        if (pivot != c) swap_rows(m, A, b, c, pivot);
+        eliminate_below(m, A, b, c);
     }
     for (int c = m - 1; c >= 0; c--) {
         double s = b[c];
@@ -533,23 +544,14 @@ static BALLC_ALWAYS_INLINE int held_dense_solve(int m, double *A, double *b)
                 if (a > best) { best = a; pr = r; pc = j; }
             }
         if (!(best > 1e-12 * largest)) { rank = c; break; }
-        if (pr != c) {
-            for (int j = 0; j < m; j++) {
-                double t = A[c * m + j]; A[c * m + j] = A[pr * m + j]; A[pr * m + j] = t;
-            }
-            double t = b[c]; b[c] = b[pr]; b[pr] = t;
-        }
+        if (pr != c) swap_rows(m, A, b, c, pr);
         if (pc != c) {
             for (int r = 0; r < m; r++) {
                 double t = A[r * m + c]; A[r * m + c] = A[r * m + pc]; A[r * m + pc] = t;
             }
             int t = column[c]; column[c] = column[pc]; column[pc] = t;
         }
-        for (int r = c + 1; r < m; r++) {
-            double f = A[r * m + c] / A[c * m + c];
-            for (int j = c; j < m; j++) A[r * m + j] -= f * A[c * m + j];
-            b[r] -= f * b[c];
-        }
+        eliminate_below(m, A, b, c);
     }
     double x[MAX_HELD];
     for (int c = m - 1; c >= 0; c--) {
