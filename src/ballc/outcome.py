@@ -25,8 +25,12 @@ def came_back(result, after_contacts: int = CAME_BACK_AFTER_CONTACTS):
     """True when the x-velocity after the first ``after_contacts`` completed contacts
     is opposite to the initial x-velocity, False when it is not, None (undetermined)
     with fewer completed contacts or no initial x-velocity (see the module docstring)."""
-    thrown = result.velocity[0, 0]
-    t_end, after = contact_columns(result, "t_end", "vx_after")
+    return _came_back(result.velocity[0, 0], *contact_columns(result, "t_end", "vx_after"),
+                      after_contacts)
+
+
+def _came_back(thrown, t_end, after, after_contacts):
+    """came_back from the throw's x-velocity and the contacts' t_end and x-velocity after."""
     done = np.flatnonzero(np.isfinite(t_end))[:after_contacts]
     if len(done) < after_contacts or thrown == 0:
         return None
@@ -44,12 +48,12 @@ def verdict(came, after_contacts: int = CAME_BACK_AFTER_CONTACTS) -> str:
 
 def first_reversal(result):
     """The first contact at which the x-velocity changed sign, or None."""
-    k = _first_reversal_index(result)
+    k = _first_reversal(*contact_columns(result, "vx_before", "vx_after"))
     return None if k is None else result.contacts[k]
 
 
-def _first_reversal_index(result):
-    before, after = contact_columns(result, "vx_before", "vx_after")
+def _first_reversal(before, after):
+    """The index of the first contact whose x-velocity changed sign, or None."""
     reversed_ = np.flatnonzero(np.isfinite(after) & (before * after < 0))
     return int(reversed_[0]) if len(reversed_) else None
 
@@ -79,11 +83,12 @@ def summary(result) -> dict:
     """Plain numbers of one run: contacts, came_back (True, False or None:
     undetermined), energies (J), solver status."""
     total = result.energy["total"]
-    (t_start,) = contact_columns(result, "t_start")
-    reversal = _first_reversal_index(result)
+    t_start, t_end, before, after = contact_columns(result, "t_start", "t_end", "vx_before",
+                                                    "vx_after")
+    reversal = _first_reversal(before, after)
     return {
         "contacts": len(t_start),
-        "came_back": came_back(result),
+        "came_back": _came_back(result.velocity[0, 0], t_end, after, CAME_BACK_AFTER_CONTACTS),
         "first_reversal_time": (float(t_start[reversal]) if reversal is not None
                                 else float("nan")),                              # s
         "energy_initial": float(total[0]),                                       # J

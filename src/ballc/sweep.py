@@ -18,7 +18,6 @@ carries the rows finished so far.
 from __future__ import annotations
 
 import contextlib
-import gc
 import inspect
 import itertools
 import math
@@ -337,10 +336,6 @@ def _start_worker():
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     threading.Thread(target=_end_with_parent, args=(os.getppid(),), daemon=True,
                      name="ballc-sweep-parent-watch").start()
-    # What the worker inherited from its parent (numpy, scipy, pandas, the tasks' module
-    # state) outlives every run: the cyclic collector need not walk it again and again
-    # (Python's advice for forked workers; it also spares the pages fork shares)
-    gc.freeze()
 
 
 def _end_with_parent(parent: int):
